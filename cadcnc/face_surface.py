@@ -1,0 +1,262 @@
+"""One B-rep face as a parametric surface r(u, w): derivatives, normals, curvature, trims.
+
+This is the fence around OpenCASCADE for everything surface-related: the interpolator
+takes the plain numbers this module returns. Parameters are the surface's native (u, w)
+(OCCT's (U, V)); lengths are mm, curvatures 1/mm. The normal points out of the material:
+r_u x r_w normalised, flipped when the face is REVERSED in its shell.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.BRepTools import BRepTools
+from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
+from OCP.GeomAbs import (
+    GeomAbs_BezierSurface,
+    GeomAbs_BSplineSurface,
+    GeomAbs_Cone,
+    GeomAbs_Cylinder,
+    GeomAbs_OffsetSurface,
+    GeomAbs_Plane,
+    GeomAbs_Sphere,
+    GeomAbs_SurfaceOfExtrusion,
+    GeomAbs_SurfaceOfRevolution,
+    GeomAbs_Torus,
+)
+from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
+from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
+from OCP.TopoDS import TopoDS, TopoDS_Face
+
+from . import differential as dg
+from .errors import InputError, SingularPointError
+from .tolerances import DEFAULT, Tolerances
+
+SURFACE_KINDS = {
+    GeomAbs_Plane: "plane",
+    GeomAbs_Cylinder: "cylinder",
+    GeomAbs_Cone: "cone",
+    GeomAbs_Sphere: "sphere",
+    GeomAbs_Torus: "torus",
+    GeomAbs_BezierSurface: "bezier",
+    GeomAbs_BSplineSurface: "bspline",
+    GeomAbs_SurfaceOfRevolution: "revolution",
+    GeomAbs_SurfaceOfExtrusion: "extrusion",
+    GeomAbs_OffsetSurface: "offset",
+}
+
+INSIDE, ON_BOUNDARY, OUTSIDE = "inside", "boundary", "outside"
+
+
+@dataclass(frozen=True)
+class Derivatives:
+    """r and its partial derivatives at (u, w); each a (3,) float array in mm."""
+
+    r: np.ndarray
+    ru: np.ndarray
+    rw: np.ndarray
+    ruu: np.ndarray
+    ruw: np.ndarray
+    rww: np.ndarray
+
+
+def as_topods_face(face) -> TopoDS_Face:
+    """Accept a CadQuery ``Face``, a ``TopoDS_Face`` or a ``FaceSurface``."""
+    if isinstance(face, FaceSurface):
+        return face.topods
+    wrapped = getattr(face, "wrapped", face)
+    if isinstance(wrapped, TopoDS_Face):
+        return wrapped
+    try:
+        return TopoDS.Face_s(wrapped)
+    except Exception as exc:  # OCP raises Standard_TypeMismatch for non-faces
+        raise InputError(f"expected a face, got {type(face).__name__}") from exc
+
+
+class FaceSurface:
+    """A trimmed B-rep face viewed as r(u, w) with its outward (cutter-side) normal.
+
+    ``number`` is the 1-based face number in the owning part (None for a loose face).
+    """
+
+    def __init__(self, face, number: int | None = None, tol: Tolerances = DEFAULT,
+                 part=None):
+        self.topods = as_topods_face(face)
+        self.number = number
+        self.part = part
+        self.tol = tol
+        self._adaptor = BRepAdaptor_Surface(self.topods, True)
+        self.kind = SURFACE_KINDS.get(self._adaptor.GetType(), "other")
+        self.reversed = self.topods.Orientation() == TopAbs_REVERSED
+        self._sign = -1.0 if self.reversed else 1.0
+        umin, umax, wmin, wmax = BRepTools.UVBounds_s(self.topods)
+        self.u_range = (umin, umax)
+        self.w_range = (wmin, wmax)
+        self.u_period = self._adaptor.UPeriod() if self._adaptor.IsUPeriodic() else None
+        self.w_period = self._adaptor.VPeriod() if self._adaptor.IsVPeriodic() else None
+        self._classifier = None
+        # scratch objects reused by every evaluation (keeps allocation out of hot loops)
+        self._p = gp_Pnt()
+        self._v = [gp_Vec() for _ in range(9)]
+
+    def __repr__(self) -> str:
+        name = f"Face{self.number}" if self.number else "face"
+        return f"<FaceSurface {name} {self.kind}{' reversed' if self.reversed else ''}>"
+
+    # -- parameters -------------------------------------------------------------------
+    @property
+    def periodic(self) -> tuple[bool, bool]:
+        return self.u_period is not None, self.w_period is not None
+
+    def wrap(self, u: float, w: float) -> tuple[float, float]:
+        """Wrap periodic parameters into [min, min + period) of the face's range."""
+        if self.u_period is not None:
+            u = self.u_range[0] + (u - self.u_range[0]) % self.u_period
+        if self.w_period is not None:
+            w = self.w_range[0] + (w - self.w_range[0]) % self.w_period
+        return u, w
+
+    def classify(self, u: float, w: float) -> str:
+        """Whether (u, w) lies inside the trimmed face, on its boundary, or outside."""
+        if self._classifier is None:
+            self._classifier = BRepTopAdaptor_FClass2d(self.topods, self.tol.on_boundary)
+        state = self._classifier.Perform(gp_Pnt2d(*self.wrap(u, w)))
+        if state == TopAbs_IN:
+            return INSIDE
+        return ON_BOUNDARY if state == TopAbs_ON else OUTSIDE
+
+    def contains(self, u: float, w: float) -> bool:
+        """True for points inside the trimmed face or on its boundary."""
+        return self.classify(u, w) != OUTSIDE
+
+    # -- evaluation ---------------------------------------------------------------------
+    def point(self, u: float, w: float) -> np.ndarray:
+        """r(u, w), (3,) mm."""
+        self._adaptor.D0(u, w, self._p)
+        return np.array(self._p.Coord())
+
+    def derivatives(self, u: float, w: float) -> Derivatives:
+        """r, r_u, r_w, r_uu, r_uw, r_ww at (u, w) (OCCT's D2)."""
+        p, v = self._p, self._v
+        self._adaptor.D2(u, w, p, v[0], v[1], v[2], v[3], v[4])
+        # OCCT order: D1U, D1V, D2U, D2V, D2UV
+        return Derivatives(
+            np.array(p.Coord()), np.array(v[0].Coord()), np.array(v[1].Coord()),
+            np.array(v[2].Coord()), np.array(v[4].Coord()), np.array(v[3].Coord()),
+        )
+
+    def derivatives_array(self, u: float, w: float, out: np.ndarray) -> np.ndarray:
+        """Fill ``out`` ((6, 3) float) with r, r_u, r_w, r_uu, r_uw, r_ww; the fast path."""
+        p, v = self._p, self._v
+        self._adaptor.D2(u, w, p, v[0], v[1], v[2], v[3], v[4])
+        out[0] = p.Coord()
+        out[1] = v[0].Coord()
+        out[2] = v[1].Coord()
+        out[3] = v[2].Coord()
+        out[4] = v[4].Coord()
+        out[5] = v[3].Coord()
+        return out
+
+    def derivative_tuples(self, u: float, w: float) -> tuple:
+        """(r, r_u, r_w, r_uu, r_uw, r_ww) as float 3-tuples: the interpolator's hot path."""
+        p, v = self._p, self._v
+        self._adaptor.D2(u, w, p, v[0], v[1], v[2], v[3], v[4])
+        return p.Coord(), v[0].Coord(), v[1].Coord(), v[2].Coord(), v[4].Coord(), v[3].Coord()
+
+    @property
+    def normal_sign(self) -> float:
+        """+1, or -1 on a REVERSED face: multiplies r_u x r_w into the outward normal."""
+        return self._sign
+
+    def project(self, point, within_face_box: bool = True) -> tuple[float, float, float]:
+        """(u, w, distance mm) of the nearest point of the surface to ``point``.
+
+        OCCT's exact projection (GeomAPI_ProjectPointOnSurf), restricted to the face's
+        parameter box when ``within_face_box``. Raises GeometryError when it finds none.
+        """
+        from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
+
+        pnt = gp_Pnt(*map(float, point))
+        if within_face_box:
+            proj = GeomAPI_ProjectPointOnSurf(pnt, self.geom_surface, *self.u_range,
+                                              *self.w_range)
+        else:
+            proj = GeomAPI_ProjectPointOnSurf(pnt, self.geom_surface)
+        if not proj.IsDone() or proj.NbPoints() == 0:
+            from .errors import GeometryError
+
+            raise GeometryError(f"{self!r}: no projection of point {tuple(point)} found")
+        u, w = proj.LowerDistanceParameters()
+        return u, w, proj.LowerDistance()
+
+    def third_derivatives(self, u: float, w: float) -> tuple[np.ndarray, ...]:
+        """r_uuu, r_uuw, r_uww, r_www at (u, w), where OCCT provides D3."""
+        p, v = self._p, self._v
+        self._adaptor.D3(u, w, p, v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8])
+        # OCCT order: ..., D3U, D3V, D3UUV, D3UVV
+        return (np.array(v[5].Coord()), np.array(v[7].Coord()),
+                np.array(v[8].Coord()), np.array(v[6].Coord()))
+
+    def singularity(self, ru: np.ndarray, rw: np.ndarray) -> float:
+        """|r_u x r_w| / (|r_u|^2 + |r_w|^2): 0 at a singular point, 1/2 for a square grid."""
+        c = np.cross(ru, rw)
+        return float(math.sqrt(c @ c) / (ru @ ru + rw @ rw + 1e-300))
+
+    def normal(self, u: float, w: float) -> np.ndarray:
+        """Unit normal out of the material, (3,). Raises SingularPointError where undefined."""
+        d = self.derivatives(u, w)
+        return self._normal_from(d.ru, d.rw, u, w)
+
+    def _normal_from(self, ru, rw, u, w) -> np.ndarray:
+        if self.singularity(ru, rw) < self.tol.singular:
+            raise SingularPointError(
+                f"{self!r}: singular parameter point (u={u:.6g}, w={w:.6g}): "
+                "r_u x r_w vanishes (pole, apex or degenerate edge), no normal", u, w)
+        c = np.cross(ru, rw)
+        return self._sign * c / np.linalg.norm(c)
+
+    def is_singular(self, u: float, w: float) -> bool:
+        d = self.derivatives(u, w)
+        return self.singularity(d.ru, d.rw) < self.tol.singular
+
+    def fundamental_forms(self, u: float, w: float) -> dg.FundamentalForms:
+        d = self.derivatives(u, w)
+        n = self._normal_from(d.ru, d.rw, u, w)
+        return dg.fundamental_forms(d.ru, d.rw, d.ruu, d.ruw, d.rww, n)
+
+    def normal_curvature(self, u: float, w: float, direction) -> float:
+        """Normal curvature (1/mm) along 3-D tangent ``direction`` (projected on the plane)."""
+        d = self.derivatives(u, w)
+        n = self._normal_from(d.ru, d.rw, u, w)
+        ff = dg.fundamental_forms(d.ru, d.rw, d.ruu, d.ruw, d.rww, n)
+        return dg.normal_curvature(ff, *dg.tangent_coordinates(ff, d.ru, d.rw, direction))
+
+    def principal_curvatures(self, u: float, w: float) -> dg.PrincipalCurvatures:
+        d = self.derivatives(u, w)
+        n = self._normal_from(d.ru, d.rw, u, w)
+        ff = dg.fundamental_forms(d.ru, d.rw, d.ruu, d.ruw, d.rww, n)
+        return dg.principal_curvatures(ff, d.ru, d.rw)
+
+    def geodesic_torsion(self, u: float, w: float, direction) -> float:
+        t = np.asarray(direction, dtype=float)
+        return dg.geodesic_torsion(self.principal_curvatures(u, w), t / np.linalg.norm(t))
+
+    # -- OCCT handles for the verification layer ----------------------------------------
+    @property
+    def geom_surface(self):
+        """The face's Geom_Surface handle, with the face's location applied."""
+        from OCP.BRep import BRep_Tool
+
+        return BRep_Tool.Surface_s(self.topods)
+
+    def area(self) -> float:
+        """Face area, mm^2."""
+        from OCP.BRepGProp import BRepGProp
+        from OCP.GProp import GProp_GProps
+
+        props = GProp_GProps()
+        BRepGProp.SurfaceProperties_s(self.topods, props)
+        return props.Mass()

@@ -1,0 +1,246 @@
+"""A B-rep part: faces numbered 1..N as CAD users know them, and which faces meet how.
+
+Faces are numbered in ``TopExp::MapShapes`` order, the numbers FreeCAD shows as
+Face1..FaceN. Every pair of faces sharing an edge is classified from the dihedral angle
+sampled along the edge, measured through the material: < 180 deg convex (outer corner),
+~180 deg tangent/smooth, > 180 deg concave (inner corner: a ball can sit in it, the pair a
+pencil path follows). This module and face_surface are the only ones that read topology.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
+from OCP.gp import gp_Pnt, gp_Vec
+from OCP.IFSelect import IFSelect_RetDone
+from OCP.STEPControl import STEPControl_Reader
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_SOLID
+from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopoDS import TopoDS, TopoDS_Shape
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
+
+from .errors import FaceNumberError, StepFileError
+from .face_surface import FaceSurface
+from .tolerances import DEFAULT, Tolerances
+
+CONCAVE, CONVEX, TANGENT, MIXED = "concave", "convex", "tangent", "mixed"
+
+
+@dataclass
+class SharedEdge:
+    """An edge shared by two faces, with its classification seen from outside the material.
+
+    ``angles_deg`` are the material-side dihedral angles at the samples (mm-free).
+    ``points`` (k, 3) are the sample points in mm; ``closed`` says the edge is a loop.
+    """
+
+    faces: tuple[int, int]
+    edge: object = field(repr=False)
+    edge_class: str
+    angles_deg: np.ndarray = field(repr=False)
+    points: np.ndarray = field(repr=False)
+    length: float
+    closed: bool
+    start: np.ndarray = field(repr=False, default=None)
+    end: np.ndarray = field(repr=False, default=None)
+    start_tangent: np.ndarray = field(repr=False, default=None)
+    end_tangent: np.ndarray = field(repr=False, default=None)
+
+    @property
+    def angle_range_deg(self) -> tuple[float, float]:
+        return float(self.angles_deg.min()), float(self.angles_deg.max())
+
+
+def load_step(path: str | os.PathLike, tol: Tolerances = DEFAULT) -> "Part":
+    """Read a STEP file into a :class:`Part`; errors name the file and the problem."""
+    path = os.fspath(path)
+    if not os.path.exists(path):
+        raise StepFileError(f"{path}: no such file")
+    if os.path.isdir(path):
+        raise StepFileError(f"{path}: is a directory, not a STEP file")
+    with open(path, "rb") as fh:
+        head = fh.read(64)
+    if b"ISO-10303-21" not in head:
+        raise StepFileError(f"{path}: not a STEP file (no ISO-10303-21 header)")
+    reader = STEPControl_Reader()
+    if reader.ReadFile(path) != IFSelect_RetDone:
+        raise StepFileError(f"{path}: STEP file could not be read (syntax or schema error)")
+    reader.TransferRoots()
+    shape = reader.OneShape()
+    return Part(shape, source=path, tol=tol)
+
+
+def _shape_of(obj) -> TopoDS_Shape:
+    """A TopoDS_Shape from a CadQuery Workplane, Shape, or OCP shape."""
+    if hasattr(obj, "vals") and hasattr(obj, "toOCC"):  # cq.Workplane
+        vals = obj.vals()
+        if len(vals) == 1:
+            return _shape_of(vals[0])
+        import cadquery as cq
+
+        return cq.Compound.makeCompound([v for v in vals if hasattr(v, "wrapped")]).wrapped
+    return getattr(obj, "wrapped", obj)
+
+
+class Part:
+    """Faces (1-based), adjacency and edge classes of a solid."""
+
+    def __init__(self, shape, source: str = "<shape>", tol: Tolerances = DEFAULT):
+        self.shape = _shape_of(shape)
+        self.source = source
+        self.tol = tol
+        if self.shape is None or self.shape.IsNull():
+            raise StepFileError(f"{source}: holds no shape")
+        if not TopExp_Explorer(self.shape, TopAbs_SOLID).More():
+            raise StepFileError(f"{source}: holds no solid (cadcnc machines solids)")
+        fmap = TopTools_IndexedMapOfShape()
+        TopExp.MapShapes_s(self.shape, TopAbs_FACE, fmap)
+        if fmap.Extent() == 0:
+            raise StepFileError(f"{source}: solid has no faces")
+        self._fmap = fmap
+        self._faces: dict[int, FaceSurface] = {}
+        self._edges: dict[tuple[int, int], list[SharedEdge]] | None = None
+
+    @classmethod
+    def from_cadquery(cls, obj, tol: Tolerances = DEFAULT) -> "Part":
+        """A part from a CadQuery Workplane or Shape (or an OCP TopoDS_Shape)."""
+        return cls(obj, source=f"<{type(obj).__name__}>", tol=tol)
+
+    def __repr__(self) -> str:
+        return f"<Part {self.source}: {len(self)} faces>"
+
+    def __len__(self) -> int:
+        return self._fmap.Extent()
+
+    def face(self, number: int) -> FaceSurface:
+        """Face ``number`` (1-based, FreeCAD's FaceN)."""
+        if not isinstance(number, (int, np.integer)) or not 1 <= number <= len(self):
+            raise FaceNumberError(
+                f"{self.source}: face number {number!r} out of range: the part has faces "
+                f"1..{len(self)}")
+        number = int(number)
+        if number not in self._faces:
+            self._faces[number] = FaceSurface(
+                TopoDS.Face_s(self._fmap.FindKey(number)), number, self.tol, part=self)
+        return self._faces[number]
+
+    @property
+    def faces(self) -> list[FaceSurface]:
+        return [self.face(i) for i in range(1, len(self) + 1)]
+
+    def face_number(self, face) -> int:
+        """The 1-based number of a TopoDS/CadQuery face of this part (0 if not found)."""
+        return self._fmap.FindIndex(getattr(face, "wrapped", face))
+
+    # -- adjacency -------------------------------------------------------------------------
+    @property
+    def adjacency(self) -> dict[tuple[int, int], list[SharedEdge]]:
+        """{(i, j): shared edges} for every pair i < j of faces that share an edge."""
+        if self._edges is None:
+            self._edges = self._classify_edges()
+        return self._edges
+
+    def shared_edges(self, i: int, j: int) -> list[SharedEdge]:
+        self.face(i), self.face(j)
+        return self.adjacency.get((min(i, j), max(i, j)), [])
+
+    def pair_class(self, i: int, j: int) -> str | None:
+        """concave/convex/tangent/mixed for adjacent faces, None if they share no edge."""
+        classes = {e.edge_class for e in self.shared_edges(i, j)}
+        if not classes:
+            return None
+        return classes.pop() if len(classes) == 1 else MIXED
+
+    def neighbours(self, n: int) -> dict[int, list[SharedEdge]]:
+        self.face(n)
+        out: dict[int, list[SharedEdge]] = {}
+        for (i, j), edges in self.adjacency.items():
+            if n in (i, j):
+                out[j if i == n else i] = edges
+        return out
+
+    def concave_pairs(self) -> list[tuple[int, int]]:
+        """Pairs whose every shared edge is concave: the candidates for an intersection path."""
+        return [pair for pair in self.adjacency if self.pair_class(*pair) == CONCAVE]
+
+    def _classify_edges(self) -> dict[tuple[int, int], list[SharedEdge]]:
+        emap = TopTools_IndexedDataMapOfShapeListOfShape()
+        TopExp.MapShapesAndAncestors_s(self.shape, TopAbs_EDGE, TopAbs_FACE, emap)
+        result: dict[tuple[int, int], list[SharedEdge]] = {}
+        for k in range(1, emap.Extent() + 1):
+            edge = TopoDS.Edge_s(emap.FindKey(k))
+            if BRep_Tool.Degenerated_s(edge):
+                continue
+            numbers = sorted({self._fmap.FindIndex(f) for f in emap.FindFromIndex(k)})
+            if len(numbers) != 2:
+                continue  # seam (one face) or non-manifold edge
+            shared = self._classify_edge(edge, *numbers)
+            result.setdefault((numbers[0], numbers[1]), []).append(shared)
+        return dict(sorted(result.items()))
+
+    def _classify_edge(self, edge, i: int, j: int, samples: int = 9) -> SharedEdge:
+        curve = BRepAdaptor_Curve(edge)
+        t0, t1 = curve.FirstParameter(), curve.LastParameter()
+        ts = t0 + (t1 - t0) * (np.arange(samples) + 0.5) / samples
+        angles, points = [], []
+        for t in ts:
+            p = np.array(curve.Value(t).Coord())
+            sides = [self._inward_and_normal(edge, self.face(n), t) for n in (i, j)]
+            (d1, n1), (d2, n2) = sides
+            theta = math.degrees(math.atan2(np.linalg.norm(np.cross(d1, d2)), d1 @ d2))
+            angles.append(360.0 - theta if d2 @ n1 > 0 else theta)
+            points.append(p)
+        angles = np.array(angles)
+        tangent = np.abs(angles - 180.0) <= self.tol.tangent_edge_deg
+        concave = (angles > 180.0) & ~tangent
+        convex = (angles < 180.0) & ~tangent
+        if concave.any() and convex.any():
+            cls = MIXED
+        elif concave.any():
+            cls = CONCAVE
+        elif convex.any():
+            cls = CONVEX
+        else:
+            cls = TANGENT
+        from OCP.GCPnts import GCPnts_AbscissaPoint
+
+        length = GCPnts_AbscissaPoint.Length_s(curve)
+        (start, t_start), (end, t_end) = _point_and_tangent(curve, t0), _point_and_tangent(curve, t1)
+        closed = bool(np.linalg.norm(start - end) < 1e-7)
+        return SharedEdge((i, j), edge, cls, angles, np.array(points), length, closed,
+                          start, end, t_start, t_end)
+
+    @staticmethod
+    def _inward_and_normal(edge, face: FaceSurface, t: float):
+        """(inward direction, outward normal) of ``face`` at edge parameter t.
+
+        The face's wires leave the material on the left seen from the normal, so with T
+        the edge tangent as oriented in this face, n x T points into the face.
+        """
+        oriented = None
+        exp = TopExp_Explorer(face.topods, TopAbs_EDGE)
+        while exp.More():
+            if exp.Current().IsSame(edge):
+                oriented = TopoDS.Edge_s(exp.Current())
+                break
+            exp.Next()
+        uv = BRepAdaptor_Curve2d(oriented, face.topods).Value(t)
+        n = face.normal(uv.X(), uv.Y())
+        tangent = _point_and_tangent(BRepAdaptor_Curve(oriented), t)[1]
+        if oriented.Orientation() == TopAbs_REVERSED:
+            tangent = -tangent
+        d = np.cross(n, tangent)
+        return d / np.linalg.norm(d), n
+
+
+def _point_and_tangent(curve: BRepAdaptor_Curve, t: float) -> tuple[np.ndarray, np.ndarray]:
+    """Point (mm) and unit tangent of an edge curve at parameter t (curve's own direction)."""
+    p, v = gp_Pnt(), gp_Vec()
+    curve.D1(t, p, v)
+    d = np.array(v.Coord())
+    return np.array(p.Coord()), d / np.linalg.norm(d)

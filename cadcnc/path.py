@@ -1,0 +1,192 @@
+"""From two faces and machining parameters to a stepper or a whole toolpath.
+
+Resolves the faces (part faces, CadQuery faces), checks that they make a pair a ball can
+follow, solves the start and end tangencies (defaults: the ends of the shared concave
+edge), and runs the :class:`~cadcnc.stepper.Stepper` loop. Units: radius, allowance,
+points in mm; feed in mm/min; period in s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import FacePairError, InputError, StartPointError
+from .face_surface import FaceSurface
+from .part import CONCAVE
+from .stepper import Stepper, Tangency
+from .tangency import solve_tangency
+from .tolerances import DEFAULT, Tolerances
+from .toolpath import Toolpath, toolpath_from_record
+
+
+@dataclass(frozen=True)
+class PathPlan:
+    """Everything the stepper needs, resolved: surfaces, offsets, start, end, direction."""
+
+    s1: FaceSurface
+    s2: FaceSurface
+    offsets: tuple[float, float]
+    start: Tangency
+    end: Tangency | None
+    closed: bool
+    direction: tuple[float, float, float]
+    inputs: dict
+
+
+def _surface(face, tol: Tolerances) -> FaceSurface:
+    return face if isinstance(face, FaceSurface) else FaceSurface(face, tol=tol)
+
+
+def _positive(name: str, value, unit: str, allow_zero: bool = False) -> float:
+    ok = isinstance(value, (int, float, np.floating)) and math.isfinite(value)
+    if not ok or value < 0 or (value == 0 and not allow_zero):
+        need = ">= 0" if allow_zero else "> 0"
+        raise InputError(f"{name} must be a number {need} {unit}, got {value!r}")
+    return float(value)
+
+
+def _point(name: str, value) -> np.ndarray | None:
+    if value is None:
+        return None
+    arr = np.asarray(value, dtype=float).reshape(-1)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise InputError(f"{name} must be a point x, y, z in mm, got {value!r}")
+    return arr
+
+
+def _label(s: FaceSurface, fallback: str) -> str:
+    return f"face {s.number}" if s.number else fallback
+
+
+def shared_edge_for(s1: FaceSurface, s2: FaceSurface, edge: int = 0):
+    """The ``edge``-th shared concave edge of two faces of one part, or FacePairError."""
+    part = s1.part
+    if part is None or s2.part is not part:
+        raise FacePairError("the two faces are not faces of one part: give start and end "
+                            "points")
+    i, j = s1.number, s2.number
+    edges = part.shared_edges(i, j)
+    if not edges:
+        raise FacePairError(
+            f"{part.source}: faces {i} and {j} are not adjacent (they share no edge); pick a "
+            "concave pair from `cadcnc faces`, or give start and end points near their "
+            "intersection")
+    concave = [e for e in edges if e.edge_class == CONCAVE]
+    if not concave:
+        kinds = ", ".join(sorted({e.edge_class for e in edges}))
+        lo = min(e.angle_range_deg[0] for e in edges)
+        hi = max(e.angle_range_deg[1] for e in edges)
+        raise FacePairError(
+            f"{part.source}: faces {i} and {j} meet along a {kinds} edge (material angle "
+            f"{lo:.1f}..{hi:.1f} deg): a ball cannot sit in that corner; pick a concave pair "
+            "(material angle > 180 deg) from `cadcnc faces`")
+    if not 0 <= edge < len(concave):
+        raise InputError(f"edge index {edge} out of range: faces {i} and {j} share "
+                         f"{len(concave)} concave edge(s)")
+    return concave[edge]
+
+
+def plan_path(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,
+              period: float, start=None, end=None, offsets=None, edge: int = 0,
+              tol: Tolerances = DEFAULT) -> PathPlan:
+    """Validate the inputs and solve the start/end tangencies (Newton, to ``tol.start``)."""
+    radius = _positive("radius", radius, "mm", allow_zero=True)
+    allowance = _positive("allowance", allowance, "mm", allow_zero=True)
+    feed = _positive("feed", feed, "mm/min")
+    period = _positive("period", period, "s")
+    s1, s2 = _surface(face_a, tol), _surface(face_b, tol)
+    r_prime = radius + allowance
+    offs = tuple(r_prime if o is None else _positive("offset", o, "mm", True)
+                 for o in (offsets or (None, None)))
+    start, end = _point("start", start), _point("end", end)
+    closed = False
+    if start is None:
+        if end is not None:
+            raise InputError("an end point needs a start point too")
+        e = shared_edge_for(s1, s2, edge)
+        anchors = [(e.start, e.start_tangent), (None if e.closed else (e.end, e.end_tangent))]
+        direction, closed = e.start_tangent, e.closed
+    else:
+        anchors = [(start, None), (None if end is None else (end, None))]
+        direction = None
+    solved = []
+    for which, anchor in zip(("start", "end"), anchors):
+        if anchor is None:
+            solved.append(None)
+            continue
+        point, tangent = anchor
+        seeds = [s.project(point)[:2] for s in (s1, s2)]
+        tan = solve_tangency(s1, s2, offs, *seeds, point, direction=tangent, tol=tol,
+                             what=which)
+        for s, uv, label in ((s1, tan.uv1, _label(s1, "surface 1")),
+                             (s2, tan.uv2, _label(s2, "surface 2"))):
+            if not s.contains(*uv):
+                raise StartPointError(
+                    f"{which}: at the {which} tangency {tuple(np.round(tan.p, 4))} the ball "
+                    f"touches {label} outside the face (its contact lies beyond the face's "
+                    f"boundary); give a {which} point further inside the intersection")
+        solved.append(tan)
+    t_start, t_end = solved
+    if direction is None:
+        n1 = s1.normal(*t_start.uv1)
+        n2 = s2.normal(*t_start.uv2)
+        m = np.cross(n1, n2)
+        if t_end is not None and m @ (np.array(t_end.p) - np.array(t_start.p)) < 0:
+            m = -m
+        direction = m
+    inputs = dict(radius=radius, allowance=allowance, feed=feed, period=period,
+                  start=None if start is None else start.tolist(),
+                  end=None if end is None else end.tolist(), offsets=list(offs), edge=edge,
+                  source=getattr(s1.part, "source", None))
+    return PathPlan(s1, s2, offs, t_start, t_end, closed,
+                    tuple(map(float, direction)), inputs)
+
+
+def make_stepper(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,
+                 period: float, start=None, end=None, offsets=None, edge: int = 0,
+                 tol: Tolerances = DEFAULT, max_cycles: int = 1_000_000,
+                 record: bool = True) -> Stepper:
+    """A :class:`Stepper` ready to be driven one period at a time (real-time use)."""
+    plan = plan_path(face_a, face_b, radius=radius, allowance=allowance, feed=feed,
+                     period=period, start=start, end=end, offsets=offsets, edge=edge, tol=tol)
+    return _stepper(plan, tol, max_cycles, record)
+
+
+def _stepper(plan: PathPlan, tol: Tolerances, max_cycles: int, record: bool) -> Stepper:
+    return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=plan.inputs["feed"],
+                   period=plan.inputs["period"], direction=plan.direction, end=plan.end,
+                   closed=plan.closed, tol=tol, max_cycles=max_cycles, record=record)
+
+
+def intersection_path(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,
+                      period: float, start=None, end=None, offsets=None, edge: int = 0,
+                      tol: Tolerances = DEFAULT, max_cycles: int = 1_000_000,
+                      progress=None) -> Toolpath:
+    """The ball-end cutter path along the intersection of two faces (the paper's method).
+
+    ``face_a``/``face_b``: part faces (``part.face(n)``), CadQuery faces or TopoDS faces.
+    ``radius``, ``allowance`` in mm; ``feed`` in mm/min; ``period`` in s (feed 1500 and
+    period 0.004 give the paper's 0.1 mm step). ``start``/``end``: points (mm) near the
+    intersection; by default the ends of the faces' shared concave edge (a closed edge is
+    followed once around). ``offsets``: per-surface offset distance, None meaning R + C;
+    0 makes that face a guide surface carrying the cutter centre itself.
+    ``progress(cycles, mm)`` is called every 10 000 cycles.
+    """
+    plan = plan_path(face_a, face_b, radius=radius, allowance=allowance, feed=feed,
+                     period=period, start=start, end=end, offsets=offsets, edge=edge, tol=tol)
+    stepper = _stepper(plan, tol, max_cycles, True).run(progress)
+    return toolpath_from_record(
+        stepper.record, plan.offsets, stepper.stop_reason, stepper.stop_detail,
+        faces=(plan.s1.number, plan.s2.number), inputs=plan.inputs)
+
+
+def intersection_paths(face_a, face_b, **kwargs) -> list[Toolpath]:
+    """One toolpath per shared concave edge of two adjacent part faces."""
+    s1 = _surface(face_a, kwargs.get("tol", DEFAULT))
+    s2 = _surface(face_b, kwargs.get("tol", DEFAULT))
+    shared_edge_for(s1, s2)
+    n = sum(e.edge_class == CONCAVE for e in s1.part.shared_edges(s1.number, s2.number))
+    return [intersection_path(s1, s2, edge=k, **kwargs) for k in range(n)]

@@ -1,0 +1,217 @@
+"""Drive the interpolator period by period: state, stop rules, and the record of cycles.
+
+A real-time caller builds a :class:`Stepper` and calls :meth:`Stepper.step` once per
+interpolation period; each call returns the axis increment dp_K (mm) for the next period,
+or None once the path has stopped (``stop_reason`` says why). The feed may change between
+calls (override, ramps). :func:`cadcnc.intersection_path` is a loop over this class.
+Kernel-free, like :mod:`cadcnc.interpolator`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .errors import InputError
+from .interpolator import (
+    BOUNDARY, CLOSED, DIVERGED, END, MAX_CYCLES, SINGULAR, Contact, StopCycle, SurfaceLike,
+    cycle,
+)
+from .tolerances import DEFAULT, Tolerances
+from .vec3 import Vec, dot, norm, scale, sub
+
+OUTSIDE = "outside"
+
+
+@dataclass(frozen=True)
+class Tangency:
+    """A cutter position touching both surfaces: centre p (mm) and contact parameters."""
+
+    p: Vec
+    uv1: tuple[float, float]
+    uv2: tuple[float, float]
+
+
+class Stepper:
+    """The interpolator's state machine: one :meth:`step` per interpolation period.
+
+    ``offsets`` are each surface's offset distance (R + C for a part face, 0 for a guide
+    surface). ``direction`` is the initial travel direction (only its sign against
+    n1 x n2 matters). With ``end`` the last step is shortened to land on it; with
+    ``closed`` the end is the start, reached after going once around.
+    """
+
+    def __init__(self, s1: SurfaceLike, s2: SurfaceLike, offsets: tuple[float, float],
+                 start: Tangency, *, feed: float, period: float, direction: Vec,
+                 end: Tangency | None = None, closed: bool = False,
+                 tol: Tolerances = DEFAULT, max_cycles: int = 1_000_000,
+                 record: bool = True, check_boundary: bool = True):
+        if not period > 0.0:
+            raise InputError(f"period must be > 0 s, got {period!r}")
+        self.tol = tol
+        self.period = float(period)
+        self.feed = self._check_feed(feed)
+        self.c1 = Contact(s1, float(offsets[0]), *start.uv1)
+        self.c2 = Contact(s2, float(offsets[1]), *start.uv2)
+        # spare contacts evaluated at the next cycle's parameters, swapped in on success
+        self._n1, self._n2 = self.c1.copy(), self.c2.copy()
+        self.p: Vec = tuple(map(float, start.p))
+        d = norm(direction)
+        self.t: Vec = scale(direction, 1.0 / d) if d > 0 else (0.0, 0.0, 0.0)
+        self.end = Tangency(start.p, start.uv1, start.uv2) if closed else end
+        self.closed = closed
+        self.max_cycles = max_cycles
+        self.check_boundary = check_boundary
+        self.cycles = 0
+        self.travelled = 0.0
+        self.stop_reason: str | None = None
+        self.stop_detail = ""
+        self.record = PathRecord() if record else None
+        if self.record is not None:
+            self.record.add(self.p, self.c1, self.c2, 0.0, 0.0)
+
+    def _check_feed(self, feed: float) -> float:
+        if not (isinstance(feed, (int, float)) and math.isfinite(feed) and feed > 0.0):
+            raise InputError(f"feed must be a positive number of mm/min, got {feed!r}")
+        return float(feed)
+
+    @property
+    def step_length(self) -> float:
+        """f = F * Ts in mm (feed mm/min, period s)."""
+        return self.feed * self.period / 60.0
+
+    @property
+    def stopped(self) -> bool:
+        return self.stop_reason is not None
+
+    def _stop(self, reason: str, detail: str) -> None:
+        self.stop_reason, self.stop_detail = reason, detail
+
+    def step(self, feed: float | None = None) -> Vec | None:
+        """Compute the next period's axis increment dp_K (mm); None once stopped."""
+        if self.stop_reason is not None:
+            return None
+        if feed is not None:
+            self.feed = self._check_feed(feed)
+        if self.cycles >= self.max_cycles:
+            self._stop(MAX_CYCLES, f"cycle limit {self.max_cycles} reached")
+            return None
+        f = self.step_length
+        landing = self._landing(f)
+        if landing is not None:
+            return landing
+        try:
+            p_e, t = self._advance(f)
+        except StopCycle as stop:
+            self._stop(stop.reason, stop.detail)
+            return None
+        if self.check_boundary:
+            left = self._left_face()
+            if left:
+                return self._land_on_boundary(f, left)
+        return self._commit(p_e, t, f)
+
+    # -- pieces of a step -----------------------------------------------------------------
+    def _advance(self, f: float) -> tuple[Vec, Vec]:
+        """Run one cycle into the spare contacts; raises StopCycle on a geometric stop."""
+        p_e, t, uv1, uv2 = cycle(self.p, self.c1, self.c2, self.t, f, self.tol)
+        for spare, uv, label in ((self._n1, uv1, 1), (self._n2, uv2, 2)):
+            spare.move_to(*uv)
+            if spare.quality < self.tol.near_singular:
+                raise StopCycle(SINGULAR, f"surface {label}: contact reaches a singular "
+                                          f"parameter point (u={spare.u:.6g}, w={spare.w:.6g})")
+        for spare, label in ((self._n1, 1), (self._n2, 2)):
+            eps = norm(sub(p_e, spare.centre()))
+            if eps > self.tol.diverged:
+                raise StopCycle(DIVERGED, f"surface {label}: carried error {eps:.4g} mm "
+                                          f"exceeds {self.tol.diverged:g} mm")
+        return p_e, t
+
+    def _left_face(self) -> str:
+        """Which spare contact lies outside its trimmed face ('' if none)."""
+        names = []
+        for spare, label in ((self._n1, "surface 1"), (self._n2, "surface 2")):
+            if spare.surface.classify(spare.u, spare.w) == OUTSIDE:
+                names.append(label)
+        return " and ".join(names)
+
+    def _land_on_boundary(self, f: float, left: str) -> Vec | None:
+        """Shorten the step so the leaving contact lands on its face boundary, then stop."""
+        lo, hi = 0.0, 1.0
+        for _ in range(48):  # bisection to ~f * 4e-15
+            mid = 0.5 * (lo + hi)
+            try:
+                self._advance(mid * f)
+            except StopCycle:
+                hi = mid
+                continue
+            if self._left_face():
+                hi = mid
+            else:
+                lo = mid
+        detail = f"contact on {left} reached the boundary of its face"
+        if lo * f < 1e-12:
+            self._stop(BOUNDARY, detail + " at the start point")
+            return None
+        p_e, t = self._advance(lo * f)
+        dp = self._commit(p_e, t, lo * f)
+        self._stop(BOUNDARY, detail)
+        return dp
+
+    def _landing(self, f: float) -> Vec | None:
+        """Land exactly on the end point when it is within this step (shortened last step)."""
+        end = self.end
+        if end is None or self.travelled < 2.0 * f:
+            return None
+        d = sub(end.p, self.p)
+        dist = norm(d)
+        if dist > f or dot(d, self.t) <= 0.0:
+            return None
+        self._n1.move_to(*end.uv1)
+        self._n2.move_to(*end.uv2)
+        dp = self._commit(end.p, self.t, dist)
+        self._stop(CLOSED if self.closed else END,
+                   "closed intersection completed" if self.closed else "end point reached")
+        return dp
+
+    def _commit(self, p_e: Vec, t: Vec, f: float) -> Vec:
+        dp = sub(p_e, self.p)
+        step = norm(dp)
+        self.p, self.t = p_e, t
+        self.c1, self._n1 = self._n1, self.c1
+        self.c2, self._n2 = self._n2, self.c2
+        self.cycles += 1
+        self.travelled += step
+        if self.record is not None:
+            self.record.add(p_e, self.c1, self.c2, f, step)
+        return dp
+
+    def run(self, progress=None, every: int = 10000) -> "Stepper":
+        """Step until stopped; ``progress(cycles, travelled_mm)`` every ``every`` cycles."""
+        while self.step() is not None:
+            if progress is not None and self.cycles % every == 0:
+                progress(self.cycles, self.travelled)
+        return self
+
+
+class PathRecord:
+    """Per-point log of the cutter centre and both contacts' geometry (for toolpaths/bounds).
+
+    Row K holds the state after cycle K (row 0: the start) and the commanded step f and
+    actual step |dp| of the cycle that led to it (0 for the start).
+    """
+
+    __slots__ = ("rows",)
+
+    def __init__(self):
+        self.rows: list[tuple] = []
+
+    def add(self, p: Vec, c1: Contact, c2: Contact, f: float, step: float) -> None:
+        self.rows.append((p, _contact_row(c1), _contact_row(c2), f, step))
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+
+def _contact_row(c: Contact) -> tuple:
+    return (c.u, c.w, c.r, c.ru, c.rw, c.n, c.E, c.F, c.G, c.L, c.M, c.N)

@@ -1,0 +1,5 @@
+"""cadcnc's command line (installed as the ``cadcnc`` console script)."""
+
+from .main import main
+
+__all__ = ["main"]
