@@ -1,0 +1,32 @@
+"""Shared test helpers: the bundled fixtures and their sidecar facts."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+FIXTURES = ROOT / "fixtures"
+SIDECAR = json.loads((FIXTURES / "fixtures.json").read_text())
+FIXTURE_NAMES = sorted(SIDECAR)
+# every (fixture, i, j) concave pair named in the sidecar
+CONCAVE_PAIRS = [(name, *p["faces"]) for name in FIXTURE_NAMES
+                 for p in SIDECAR[name]["pairs"] if p["class"] == "concave"]
+
+_parts: dict = {}
+
+
+def load_fixture(name: str):
+    """The fixture's Part, loaded once per test session."""
+    import cadcnc
+
+    if name not in _parts:
+        _parts[name] = cadcnc.load_step(FIXTURES / SIDECAR[name]["file"])
+    return _parts[name]
+
+
+@pytest.fixture
+def fixture_part():
+    return load_fixture
