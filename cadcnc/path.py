@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import FacePairError, InputError, StartPointError
+from .errors import FacePairError, GeometryError, InputError, StartPointError
 from .face_surface import FaceSurface
 from .part import CONCAVE
 from .stepper import Stepper, Tangency
@@ -123,13 +123,16 @@ def plan_path(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: fl
                              what=which)
         for s, uv, label in ((s1, tan.uv1, _label(s1, "surface 1")),
                              (s2, tan.uv2, _label(s2, "surface 2"))):
-            if not s.contains(*uv):
+            # an end beyond a face is fine: the path stops where the contact leaves it
+            if which == "start" and not s.contains(*uv):
                 raise StartPointError(
                     f"{which}: at the {which} tangency {tuple(np.round(tan.p, 4))} the ball "
                     f"touches {label} outside the face (its contact lies beyond the face's "
                     f"boundary); give a {which} point further inside the intersection")
         solved.append(tan)
     t_start, t_end = solved
+    if t_end is None and start is not None:
+        closed = True  # a user start without an end: stop if the path comes back to it
     if direction is None:
         n1 = s1.normal(*t_start.uv1)
         n2 = s2.normal(*t_start.uv2)
@@ -178,6 +181,9 @@ def intersection_path(face_a, face_b, *, radius: float, allowance: float = 0.0, 
     plan = plan_path(face_a, face_b, radius=radius, allowance=allowance, feed=feed,
                      period=period, start=start, end=end, offsets=offsets, edge=edge, tol=tol)
     stepper = _stepper(plan, tol, max_cycles, True).run(progress)
+    if stepper.cycles == 0:
+        raise GeometryError(f"no path: the interpolator stopped at the start point "
+                            f"({stepper.stop_reason}): {stepper.stop_detail}")
     return toolpath_from_record(
         stepper.record, plan.offsets, stepper.stop_reason, stepper.stop_detail,
         faces=(plan.s1.number, plan.s2.number), inputs=plan.inputs)
