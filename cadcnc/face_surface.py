@@ -122,7 +122,10 @@ class FaceSurface:
     def classify(self, u: float, w: float) -> str:
         """Whether (u, w) lies inside the trimmed face, on its boundary, or outside."""
         if self._classifier is None:
-            self._classifier = BRepTopAdaptor_FClass2d(self.topods, self.tol.on_boundary)
+            # the classifier's tolerance is in (u, w): convert the 3-D one (mm)
+            tol = self.tol.on_boundary
+            tol_uv = min(self._adaptor.UResolution(tol), self._adaptor.VResolution(tol))
+            self._classifier = BRepTopAdaptor_FClass2d(self.topods, tol_uv)
         state = self._classifier.Perform(gp_Pnt2d(*self.wrap(u, w)))
         if state == TopAbs_IN:
             return INSIDE

@@ -34,6 +34,7 @@ class PathPlan:
     closed: bool
     direction: tuple[float, float, float]
     inputs: dict
+    check_boundary: bool = True
 
 
 def _surface(face, tol: Tolerances) -> FaceSurface:
@@ -144,8 +145,11 @@ def plan_path(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: fl
                   start=None if start is None else start.tolist(),
                   end=None if end is None else end.tolist(), offsets=list(offs), edge=edge,
                   source=getattr(s1.part, "source", None))
+    # With both offsets 0 along a shared edge the contacts run on the faces' common
+    # boundary by construction: the boundary rule cannot apply, the edge's ends bound it.
+    on_edge = start is None and offs == (0.0, 0.0)
     return PathPlan(s1, s2, offs, t_start, t_end, closed,
-                    tuple(map(float, direction)), inputs)
+                    tuple(map(float, direction)), inputs, check_boundary=not on_edge)
 
 
 def make_stepper(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,
@@ -161,7 +165,8 @@ def make_stepper(face_a, face_b, *, radius: float, allowance: float = 0.0, feed:
 def _stepper(plan: PathPlan, tol: Tolerances, max_cycles: int, record: bool) -> Stepper:
     return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=plan.inputs["feed"],
                    period=plan.inputs["period"], direction=plan.direction, end=plan.end,
-                   closed=plan.closed, tol=tol, max_cycles=max_cycles, record=record)
+                   closed=plan.closed, tol=tol, max_cycles=max_cycles, record=record,
+                   check_boundary=plan.check_boundary)
 
 
 def intersection_path(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,

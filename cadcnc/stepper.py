@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from .errors import InputError
 from .interpolator import (
     BOUNDARY, CLOSED, DIVERGED, END, MAX_CYCLES, SINGULAR, Contact, StopCycle, SurfaceLike,
-    cycle,
+    check_curvature, cycle,
 )
 from .tolerances import DEFAULT, Tolerances
 from .vec3 import Vec, dot, norm, scale, sub
@@ -100,16 +100,10 @@ class Stepper:
         landing = self._landing(f)
         if landing is not None:
             return landing
-        try:
-            p_e, t = self._advance(f)
-        except StopCycle as stop:
-            self._stop(stop.reason, stop.detail)
-            return None
-        if self.check_boundary:
-            left = self._left_face()
-            if left:
-                return self._land_on_boundary(f, left)
-        return self._commit(p_e, t, f)
+        failure = self._try(f)
+        if failure is None:
+            return self._commit(*self._trial, f)
+        return self._land_on_limit(f, failure)
 
     # -- pieces of a step -----------------------------------------------------------------
     def _advance(self, f: float) -> tuple[Vec, Vec]:
@@ -120,43 +114,72 @@ class Stepper:
             if spare.quality < self.tol.near_singular:
                 raise StopCycle(SINGULAR, f"surface {label}: contact reaches a singular "
                                           f"parameter point (u={spare.u:.6g}, w={spare.w:.6g})")
-        for spare, label in ((self._n1, 1), (self._n2, 2)):
             eps = norm(sub(p_e, spare.centre()))
             if eps > self.tol.diverged:
                 raise StopCycle(DIVERGED, f"surface {label}: carried error {eps:.4g} mm "
                                           f"exceeds {self.tol.diverged:g} mm")
+            # the new contact too: a point whose ball cannot touch there is never emitted
+            check_curvature(spare, spare.curvature(t), f"surface {label}")
         return p_e, t
 
-    def _left_face(self) -> str:
-        """Which spare contact lies outside its trimmed face ('' if none)."""
+    def _try(self, f: float) -> tuple[str, str] | None:
+        """Attempt a cycle of step f: None (and ``self._trial`` = (p_e, t)) on success,
+        else the (reason, detail) that forbids it."""
+        try:
+            p_e, t = self._advance(f)
+        except StopCycle as stop:
+            return stop.reason, stop.detail
+        if self.check_boundary:
+            left = self._left_face(p_e, t)
+            if left:
+                return BOUNDARY, f"contact on {left} reached the boundary of its face"
+        self._trial = (p_e, t)
+        return None
+
+    def _land_on_limit(self, f: float, failure: tuple[str, str]) -> Vec | None:
+        """Shorten the step to the limit the geometry allows (a contact on its face's
+        boundary, R' k reaching 1, a singular point, tangent faces), commit it, and stop.
+
+        Bisection on the step length, 48 halvings (to ~f * 4e-15); the reason reported is
+        the one found next to the limit. Only trials that pass every check are committed.
+        """
+        lo, hi = 0.0, 1.0
+        for _ in range(48):
+            mid = 0.5 * (lo + hi)
+            found = self._try(mid * f)
+            if found is None:
+                lo = mid
+            else:
+                hi, failure = mid, found
+        reason, detail = failure
+        if lo * f < 1e-12 or self._try(lo * f) is not None:
+            self._stop(reason, detail + " (no step possible from the current point)")
+            return None
+        dp = self._commit(*self._trial, lo * f)
+        self._stop(reason, detail)
+        return dp
+
+    def _left_face(self, p_e: Vec, t: Vec) -> str:
+        """Which spare contact lies outside its trimmed face ('' if none).
+
+        The approximate contact q carries an O(f^2) error, so a contact running along a
+        boundary (radius 0) may fall outside by its own approximation error. When q is
+        outside, the contact is re-estimated by one more inverse step towards p_e (no new
+        evaluation); it has left the face only if that estimate is outside as well.
+        """
         names = []
         for spare, label in ((self._n1, "surface 1"), (self._n2, "surface 2")):
-            if spare.surface.classify(spare.u, spare.w) == OUTSIDE:
+            surface = spare.surface
+            if surface.classify(spare.u, spare.w) != OUTSIDE:
+                continue
+            # tangent-plane projection of the remaining offset (eq. 5's 2x2 system is
+            # ill-conditioned when what remains is mostly along the normal)
+            k = spare.curvature(t)
+            du, dw = spare.tangent_coords(scale(sub(p_e, spare.centre()),
+                                                1.0 / (1.0 - k * spare.offset)))
+            if surface.classify(spare.u + du, spare.w + dw) == OUTSIDE:
                 names.append(label)
         return " and ".join(names)
-
-    def _land_on_boundary(self, f: float, left: str) -> Vec | None:
-        """Shorten the step so the leaving contact lands on its face boundary, then stop."""
-        lo, hi = 0.0, 1.0
-        for _ in range(48):  # bisection to ~f * 4e-15
-            mid = 0.5 * (lo + hi)
-            try:
-                self._advance(mid * f)
-            except StopCycle:
-                hi = mid
-                continue
-            if self._left_face():
-                hi = mid
-            else:
-                lo = mid
-        detail = f"contact on {left} reached the boundary of its face"
-        if lo * f < 1e-12:
-            self._stop(BOUNDARY, detail + " at the start point")
-            return None
-        p_e, t = self._advance(lo * f)
-        dp = self._commit(p_e, t, lo * f)
-        self._stop(BOUNDARY, detail)
-        return dp
 
     def _landing(self, f: float) -> Vec | None:
         """Land exactly on the end point when it is within this step (shortened last step)."""

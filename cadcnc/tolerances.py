@@ -18,7 +18,9 @@ class Tolerances:
     - ``tangent_edge_deg``: a dihedral angle within this of 180 deg classifies an edge
       sample as tangent/smooth.
     - ``start`` (mm): the initial tangency is solved to this residual.
-    - ``on_boundary`` (mm): a contact within this of the trimmed face's boundary is on it.
+    - ``on_boundary`` (mm): a contact within this of the trimmed face's boundary is on it
+      (converted to (u, w) with the surface's resolution). With radius 0 the contacts run
+      along the boundary itself, so this must exceed the interpolation error there.
     - ``near_singular``: the interpolator stops (reason "singular") when a contact's
       |r_u x r_w| / (|r_u|^2 + |r_w|^2) falls below this: the 2x2 inverse is ill-posed there.
     - ``diverged`` (mm): the carried error |p - (q + R' n)| above which the interpolator
