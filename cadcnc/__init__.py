@@ -15,6 +15,7 @@ from .path import intersection_path, intersection_paths, make_stepper
 from .stepper import Stepper, Tangency
 from .tolerances import Tolerances
 from .toolpath import Toolpath
+from .verification import VerificationReport, verify
 
 __version__ = "0.1.0"
 
@@ -22,5 +23,6 @@ __all__ = [
     "CadcncError", "FaceNumberError", "FacePairError", "GeometryError", "InputError",
     "OutputError", "SingularPointError", "StartPointError", "StepFileError", "FaceSurface",
     "Part", "SharedEdge", "load_step", "intersection_path", "intersection_paths",
-    "make_stepper", "Stepper", "Tangency", "Tolerances", "Toolpath",
+    "make_stepper", "Stepper", "Tangency", "Tolerances", "Toolpath", "VerificationReport",
+    "verify",
 ]

@@ -98,7 +98,7 @@ class Stepper:
             return None
         f = self.step_length
         landing = self._landing(f)
-        if landing is not None:
+        if landing is not None or self.stop_reason is not None:
             return landing
         failure = self._try(f)
         if failure is None:
@@ -188,6 +188,9 @@ class Stepper:
             return None
         d = sub(end.p, self.p)
         dist = norm(d)
+        if dist <= self.tol.end_reached:  # the last full step already landed on it
+            self._stop(CLOSED if self.closed else END, "end point reached")
+            return None
         if dist > f or dot(d, self.t) <= 0.0:
             return None
         self._n1.move_to(*end.uv1)

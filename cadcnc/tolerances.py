@@ -21,6 +21,8 @@ class Tolerances:
     - ``on_boundary`` (mm): a contact within this of the trimmed face's boundary is on it
       (converted to (u, w) with the surface's resolution). With radius 0 the contacts run
       along the boundary itself, so this must exceed the interpolation error there.
+    - ``end_reached`` (mm): a full step that lands this close to the end point (either
+      side) has reached it; no extra zero-length step is emitted.
     - ``near_singular``: the interpolator stops (reason "singular") when a contact's
       |r_u x r_w| / (|r_u|^2 + |r_w|^2) falls below this: the 2x2 inverse is ill-posed there.
     - ``diverged`` (mm): the carried error |p - (q + R' n)| above which the interpolator
@@ -33,6 +35,7 @@ class Tolerances:
     tangent_edge_deg: float = 1.0
     start: float = 1e-9
     on_boundary: float = 1e-6
+    end_reached: float = 1e-7
     near_singular: float = 1e-4
     diverged: float = 0.5
 

@@ -1,25 +1,179 @@
-"""Entry point: argparse subcommands; heavy imports happen inside the commands."""
+"""``cadcnc``: argparse subcommands; each command imports the library when it runs.
+
+Errors the library raises on purpose (:class:`cadcnc.errors.CadcncError`) become one line
+``cadcnc: error: <message>`` on stderr and the error's exit code (2 input, 3 geometry,
+4 output; argparse usage errors are 2 as well; a failed ``verify`` gate is 5). ``--debug``
+shows the traceback instead.
+"""
 
 from __future__ import annotations
 
 import sys
 
+UNITS = "Units: lengths mm, feed mm/min, period with a unit (4ms, 0.004s, 250us)."
 
-def main(argv: list[str] | None = None) -> int:
+
+def _common(debug_quiet: bool = True):
     import argparse
 
-    parser = argparse.ArgumentParser(prog="cadcnc")
-    sub = parser.add_subparsers(dest="command", required=True)
-    faces = sub.add_parser("faces", help="list faces and concave pairs of a STEP part")
-    faces.add_argument("step")
-    args = parser.parse_args(argv)
-    import cadcnc
+    common = argparse.ArgumentParser(add_help=False)
+    g = common.add_argument_group("general")
+    g.add_argument("-q", "--quiet", action="store_true", default=argparse.SUPPRESS,
+                   help="no progress or summary on stderr/stdout (errors still shown)")
+    g.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                   help="show the Python traceback on errors")
+    return common
 
-    part = cadcnc.load_step(args.step)
-    for f in part.faces:
-        print(f.number, f.kind)
-    print("concave pairs:", part.concave_pairs())
-    return 0
+
+def _job_args(p, outputs: bool = True):
+    p.add_argument("step", metavar="PART.step", help="the part (STEP file, mm)")
+    p.add_argument("--faces", nargs=2, type=int, required=True, metavar=("I", "J"),
+                   help="the two faces, numbered as `cadcnc faces` (FreeCAD's FaceN)")
+    p.add_argument("--radius", required=True, metavar="R", help="ball radius, mm")
+    p.add_argument("--allowance", default="0", metavar="C",
+                   help="stock allowance left on both faces, mm (default 0)")
+    p.add_argument("--feed", required=True, metavar="F", help="feed, mm/min")
+    p.add_argument("--period", required=True, metavar="T",
+                   help="interpolation period with its unit: 4ms, 0.004s or 250us")
+    p.add_argument("--start", metavar="X,Y,Z",
+                   help="start point near the intersection, mm (default: the shared "
+                        "concave edge's start)")
+    p.add_argument("--end", metavar="X,Y,Z", help="end point, mm (needs --start)")
+    p.add_argument("--edge", type=int, default=1, metavar="K",
+                   help="which shared concave edge when the faces share several (1, 2, ...)")
+
+
+def _gcode_args(p):
+    g = p.add_argument_group("G-code (.ngc output)")
+    g.add_argument("--tolerance", metavar="MM",
+                   help="drop points whose removal moves the path less than this, mm; also "
+                        "the G64 P blending tolerance and the print precision (default: keep "
+                        "every point, 0.001 mm for G64 P and digits)")
+    g.add_argument("--tool-tip", action="store_true",
+                   help="program the ball's tip (Z - R) instead of its centre")
+    g.add_argument("--safe-z", metavar="Z",
+                   help="height for rapid moves, mm in programmed coordinates (default: "
+                        "the part's top plus 10 mm)")
+    g.add_argument("--spindle", metavar="RPM", type=float,
+                   help="spindle speed; adds S<RPM> M3 ... M5 (default: none)")
+
+
+def build_parser():
+    import argparse
+
+    from . import commands
+
+    common = _common()
+    parser = argparse.ArgumentParser(
+        prog="cadcnc", parents=[common],
+        description="Ball-end cutter paths along the intersection of two faces of a STEP "
+                    "part, by direct interpolation (Zhou et al. 1994). " + UNITS,
+        epilog="Run `cadcnc demo` for a worked example; `cadcnc COMMAND --help` for details.")
+    parser.add_argument("--version", action="version", version=_version())
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    def add(name, func, help_, description=None):
+        p = sub.add_parser(name, parents=[common], help=help_,
+                           description=(description or help_) + " " + UNITS)
+        p.set_defaults(func=func)
+        return p
+
+    p = add("faces", commands.faces, "list faces, neighbours and the concave pairs to follow",
+            "List every face (number, kind, area in mm^2) and its neighbours with the edge "
+            "class and material-side dihedral angle (deg); concave pairs are the candidates "
+            "for an intersection path.")
+    p.add_argument("step", metavar="PART.step")
+    p.add_argument("--json", action="store_true", help="machine-readable output")
+
+    p = add("path", commands.path, "compute a path and write it (.json, .csv, .ngc)",
+            "Compute the ball-end path along the intersection of faces I and J and write it; "
+            "the format follows each output's suffix.")
+    _job_args(p)
+    p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
+                   help="output file: .json (everything), .csv (a row per cycle) or .ngc "
+                        "(G-code); repeat for several")
+    p.add_argument("--gouge-tolerance", default="0.001", metavar="MM",
+                   help="refuse (exit 5, nothing written) a path whose ball cuts any face of "
+                        "the part deeper than this, mm (default 0.001)")
+    p.add_argument("--allow-gouge", action="store_true",
+                   help="write the path even when the whole-part check finds a gouge")
+    _gcode_args(p)
+
+    p = add("run", commands.run, "execute an APT-like part program (PATH = P/[...])",
+            "Execute an APT-like part program (grammar: docs/cli.md). Prints a summary per "
+            "path, streams the per-period increments, or writes outputs.")
+    p.add_argument("program", metavar="PROGRAM.apt")
+    p.add_argument("--stream", action="store_true",
+                   help="print 'dx dy dz' (mm) per interpolation period to stdout")
+    p.add_argument("-o", "--output", action="append", metavar="OUT",
+                   help=".ngc: one program for all paths; .json/.csv: one file per path "
+                        "(OUT-NAME.json when the program has several)")
+    _gcode_args(p)
+
+    p = add("demo", commands.demo, "run the main job on a bundled part and write everything",
+            "Compute the path around the boss of the bundled bspline_boss part (faces 4 and "
+            "5, R 3 mm, 1500 mm/min, 4 ms), verify it, and write JSON, CSV, G-code, a "
+            "verification report and a picture to a folder.")
+    p.add_argument("--out", default="cadcnc-demo", metavar="DIR",
+                   help="output folder (default: ./cadcnc-demo)")
+
+    p = add("plot", commands.plot, "picture of a saved path (.png) or a 3-D scene (.glb)")
+    p.add_argument("path_json", metavar="PATH.json", help="a path written by `cadcnc path`")
+    p.add_argument("--part", metavar="PART.step",
+                   help="the part (default: the STEP file recorded in the path)")
+    p.add_argument("-o", "--output", required=True, metavar="OUT",
+                   help=".png (matplotlib) or .glb (glTF scene)")
+
+    p = add("verify", commands.verify, "check a path against OCCT (gouge gate for pipelines)",
+            "Verify a path against geometry computed independently by OCCT: either compute it "
+            "(PART.step --faces I J --radius R --feed F --period T) or read it (PATH.json "
+            "[--part PART.step]). Exit 5 when the over-cut exceeds --tolerance.")
+    p.add_argument("input", metavar="PART.step|PATH.json")
+    p.add_argument("--part", metavar="PART.step", help="the part of a saved PATH.json")
+    p.add_argument("--faces", nargs=2, type=int, metavar=("I", "J"))
+    p.add_argument("--radius", metavar="R", help="ball radius, mm")
+    p.add_argument("--allowance", default="0", metavar="C", help="stock allowance, mm")
+    p.add_argument("--feed", metavar="F", help="feed, mm/min")
+    p.add_argument("--period", metavar="T", help="period with its unit: 4ms, 0.004s, 250us")
+    p.add_argument("--start", metavar="X,Y,Z")
+    p.add_argument("--end", metavar="X,Y,Z")
+    p.add_argument("--edge", type=int, default=1, metavar="K")
+    p.add_argument("--tolerance", default="0.001", metavar="MM",
+                   help="largest acceptable over-cut, mm (default 0.001 = 1 um)")
+    p.add_argument("--json", action="store_true", help="the report as JSON")
+    return parser
+
+
+def _version() -> str:
+    try:
+        from importlib.metadata import version
+
+        return f"cadcnc {version('cadcnc')}"
+    except Exception:  # noqa: BLE001 - not installed: fall back to the source tree's value
+        return "cadcnc (version unknown)"
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    debug = getattr(args, "debug", False)
+    args.quiet = getattr(args, "quiet", False)
+    from cadcnc.errors import CadcncError
+
+    try:
+        return int(args.func(args) or 0)
+    except CadcncError as e:
+        if debug:
+            raise
+        print(f"cadcnc: error: {e}", file=sys.stderr)
+        return e.exit_code
+    except BrokenPipeError:  # `cadcnc run --stream ... | head`: the reader left, fine
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except KeyboardInterrupt:
+        print("cadcnc: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

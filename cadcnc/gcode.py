@@ -1,0 +1,166 @@
+"""RS274/NGC (LinuxCNC dialect, plain enough for most 3-axis controls) from toolpaths.
+
+Conventions (docs/cli.md "G-code"): mm (G21), absolute (G90), XY plane (G17), feed per
+minute (G94), path blending ``G64 P<tolerance>``; the part's +Z is the spindle axis and the
+path is reached from above: rapid to a safe Z, rapid over the first point, rapid down to
+``clearance`` above it, feed down onto it, one ``G1`` per kept point, rapid back up to the
+safe Z, ``M2``. The programmed point is the ball centre, or with ``tool_tip=True`` the tip
+of the ball (Z - R, R the cutter radius without allowance).
+
+Point dropping (``tolerance`` given): Douglas-Peucker, keeping a point whenever dropping it
+would move the polyline by ``tolerance`` or more; every dropped point lies within
+``tolerance`` of the chord that replaces it, and the two polylines are then within
+``tolerance`` of each other (Hausdorff). Coordinates are printed with the fewest decimals
+for which rounding moves a point (all three axes together, sqrt(3)/2 * 10^-d) by at most a
+tenth of the tolerance; without ``tolerance`` every point is kept and digits follow
+:data:`DEFAULT_TOLERANCE` (1 um: 4 decimals).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+from .errors import InputError
+
+DEFAULT_TOLERANCE = 0.001  # mm
+CLEARANCE = 2.0  # mm above the first point where the rapid approach ends
+SAFE_MARGIN = 10.0  # mm above the highest point (part or path) for rapids
+
+
+def digits_for(tolerance: float) -> int:
+    """Fewest decimals d with sqrt(3)/2 * 10**-d <= tolerance / 10 (3-D rounding error)."""
+    if not (math.isfinite(tolerance) and tolerance > 0):
+        raise InputError(f"G-code tolerance must be > 0 mm, got {tolerance!r}")
+    d = math.ceil(-math.log10(tolerance / 10 / (math.sqrt(3) / 2)) - 1e-12)
+    return max(d, 0)
+
+
+def _segment_distances(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance of each row of ``points`` to the segment a-b."""
+    ab = b - a
+    denom = ab @ ab
+    if denom == 0.0:
+        return np.linalg.norm(points - a, axis=1)
+    t = np.clip((points - a) @ ab / denom, 0.0, 1.0)
+    return np.linalg.norm(points - (a + t[:, None] * ab), axis=1)
+
+
+def simplify(points: np.ndarray, tolerance: float) -> np.ndarray:
+    """Indices of the points kept by Douglas-Peucker (first and last always kept).
+
+    A stretch i..j collapses to its chord only if every point in it is closer than
+    ``tolerance`` to the chord. Iterative (no recursion limit). ``points`` is (N, 3).
+    """
+    pts = np.asarray(points, dtype=float)
+    n = len(pts)
+    if n <= 2 or tolerance <= 0:
+        return np.arange(n)
+    keep = np.zeros(n, dtype=bool)
+    keep[0] = keep[-1] = True
+    stack = [(0, n - 1)]
+    while stack:
+        i, j = stack.pop()
+        if j - i < 2:
+            continue
+        d = _segment_distances(pts[i + 1:j], pts[i], pts[j])
+        k = int(np.argmax(d))
+        if d[k] >= tolerance:
+            m = i + 1 + k
+            keep[m] = True
+            stack.append((i, m))
+            stack.append((m, j))
+    return np.flatnonzero(keep)
+
+
+def _comment(text: str) -> str:
+    """An NGC comment: no parentheses inside, ASCII only."""
+    text = re.sub(r"[()]", lambda m: "[" if m.group() == "(" else "]", str(text))
+    return "(" + text.encode("ascii", "replace").decode() + ")"
+
+
+def _num(v: float, digits: int) -> str:
+    s = f"{v:.{digits}f}"
+    if "." in s:
+        s = s.rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+def programmed_points(path, tool_tip: bool = False) -> np.ndarray:
+    """The path's points as programmed: ball centres, or tips (Z - R) with ``tool_tip``."""
+    pts = np.array(path.points, dtype=float)
+    if tool_tip:
+        pts[:, 2] -= float(path.inputs.get("radius", 0.0))
+    return pts
+
+
+def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
+           safe_z: float | None = None, clearance: float = CLEARANCE,
+           spindle: float | None = None, title: str = "") -> str:
+    """One RS274/NGC program machining ``paths`` (Toolpath objects) in order.
+
+    ``tolerance`` (mm): drop points (see module doc); None keeps every point. ``safe_z``
+    (mm, programmed coordinates): rapid height; default the highest programmed point plus
+    10 mm (give the part's top plus a margin when the part rises above the path).
+    ``spindle`` (rpm): emit ``S.. M3`` / ``M5``.
+    """
+    paths = list(paths)
+    if not paths:
+        raise InputError("no toolpath to write")
+    tol = DEFAULT_TOLERANCE if tolerance is None else float(tolerance)
+    digits = digits_for(tol)
+    if clearance < 0:
+        raise InputError(f"clearance must be >= 0 mm, got {clearance!r}")
+    programmed = [programmed_points(p, tool_tip) for p in paths]
+    top = max(float(p[:, 2].max()) for p in programmed)
+    if safe_z is None:
+        safe_z = top + SAFE_MARGIN
+    elif safe_z < top + clearance:
+        raise InputError(f"safe Z {safe_z:g} mm is below the path's highest point "
+                         f"{top:g} mm plus the clearance {clearance:g} mm")
+    feeds = {float(p.inputs.get("feed", 0.0)) for p in paths}
+    if any(not f > 0 for f in feeds):
+        raise InputError("a toolpath has no feed in its inputs")
+    n = lambda v: _num(v, digits)  # noqa: E731
+    point_name = "tool tip (ball centre Z - R)" if tool_tip else "ball centre"
+    lines = [
+        "%",
+        _comment(f"cadcnc {title}".strip()),
+        _comment(f"programmed point: {point_name}; units mm; +Z is the spindle axis"),
+        _comment(f"tolerance {tol:g} mm ({'points dropped' if tolerance else 'every point kept'}"
+                 f"); {digits} decimals"),
+        "G17 G21 G40 G90 G94",
+        f"G64 P{_num(tol, digits)}",
+        f"G0 Z{n(safe_z)}",
+    ]
+    if spindle:
+        lines.append(f"S{_num(spindle, 0)} M3")
+    for k, (path, pts) in enumerate(zip(paths, programmed), 1):
+        keep = simplify(pts, tolerance) if tolerance else np.arange(len(pts))
+        r = float(path.inputs.get("radius", float("nan")))
+        c = float(path.inputs.get("allowance", 0.0))
+        lines.append(_comment(
+            f"path {k}: faces {path.faces[0]} {path.faces[1]}, ball R {r:g} mm, allowance "
+            f"{c:g} mm, {len(keep)} of {len(pts)} points, stop: {path.stop_reason}"))
+        first = pts[0]
+        lines += [
+            f"G0 X{n(first[0])} Y{n(first[1])}",
+            f"G0 Z{n(first[2] + clearance)}",
+            f"F{_num(float(path.inputs['feed']), 3)}",
+            f"G1 Z{n(first[2])}",
+        ]
+        lines += [f"G1 X{n(x)} Y{n(y)} Z{n(z)}" for x, y, z in pts[keep[1:]]]
+        lines.append(f"G0 Z{n(safe_z)}")
+    if spindle:
+        lines.append("M5")
+    lines += ["M2", "%"]
+    return "\n".join(lines) + "\n"
+
+
+def write_ngc(paths, out, **options) -> None:
+    """Write :func:`to_ngc` to ``out`` atomically."""
+    from .writers import write_text
+
+    write_text(out, to_ngc(paths, **options))

@@ -1,0 +1,83 @@
+"""Parse the quantities users type: durations with a unit, lengths, feeds and points.
+
+Internally cadcnc works in mm, mm/min and s (docs/conventions.md). A period must carry its
+unit (``4ms``, ``0.004s``, ``250us``) because a bare ``4`` is ambiguous; lengths may carry
+``mm`` and feeds ``mm/min``, nothing else. Every failure is an :class:`InputError` naming
+the parameter and the unit it expects.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+from .errors import InputError
+
+_NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+_QUANTITY = re.compile(rf"^\s*({_NUMBER})\s*([A-Za-zµ/]*)\s*$")
+DURATION_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
+
+
+def _split(text: str, name: str, expected: str) -> tuple[float, str]:
+    m = _QUANTITY.match(str(text))
+    if not m:
+        raise InputError(f"{name}: cannot read {text!r} as a number ({expected})")
+    value = float(m.group(1))
+    if not math.isfinite(value):
+        raise InputError(f"{name}: {text!r} is not a finite number ({expected})")
+    return value, m.group(2)
+
+
+def parse_duration(text: str, name: str = "period") -> float:
+    """Seconds from ``4ms``, ``0.004s``, ``250us`` (or ``250µs``); must be > 0."""
+    expected = "give a unit: 4ms, 0.004s or 250us"
+    value, unit = _split(text, name, expected)
+    if not unit:
+        raise InputError(f"{name}: {text!r} has no unit; {expected}")
+    if unit not in DURATION_UNITS:
+        raise InputError(f"{name}: unknown unit {unit!r} in {text!r}; {expected}")
+    if value <= 0:
+        raise InputError(f"{name} must be > 0, got {text!r}")
+    return value * DURATION_UNITS[unit]
+
+
+def parse_length(text: str, name: str, allow_zero: bool = True) -> float:
+    """Millimetres from ``3`` or ``3mm``; must be >= 0 (> 0 unless ``allow_zero``)."""
+    value, unit = _split(text, name, "a length in mm")
+    if unit not in ("", "mm"):
+        raise InputError(f"{name}: lengths are in mm, got unit {unit!r} in {text!r}")
+    if value < 0 or (value == 0 and not allow_zero):
+        raise InputError(f"{name} must be {'>=' if allow_zero else '>'} 0 mm, got {text!r}")
+    return value
+
+
+def parse_feed(text: str, name: str = "feed") -> float:
+    """mm/min from ``1500`` or ``1500mm/min``; must be > 0."""
+    value, unit = _split(text, name, "a feed in mm/min")
+    if unit not in ("", "mm/min"):
+        raise InputError(f"{name}: feeds are in mm/min, got unit {unit!r} in {text!r}")
+    if value <= 0:
+        raise InputError(f"{name} must be > 0 mm/min, got {text!r}")
+    return value
+
+
+def parse_point(text: str, name: str) -> tuple[float, float, float]:
+    """A point ``X,Y,Z`` in mm (spaces allowed)."""
+    parts = [p for p in re.split(r"[,\s]+", str(text).strip()) if p]
+    if len(parts) != 3:
+        raise InputError(f"{name}: expected X,Y,Z in mm, got {text!r}")
+    try:
+        xyz = tuple(float(p) for p in parts)
+    except ValueError:
+        raise InputError(f"{name}: expected X,Y,Z in mm, got {text!r}") from None
+    if not all(math.isfinite(v) for v in xyz):
+        raise InputError(f"{name}: coordinates must be finite, got {text!r}")
+    return xyz
+
+
+def format_duration(seconds: float) -> str:
+    """``4 ms``, ``250 us``, ``1.5 s``: the largest unit that keeps the number >= 1."""
+    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6)):
+        if abs(seconds) >= scale:
+            return f"{seconds / scale:g} {unit}"
+    return f"{seconds:g} s"

@@ -1,0 +1,7 @@
+"""``python -m cadcnc.cli``: the same as the ``cadcnc`` console script."""
+
+import sys
+
+from .main import main
+
+sys.exit(main())

@@ -1,0 +1,219 @@
+"""cadcnc.verification: the independent OCCT check of a toolpath (issue 4).
+
+Tolerances used below, and why:
+- 1e-9 mm where verify and a closed form compute the same exact distance two ways (OCCT
+  projection vs algebra): both are exact to ~1e-12 mm at coordinates of ~50 mm.
+- 1e-3 mm gouge: the default pass/fail tolerance of `cadcnc verify` (1 micrometre).
+- corruption magnitudes are compared within the uncorrupted path's own worst deviation
+  (3e-5 mm on crossing_cylinders at f = 0.1 mm) plus 1e-6 mm.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import time
+
+import numpy as np
+import pytest
+
+import cadcnc
+from cadcnc.verification import verify
+from conftest import CONCAVE_PAIRS, FIXTURES, load_fixture
+
+VSIDE = json.loads((FIXTURES / "verification_fixtures.json").read_text())["third_face"]
+F = 0.1  # mm per cycle: feed 1500 mm/min, period 4 ms (the paper's numbers)
+
+
+def radius_for(name: str) -> float:
+    """3 mm, except narrow_slot whose 4 mm slot and r=2 hole cannot take a 3 mm ball."""
+    return 1.5 if name == "narrow_slot" else 3.0
+
+
+def path(name, i, j, radius=None, step=F, **kw):
+    part = load_fixture(name)
+    r = radius_for(name) if radius is None else radius
+    return part, cadcnc.intersection_path(part.face(i), part.face(j), radius=r,
+                                          feed=step / 0.004 * 60, period=0.004, **kw)
+
+
+def subset(tp, keep):
+    """The toolpath restricted to the cycles ``keep`` (bounds included)."""
+    b = tuple(dataclasses.replace(s, **{f.name: getattr(s, f.name)[keep]
+                                        for f in dataclasses.fields(s)}) for s in tp.bounds)
+    return dataclasses.replace(
+        tp, points=tp.points[keep], contacts=tp.contacts[keep], normals=tp.normals[keep],
+        uv=tp.uv[keep], steps=tp.steps[keep], commanded=tp.commanded[keep], bounds=b)
+
+
+def closed_form_distance(p, a=23.0, b=13.0):
+    """Distance from p to the offset saddle (b cos t, b sin t, sqrt(a^2 - b^2 sin^2 t))."""
+    t0, half = np.arctan2(p[1], p[0]), 0.05
+    for _ in range(12):  # zoom in on the minimum, 40x each round
+        t = np.linspace(t0 - half, t0 + half, 81)
+        q = np.stack([b * np.cos(t), b * np.sin(t), np.sqrt(a * a - (b * np.sin(t)) ** 2)], 1)
+        d = np.linalg.norm(q - p, axis=1)
+        t0, half = t[np.argmin(d)], half / 40
+    return d.min()
+
+
+@pytest.fixture(scope="module")
+def cylinders():
+    part, tp = path("crossing_cylinders", 1, 2)
+    return part, tp, verify(tp, part)
+
+
+# -- agreement with a closed form ---------------------------------------------------------
+def test_crossing_cylinders_deviation_matches_closed_form(cylinders):
+    _, tp, rep = cylinders
+    x, y, z = tp.points.T
+    exact = [np.hypot(y, z) - 20.0 - 3.0, np.hypot(x, y) - 10.0 - 3.0]
+    for s, e in zip(rep.surfaces, exact):
+        assert np.abs(s.deviation - e).max() < 1e-9
+        assert np.abs(s.face_deviation - e).max() < 1e-9
+    worst_over = max(np.maximum(-e, 0).max() for e in exact)
+    worst_under = max(np.maximum(e, 0).max() for e in exact)
+    assert rep.max_overcut_mm == pytest.approx(worst_over, abs=1e-9)
+    assert rep.max_undercut_mm == pytest.approx(worst_under, abs=1e-9)
+    # the offset intersection y^2+z^2 = 23^2, x^2+y^2 = 13^2 is OCCT's branch too
+    ref = rep.reference
+    assert ref.residual_mm < 1e-7
+    d = np.array([closed_form_distance(p) for p in tp.points])
+    # OCCT's curve is an approximation within residual_mm of both offset surfaces; the
+    # normals meet at 60..90 deg, so it is within ~1.6 x residual of the true curve
+    assert np.abs(ref.points_to_branch - d).max() < 2 * ref.residual_mm + 1e-9
+    assert ref.coverage == 1.0 and rep.stop["consistent"]
+
+
+def test_crossing_cylinders_radius_zero_follows_the_brep_edge():
+    part, tp = path("crossing_cylinders", 1, 2, radius=0.0)
+    rep = verify(tp, part)
+    assert rep.edge_deviation_mm is not None and rep.edge_deviation_mm < 1e-5
+    assert rep.hausdorff_mm < 1e-3
+
+
+# -- every fixture pair -------------------------------------------------------------------
+KNOWN_GOUGES = {("ellipse_pocket", 7, 8): "3 mm ball where R'k reaches 0.9: over-cut 3.1e-3 mm"}
+# step length off the commanded f by more than 1 % (a finding reported to the interpolator)
+KNOWN_FEED = {("ellipse_pocket", 7, 8): 0.049, ("narrow_slot", 11, 12): 0.0146}
+
+
+@pytest.mark.parametrize("name,i,j", CONCAVE_PAIRS)
+def test_every_fixture_pair_verifies(name, i, j):
+    part, tp = path(name, i, j)
+    if len(tp) < 2:
+        pytest.skip(f"{name} {i}/{j}: no path at radius {radius_for(name)} ({tp.stop_reason})")
+    rep = verify(tp, part)
+    d = rep.to_dict()
+    json.dumps(d)
+    for key in ("max_overcut_mm", "max_undercut_mm", "hausdorff_mm", "coverage",
+                "whole_part_hits"):
+        assert key in d
+    assert all(s.unseeded_disagreements == 0 for s in rep.surfaces)
+    assert rep.reference.residual_mm < 1e-6  # OCCT's curve is a trustworthy reference
+    # each centre's distance to OCCT's branch is no larger than its deviation allows
+    dev = max(np.abs(s.face_deviation).max() for s in rep.surfaces)
+    assert rep.reference.points_max_mm < 10 * dev + 1e-6
+    if tp.stop_reason in ("end", "closed"):
+        assert rep.coverage > 0.999
+    else:
+        assert rep.stop["consistent"] and rep.stop["left_face"]
+    assert rep.feed["max_rel_error"] < KNOWN_FEED.get((name, i, j), 0.0099) + 0.001
+    third = [h for h in rep.whole_part_hits if not h["followed"]]
+    assert third == []
+    if (name, i, j) in KNOWN_GOUGES:
+        pytest.xfail(KNOWN_GOUGES[(name, i, j)])
+    assert rep.ok(1e-3), rep.format_table()
+
+
+# -- corrupted paths are caught -----------------------------------------------------------
+def test_point_pushed_into_a_face_is_caught_at_its_cycle(cylinders):
+    part, tp, clean = cylinders
+    k = 150
+    pts = tp.points.copy()
+    pts[k] -= 0.01 * tp.normals[k, 0]
+    rep = verify(dataclasses.replace(tp, points=pts), part)
+    s = rep.surfaces[0]
+    assert s.overcut_cycle == k
+    assert abs(s.max_overcut_mm - 0.01) < clean.surfaces[0].max_overcut_mm + 1e-6
+    assert rep.max_gouge_mm == pytest.approx(s.max_overcut_mm)
+    assert not rep.ok(1e-3) and clean.ok(1e-3)
+    hit = [h for h in rep.whole_part_hits if h["face"] == 1][0]
+    assert hit["worst_cycle"] == k
+
+
+def test_skipped_stretch_on_a_curve_is_caught(cylinders):
+    part, tp, clean = cylinders
+    keep = np.r_[0:100, 150:len(tp)]
+    rep = verify(subset(tp, keep), part)
+    gaps = rep.reference.gaps
+    assert len(gaps) == 1
+    # 50 missing steps = 5 mm; each neighbour covers 0.6 f of it
+    assert 5.0 - 1.2 * F - 0.05 < gaps[0][1] - gaps[0][0] < 5.0 + 0.05
+    assert rep.coverage < 0.9
+    # a 5 mm chord across the gap sags ~ 5^2 / (8 * 13) ~ 0.02 mm off the curve
+    assert rep.hausdorff_mm > 100 * clean.hausdorff_mm
+    assert rep.feed["worst_cycle"] == 100 and rep.feed["max_rel_error"] > 40
+
+
+def test_skipped_stretch_on_a_straight_edge_is_caught_by_coverage():
+    part, tp = path("pocket", 10, 17)
+    rep = verify(subset(tp, np.r_[0:50, 80:len(tp)]), part)
+    assert rep.hausdorff_mm < 1e-9  # a straight gap cannot show in the Hausdorff distance
+    # centres 49 and 80 remain: 31 steps apart, each covers 0.6 f of the gap
+    assert rep.coverage == pytest.approx(1 - (31 * F - 1.2 * F) / tp.length, abs=1e-3)
+
+
+def test_wrong_step_is_caught_by_the_feed_check(cylinders):
+    part, tp, clean = cylinders
+    k = 200
+    pts = tp.points.copy()
+    pts[k] += 0.02 * tp.tangents[k]
+    rep = verify(dataclasses.replace(tp, points=pts), part)
+    assert rep.feed["worst_cycle"] in (k, k + 1)
+    assert rep.feed["max_rel_error"] == pytest.approx(0.2, abs=2e-3)
+    assert clean.feed["max_rel_error"] < 1e-4
+
+
+# -- whole-part gouge check --------------------------------------------------------------
+@pytest.fixture(scope="module")
+def third_face_part():
+    return cadcnc.load_step(FIXTURES / VSIDE["file"])
+
+
+@pytest.mark.parametrize("case", VSIDE["cases"], ids=lambda c: c["name"])
+def test_whole_part_check_catches_a_third_face(third_face_part, case):
+    part = third_face_part
+    tp = cadcnc.intersection_path(*(part.face(n) for n in case["faces"]),
+                                  radius=case["radius"], feed=1500, period=0.004)
+    rep = verify(tp, part)
+    hits = {h["face"]: h for h in rep.whole_part_hits}
+    assert rep.max_overcut_mm < 1e-9  # the pair itself is followed exactly (planes)
+    for face, exp in case["hits"].items():
+        h = hits[int(face)]
+        assert h["depth_mm"] == pytest.approx(exp["max_depth"], abs=1e-9)
+        # closed form: the ball reaches R' - |x - x_wall| into the wall
+        expected = np.nonzero(case["radius"] - np.abs(tp.points[:, 0] - exp["plane_x"])
+                              > 1e-6)[0]
+        assert h["n_cycles"] == len(expected)
+        assert h["cycles"][0][0] == expected[0] and h["cycles"][-1][1] == expected[-1]
+    assert not rep.ok(1e-3)
+
+
+# -- API details --------------------------------------------------------------------------
+def test_part_defaults_to_the_toolpath_source_and_progress_is_called(cylinders):
+    _, tp, clean = cylinders
+    calls = []
+    rep = verify(tp, progress=lambda *a: calls.append(a))
+    assert rep.max_overcut_mm == clean.max_overcut_mm
+    assert {c[0] for c in calls} >= {"surfaces", "reference", "whole part"}
+    text = rep.format_table()
+    assert "face 1" in text and "OK" in text
+
+
+def test_a_thousand_point_path_verifies_in_seconds():
+    part, tp = path("torus_cone", 4, 5)
+    assert len(tp) > 1000
+    t0 = time.perf_counter()
+    verify(tp, part)
+    assert time.perf_counter() - t0 < 10.0
