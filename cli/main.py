@@ -25,15 +25,20 @@ def _common(debug_quiet: bool = True):
     return common
 
 
-def _job_args(p, outputs: bool = True):
+def _job_args(p):
     p.add_argument("step", metavar="PART.step", help="the part (STEP file, mm)")
-    p.add_argument("--faces", nargs=2, type=int, required=True, metavar=("I", "J"),
+    _job_options(p, required=True)
+
+
+def _job_options(p, required: bool):
+    """The machining job's options (faces, cutter, feed, period, start/end, edge)."""
+    p.add_argument("--faces", nargs=2, type=int, required=required, metavar=("I", "J"),
                    help="the two faces, numbered as `cadcnc faces` (FreeCAD's FaceN)")
-    p.add_argument("--radius", required=True, metavar="R", help="ball radius, mm")
+    p.add_argument("--radius", required=required, metavar="R", help="ball radius, mm")
     p.add_argument("--allowance", default="0", metavar="C",
                    help="stock allowance left on both faces, mm (default 0)")
-    p.add_argument("--feed", required=True, metavar="F", help="feed, mm/min")
-    p.add_argument("--period", required=True, metavar="T",
+    p.add_argument("--feed", required=required, metavar="F", help="feed, mm/min")
+    p.add_argument("--period", required=required, metavar="T",
                    help="interpolation period with its unit: 4ms, 0.004s or 250us")
     p.add_argument("--start", metavar="X,Y,Z",
                    help="start point near the intersection, mm (default: the shared "
@@ -130,14 +135,7 @@ def build_parser():
             "[--part PART.step]). Exit 5 when the over-cut exceeds --tolerance.")
     p.add_argument("input", metavar="PART.step|PATH.json")
     p.add_argument("--part", metavar="PART.step", help="the part of a saved PATH.json")
-    p.add_argument("--faces", nargs=2, type=int, metavar=("I", "J"))
-    p.add_argument("--radius", metavar="R", help="ball radius, mm")
-    p.add_argument("--allowance", default="0", metavar="C", help="stock allowance, mm")
-    p.add_argument("--feed", metavar="F", help="feed, mm/min")
-    p.add_argument("--period", metavar="T", help="period with its unit: 4ms, 0.004s, 250us")
-    p.add_argument("--start", metavar="X,Y,Z")
-    p.add_argument("--end", metavar="X,Y,Z")
-    p.add_argument("--edge", type=int, default=1, metavar="K")
+    _job_options(p, required=False)
     p.add_argument("--tolerance", default="0.001", metavar="MM",
                    help="largest acceptable over-cut, mm (default 0.001 = 1 um)")
     p.add_argument("--json", action="store_true", help="the report as JSON")

@@ -312,3 +312,17 @@ def test_docs_examples_run(example, tmp_path):
         from test_gcode import rs274
 
         assert len(rs274(tmp_path, out.read_text())) > 400
+
+
+def test_path_refuses_a_path_that_gouges_a_third_face(tmp_path):
+    """A 3 mm ball in the 4 mm slot cuts the opposite wall: refused, nothing written."""
+    out = tmp_path / "slot.json"
+    args = [sys.executable, "-m", "cadcnc.cli", "path", str(FIXTURES / "narrow_slot.step"),
+            "--faces", "3", "4", "--radius", "3", "--feed", "1500", "--period", "4ms",
+            "-o", str(out)]
+    run = subprocess.run(args, capture_output=True, text=True)
+    assert run.returncode == 5, run.stderr
+    assert "refused" in run.stderr and "face 5 by 2 mm" in run.stderr
+    assert not out.exists()
+    run = subprocess.run(args + ["--allow-gouge", "--quiet"], capture_output=True, text=True)
+    assert run.returncode == 0 and out.exists()
