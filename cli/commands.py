@@ -234,6 +234,11 @@ def run(args) -> int:
         paths.append(tp)
         if not args.quiet:
             print(f"PATH {job.name} (line {job.line}): " + summary(tp, job.part_file))
+        refused = "" if args.allow_gouge or not outputs else _gouge_gate(
+            tp, part, float(args.gouge_tolerance))
+        if refused:
+            _err(f"{source}:{job.line}: PATH {job.name}: " + refused)
+            return VERIFY_FAILED
     for out in outputs:
         if Path(out).suffix.lower() == ".ngc":
             gopts = _gcode_options(args, checked[0][1])

@@ -48,6 +48,14 @@ def _job_options(p, required: bool):
                    help="which shared concave edge when the faces share several (1, 2, ...)")
 
 
+def _gouge_args(p):
+    p.add_argument("--gouge-tolerance", default="0.001", metavar="MM",
+                   help="refuse (exit 5, nothing written) a path whose ball cuts any face of "
+                        "the part deeper than this, mm (default 0.001)")
+    p.add_argument("--allow-gouge", action="store_true",
+                   help="write the path even when the whole-part check finds a gouge")
+
+
 def _gcode_args(p):
     g = p.add_argument_group("G-code (.ngc output)")
     g.add_argument("--tolerance", metavar="MM",
@@ -97,11 +105,7 @@ def build_parser():
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
                    help="output file: .json (everything), .csv (a row per cycle) or .ngc "
                         "(G-code); repeat for several")
-    p.add_argument("--gouge-tolerance", default="0.001", metavar="MM",
-                   help="refuse (exit 5, nothing written) a path whose ball cuts any face of "
-                        "the part deeper than this, mm (default 0.001)")
-    p.add_argument("--allow-gouge", action="store_true",
-                   help="write the path even when the whole-part check finds a gouge")
+    _gouge_args(p)
     _gcode_args(p)
 
     p = add("run", commands.run, "execute an APT-like part program (PATH = P/[...])",
@@ -113,6 +117,7 @@ def build_parser():
     p.add_argument("-o", "--output", action="append", metavar="OUT",
                    help=".ngc: one program for all paths; .json/.csv: one file per path "
                         "(OUT-NAME.json when the program has several)")
+    _gouge_args(p)
     _gcode_args(p)
 
     p = add("demo", commands.demo, "run the main job on a bundled part and write everything",
