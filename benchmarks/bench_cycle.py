@@ -2,7 +2,7 @@
 
 Prints, for two fixtures, the time of one interpolation cycle (median, p99, max, in
 microseconds) and of one baseline step run in the same process: predict along n1 x n2,
-then Newton on the four contact parameters to 1e-10 mm (cadcnc.tangency.solve_tangency).
+then Newton on the four contact parameters to 1e-10 mm (cadcnc.interp.tangency.solve_tangency).
 Ratios, not absolute times, are the figures to compare across machines.
 
     .venv/bin/python benchmarks/bench_cycle.py [--cycles N]
@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 
 import cadcnc
-from cadcnc.path import plan_path
-from cadcnc.stepper import Stepper
-from cadcnc.tangency import solve_tangency
+from cadcnc.ops.pair_path import plan_path
+from cadcnc.interp.stepper import Stepper
+from cadcnc.interp.tangency import solve_tangency
 from cadcnc.tolerances import DEFAULT
 
 ROOT = Path(__file__).resolve().parents[1]

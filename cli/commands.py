@@ -66,7 +66,7 @@ def part_top(part) -> float:
 
 
 def _gcode_options(args, part) -> dict:
-    from cadcnc.gcode import SAFE_MARGIN
+    from cadcnc.io.gcode import SAFE_MARGIN
     from cadcnc.units import parse_length
 
     tol = None if args.tolerance is None else parse_length(args.tolerance, "tolerance", False)
@@ -173,7 +173,7 @@ def faces_report(part) -> dict:
 # -- path ------------------------------------------------------------------------------------
 def path(args) -> int:
     import cadcnc
-    from cadcnc.writers import check_output, write_toolpaths
+    from cadcnc.io.writers import check_output, write_toolpaths
 
     for out in args.output:
         check_output(out)
@@ -215,7 +215,7 @@ def _gouge_gate(tp, part, tolerance_mm: float) -> str:
 def run(args) -> int:
     from cadcnc import apt
     from cadcnc.errors import InputError
-    from cadcnc.writers import check_output, write_toolpaths
+    from cadcnc.io.writers import check_output, write_toolpaths
 
     outputs = args.output or []
     if args.stream and outputs:
@@ -292,8 +292,8 @@ def demo_step() -> Path:
 def demo(args) -> int:
     import cadcnc
     from cadcnc.errors import OutputError
-    from cadcnc.plot import write_picture
-    from cadcnc.writers import write_text, write_toolpaths
+    from cadcnc.io.plot import write_picture
+    from cadcnc.io.writers import write_text, write_toolpaths
 
     step = demo_step()
     out = Path(args.out)
@@ -366,7 +366,7 @@ def _verification(tp, part):
 def _load_saved(path_json: str, part_file: str | None):
     import cadcnc
     from cadcnc.errors import InputError
-    from cadcnc.writers import read_json
+    from cadcnc.io.writers import read_json
 
     tp = read_json(path_json)
     if part_file is None:
@@ -380,7 +380,7 @@ def _load_saved(path_json: str, part_file: str | None):
 
 
 def plot(args) -> int:
-    from cadcnc.plot import write_picture
+    from cadcnc.io.plot import write_picture
     from cadcnc.errors import OutputError
 
     if Path(args.output).suffix.lower() not in (".png", ".glb"):

@@ -17,7 +17,7 @@ from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 
 from cadcnc import FaceSurface, SingularPointError
-from cadcnc.face_surface import INSIDE, ON_BOUNDARY, OUTSIDE
+from cadcnc.geometry.face_surface import INSIDE, ON_BOUNDARY, OUTSIDE
 
 V = cq.Vector
 

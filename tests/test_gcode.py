@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.gcode import DEFAULT_TOLERANCE, digits_for, programmed_points, simplify, to_ngc
+from cadcnc.io.gcode import DEFAULT_TOLERANCE, digits_for, programmed_points, simplify, to_ngc
 
 from conftest import load_fixture
 

@@ -10,7 +10,7 @@ import pytest
 from conftest import SIDECAR, load_fixture
 
 import cadcnc
-from cadcnc.interpolator import BOUNDARY, CLOSED, CURVATURE, END, MAX_CYCLES, SINGULAR, TANGENT
+from cadcnc.interp.cycle import BOUNDARY, CLOSED, CURVATURE, END, MAX_CYCLES, SINGULAR, TANGENT
 
 KW = dict(feed=1500.0, period=0.004)  # step 0.1 mm
 

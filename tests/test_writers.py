@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.error_bounds import SurfaceBounds
+from cadcnc.interp.error_bounds import SurfaceBounds
 from cadcnc.errors import InputError, OutputError
-from cadcnc.writers import (
+from cadcnc.io.writers import (
     ARRAYS, CSV_COLUMNS, atomic_write, check_output, read_csv, read_json, toolpath_from_dict,
     toolpath_to_dict, write_csv, write_json, write_toolpaths,
 )

@@ -23,7 +23,7 @@ import re
 
 import numpy as np
 
-from .errors import InputError
+from ..errors import InputError
 
 DEFAULT_TOLERANCE = 0.001  # mm
 CLEARANCE = 2.0  # mm above the first point where the rapid approach ends

@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .error_bounds import SurfaceBounds, bounds_for_surface, mp_length, surface_curvatures
-from .stepper import PathRecord
+from ..interp.error_bounds import SurfaceBounds, bounds_for_surface, mp_length, surface_curvatures
+from ..interp.stepper import PathRecord
 
 
 @dataclass

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import verification_occt as occt
+from . import probe as occt
 
 
 @dataclass

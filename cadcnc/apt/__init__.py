@@ -29,8 +29,8 @@ import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from .errors import CadcncError, InputError, ProgramSyntaxError
-from .units import DURATION_UNITS
+from ..errors import CadcncError, InputError, ProgramSyntaxError
+from ..units import DURATION_UNITS
 
 _NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _TOKEN = re.compile(rf"""
@@ -382,8 +382,8 @@ def check(job_list: list[PathJob], source: str = "<program>", load=None):
     """
     import numpy as np
 
-    from .part import load_step
-    from .path import shared_edge_for
+    from ..geometry.part import load_step
+    from ..ops.pair_path import shared_edge_for
 
     load = load or load_step
     parts: dict[str, object] = {}
@@ -412,7 +412,7 @@ def check(job_list: list[PathJob], source: str = "<program>", load=None):
 
 def run_job(job: PathJob, part, progress=None, source: str = "<program>"):
     """The :class:`~cadcnc.toolpath.Toolpath` of one checked job."""
-    from .path import intersection_path
+    from ..ops.pair_path import intersection_path
 
     try:
         return intersection_path(part.face(job.faces[0]), part.face(job.faces[1]),
@@ -423,7 +423,7 @@ def run_job(job: PathJob, part, progress=None, source: str = "<program>"):
 
 def stream_job(job: PathJob, part, source: str = "<program>"):
     """(stepper, increments): the stepper and a generator of its per-period (dx, dy, dz)."""
-    from .path import make_stepper
+    from ..ops.pair_path import make_stepper
 
     try:
         stepper = make_stepper(part.face(job.faces[0]), part.face(job.faces[1]),

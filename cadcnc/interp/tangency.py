@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import StartPointError
+from ..errors import StartPointError
 from .stepper import Tangency
-from .tolerances import DEFAULT, Tolerances
+from ..tolerances import DEFAULT, Tolerances
 
 
 def offset_point_and_jacobian(surface, offset: float, u: float, w: float):

@@ -32,8 +32,8 @@ from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
 from OCP.TopoDS import TopoDS, TopoDS_Face
 
 from . import differential as dg
-from .errors import InputError, SingularPointError
-from .tolerances import DEFAULT, Tolerances
+from ..errors import InputError, SingularPointError
+from ..tolerances import DEFAULT, Tolerances
 
 SURFACE_KINDS = {
     GeomAbs_Plane: "plane",
@@ -189,7 +189,7 @@ class FaceSurface:
         else:
             proj = GeomAPI_ProjectPointOnSurf(pnt, self.geom_surface)
         if not proj.IsDone() or proj.NbPoints() == 0:
-            from .errors import GeometryError
+            from ..errors import GeometryError
 
             raise GeometryError(f"{self!r}: no projection of point {tuple(point)} found")
         u, w = proj.LowerDistanceParameters()

@@ -13,13 +13,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import FacePairError, GeometryError, InputError, StartPointError
-from .face_surface import FaceSurface
-from .part import CONCAVE
-from .stepper import Stepper, Tangency
-from .tangency import solve_tangency
-from .tolerances import DEFAULT, Tolerances
-from .toolpath import Toolpath, toolpath_from_record
+from ..errors import FacePairError, GeometryError, InputError, StartPointError
+from ..geometry.face_surface import FaceSurface
+from ..geometry.part import CONCAVE
+from ..interp.stepper import Stepper, Tangency
+from ..interp.tangency import solve_tangency
+from ..tolerances import DEFAULT, Tolerances
+from ..program.toolpath import Toolpath, toolpath_from_record
 
 
 @dataclass(frozen=True)

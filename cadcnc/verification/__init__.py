@@ -17,9 +17,9 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from . import verification_occt as occt
-from .errors import InputError
-from .verification_reference import ReferenceCheck, check_reference
+from . import probe as occt
+from ..errors import InputError
+from .reference import ReferenceCheck, check_reference
 
 NOISE_MM = 1e-8  # below this is round-off: start tangency solved to 1e-9, IntSS curve ~5e-9
 
@@ -122,7 +122,7 @@ class VerificationReport:
             edge_deviation_mm=self.edge_deviation_mm, seconds=self.seconds))
 
     def format_table(self, tolerance_mm: float = 1e-3) -> str:
-        from .verification_table import format_table
+        from .table import format_table
 
         return format_table(self, tolerance_mm)
 
@@ -155,7 +155,7 @@ def _ranges(cycles) -> list:
 def _resolve_part(toolpath, part):
     if part is not None:
         return part
-    from .part import load_step
+    from ..geometry.part import load_step
 
     source = toolpath.inputs.get("source")
     if not source or str(source).startswith("<"):
@@ -329,7 +329,7 @@ def verify(toolpath, part=None, *, sample_unseeded: int = 64, hit_tolerance_mm: 
     ball = radius + float(inputs.get("allowance", 0.0))
     edge = None
     if inputs.get("start") is None and "edge" in inputs:
-        from .part import CONCAVE
+        from ..geometry.part import CONCAVE
 
         concave = [e for e in part.shared_edges(*toolpath.faces) if e.edge_class == CONCAVE]
         edge = concave[inputs["edge"]] if inputs["edge"] < len(concave) else None

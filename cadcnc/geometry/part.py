@@ -24,9 +24,9 @@ from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
-from .errors import FaceNumberError, StepFileError
+from ..errors import FaceNumberError, StepFileError
 from .face_surface import FaceSurface
-from .tolerances import DEFAULT, Tolerances
+from ..tolerances import DEFAULT, Tolerances
 
 CONCAVE, CONVEX, TANGENT, MIXED = "concave", "convex", "tangent", "mixed"
 

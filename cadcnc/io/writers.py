@@ -28,9 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .error_bounds import SurfaceBounds
-from .errors import InputError, OutputError
-from .toolpath import Toolpath
+from ..interp.error_bounds import SurfaceBounds
+from ..errors import InputError, OutputError
+from ..program.toolpath import Toolpath
 
 FORMAT = "cadcnc-toolpath"
 VERSION = 1

@@ -143,7 +143,7 @@ def write_picture(path, part, out, title: str = "") -> None:
     """Write ``out`` by suffix: .png (matplotlib) or .glb (trimesh scene), atomically."""
     from pathlib import Path
 
-    from .errors import OutputError
+    from ..errors import OutputError
     from .writers import write_bytes
 
     suffix = Path(out).suffix.lower()

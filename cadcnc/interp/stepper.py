@@ -12,12 +12,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .errors import InputError
-from .interpolator import (
+from ..errors import InputError
+from .cycle import (
     BOUNDARY, CLOSED, DIVERGED, END, MAX_CYCLES, SINGULAR, Contact, StopCycle, SurfaceLike,
     check_curvature, cycle,
 )
-from .tolerances import DEFAULT, Tolerances
+from ..tolerances import DEFAULT, Tolerances
 from .vec3 import Vec, dot, norm, scale, sub
 
 OUTSIDE = "outside"

@@ -1,0 +1,119 @@
+"""The layout rules of docs/architecture.md, checked on the source tree.
+
+- The interpolation core (``cadcnc/interp/``) imports no OCCT: only itself, the kernel-free
+  top-level modules, the standard library, numpy and numba.
+- No import cycles between cadcnc modules, function-local imports included.
+- No module over 400 lines; no flat ``verification_*`` modules.
+"""
+
+from __future__ import annotations
+
+import ast
+import sys
+from pathlib import Path
+
+import pytest
+
+PKG = Path(__file__).resolve().parents[1] / "cadcnc"
+CLI = PKG.parent / "cli"
+KERNEL_FREE_TOP = {"cadcnc.errors", "cadcnc.tolerances", "cadcnc.job", "cadcnc.units",
+                   "cadcnc.trim"}
+THIRD_PARTY_OK_IN_CORE = {"numpy", "numba"}
+
+
+def module_name(path: Path) -> str:
+    if path.is_relative_to(CLI):
+        parts = ("cadcnc", "cli", *path.relative_to(CLI).with_suffix("").parts)
+    else:
+        parts = ("cadcnc", *path.relative_to(PKG).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def sources() -> dict[str, Path]:
+    files = list(PKG.rglob("*.py")) + list(CLI.rglob("*.py"))
+    return {module_name(f): f for f in files if "__pycache__" not in f.parts}
+
+
+MODULES = sources()
+
+
+def imports(name: str) -> set[str]:
+    """Every module ``name`` imports (absolute names), at any depth of the file."""
+    path = MODULES[name]
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[:len(base) - node.level + 1]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module or ""
+            out.add(mod)
+            # `from . import x` / `from .pkg import mod`: x may itself be a module
+            out |= {f"{mod}.{a.name}" for a in node.names if f"{mod}.{a.name}" in MODULES}
+    return out
+
+
+def internal(name: str) -> set[str]:
+    """The cadcnc modules ``name`` depends on (a package import counts as its __init__)."""
+    return {m for m in imports(name) if m in MODULES and m != name}
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES if n.startswith("cadcnc.interp")))
+def test_interpolation_core_imports_no_occt(name):
+    for mod in imports(name):
+        top = mod.split(".")[0]
+        if top == "cadcnc":
+            assert mod.startswith("cadcnc.interp") or mod in KERNEL_FREE_TOP, (name, mod)
+        else:
+            assert top in sys.stdlib_module_names or top in THIRD_PARTY_OK_IN_CORE, (name, mod)
+
+
+def test_kernel_free_top_level_modules_import_no_occt():
+    for name in KERNEL_FREE_TOP & set(MODULES):
+        for mod in imports(name):
+            top = mod.split(".")[0]
+            assert top not in ("OCP", "cadquery"), (name, mod)
+            if top == "cadcnc":
+                assert mod in KERNEL_FREE_TOP, (name, mod)
+
+
+def test_no_import_cycles():
+    graph = {n: internal(n) for n in MODULES}
+    # a package's __init__ re-exporting its submodules is not a dependency of them
+    for n, deps in graph.items():
+        graph[n] = {d for d in deps if not n.startswith(d + ".")}
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def visit(n):
+        state[n] = 1
+        stack.append(n)
+        for d in sorted(graph[n]):
+            if state.get(d) == 1:
+                cycle = stack[stack.index(d):] + [d]
+                pytest.fail("import cycle: " + " -> ".join(cycle))
+            if d not in state:
+                visit(d)
+        stack.pop()
+        state[n] = 2
+
+    for n in sorted(graph):
+        if n not in state:
+            visit(n)
+
+
+def test_modules_are_small():
+    long = {n: len(p.read_text().splitlines()) for n, p in MODULES.items()}
+    assert {n: k for n, k in long.items() if k > 400} == {}
+
+
+def test_no_flat_verification_modules():
+    assert not list(PKG.glob("verification_*.py"))
+    assert (PKG / "verification" / "__init__.py").is_file()
