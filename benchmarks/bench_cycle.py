@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 import cadcnc
-from cadcnc.ops.pair_path import plan_path
+from cadcnc.ops.pair_path import pair_job, plan_path
 from cadcnc.interp.stepper import Stepper
 from cadcnc.interp.tangency import solve_tangency
 from cadcnc.tolerances import DEFAULT
@@ -76,7 +76,7 @@ def main() -> None:
     args = ap.parse_args()
     for name, i, j in CASES:
         part = cadcnc.load_step(ROOT / "fixtures" / name)
-        plan = plan_path(part.face(i), part.face(j), radius=R, feed=FEED, period=PERIOD)
+        plan = plan_path(*pair_job(part.face(i), part.face(j), radius=R, feed=FEED, period=PERIOD))
         time_interpolator(plan, 20)  # warm-up (classifier construction, caches)
         direct = time_interpolator(plan, args.cycles)
         newton = time_newton(plan, len(direct))

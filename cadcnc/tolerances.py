@@ -2,15 +2,23 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, fields
+
+from .errors import InputError
 
 
 @dataclass(frozen=True)
 class Tolerances:
-    """Thresholds used across cadcnc. Pass a modified copy (``dataclasses.replace``) to change one.
+    """Every threshold cadcnc uses. Pass a modified copy (``dataclasses.replace``) to change one.
 
-    - ``singular``: |r_u x r_w| / (|r_u| |r_w|) below this is a singular parameter point
-      (sphere pole, cone apex, collapsed B-spline edge): no normal exists there.
+    Geometry and interpolation:
+
+    - ``singular``: the *singularity ratio* s = |r_u x r_w| / (|r_u|^2 + |r_w|^2) (0 at a
+      singular point: sphere pole, cone apex, collapsed B-spline edge; 1/2 on a square
+      parameter grid) below this means no normal exists at the point.
+    - ``near_singular``: the interpolator stops (reason "singular") when a contact's
+      singularity ratio falls below this: the 2x2 inverse is ill-posed there.
     - ``flat_curvature`` (1/mm): |k| below this is treated as zero curvature; the curvature
       sphere degenerates to the offset tangent plane.
     - ``tangent_sin``: |n1 x n2| below this means the two faces are tangent, the
@@ -23,21 +31,50 @@ class Tolerances:
       along the boundary itself, so this must exceed the interpolation error there.
     - ``end_reached`` (mm): a full step that lands this close to the end point (either
       side) has reached it; no extra zero-length step is emitted.
-    - ``near_singular``: the interpolator stops (reason "singular") when a contact's
-      |r_u x r_w| / (|r_u|^2 + |r_w|^2) falls below this: the 2x2 inverse is ill-posed there.
     - ``diverged`` (mm): the carried error |p - (q + R' n)| above which the interpolator
       stops rather than emit a point computed from a lost state.
+    - ``closed`` (mm): a curve (edge, intersection branch, polyline) whose ends are closer
+      than this is a loop.
+
+    Verification and gates:
+
+    - ``gouge`` (mm): the gouge limit: a ball reaching deeper than this into any face fails
+      the whole-part gate and ``cadcnc verify`` (1 um).
+    - ``hit`` (mm): a ball reaching deeper than this into a face is reported as a hit
+      (below it is tangency round-off).
+    - ``off_face`` (mm): a contact whose trimmed-face distance exceeds its surface distance
+      by more than this touches only the surface's extension (reported as off the face).
+    - ``noise`` (mm): differences below this are round-off (start tangency solved to 1e-9,
+      OCCT's intersection curve ~5e-9).
+    - ``classify`` (mm): boundary tolerance of verification's 2-D face classifier.
+    - ``classify_loose`` (mm): the looser classifier used to say where a stopped path's
+      last contacts lie.
     """
 
     singular: float = 1e-9
+    near_singular: float = 1e-4
     flat_curvature: float = 1e-9
     tangent_sin: float = 1e-2
     tangent_edge_deg: float = 1.0
     start: float = 1e-9
     on_boundary: float = 1e-6
     end_reached: float = 1e-7
-    near_singular: float = 1e-4
     diverged: float = 0.5
+    closed: float = 1e-6
+    gouge: float = 1e-3
+    hit: float = 1e-6
+    off_face: float = 1e-6
+    noise: float = 1e-8
+    classify: float = 1e-7
+    classify_loose: float = 1e-4
+
+    def __post_init__(self):
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if not (isinstance(value, (int, float)) and not isinstance(value, bool)
+                    and math.isfinite(value) and value > 0):
+                raise InputError(f"tolerance {f.name} must be a finite number > 0, got "
+                                 f"{value!r}")
 
 
 DEFAULT = Tolerances()

@@ -173,7 +173,7 @@ def faces_report(part) -> dict:
 # -- path ------------------------------------------------------------------------------------
 def path(args) -> int:
     import cadcnc
-    from cadcnc.io.writers import check_output, write_toolpaths
+    from cadcnc.io import check_output, write_toolpaths
 
     for out in args.output:
         check_output(out)
@@ -215,7 +215,7 @@ def _gouge_gate(tp, part, tolerance_mm: float) -> str:
 def run(args) -> int:
     from cadcnc import apt
     from cadcnc.errors import InputError
-    from cadcnc.io.writers import check_output, write_toolpaths
+    from cadcnc.io import check_output, write_toolpaths
 
     outputs = args.output or []
     if args.stream and outputs:
@@ -293,7 +293,7 @@ def demo(args) -> int:
     import cadcnc
     from cadcnc.errors import OutputError
     from cadcnc.io.plot import write_picture
-    from cadcnc.io.writers import write_text, write_toolpaths
+    from cadcnc.io import write_text, write_toolpaths
 
     step = demo_step()
     out = Path(args.out)
@@ -366,7 +366,7 @@ def _verification(tp, part):
 def _load_saved(path_json: str, part_file: str | None):
     import cadcnc
     from cadcnc.errors import InputError
-    from cadcnc.io.writers import read_json
+    from cadcnc.io import read_json
 
     tp = read_json(path_json)
     if part_file is None:

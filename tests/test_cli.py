@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.io.writers import read_csv, read_json
+from cadcnc.io import read_csv, read_json
 
 from conftest import FIXTURES, load_fixture
 

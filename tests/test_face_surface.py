@@ -17,7 +17,7 @@ from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 
 from cadcnc import FaceSurface, SingularPointError
-from cadcnc.geometry.face_surface import INSIDE, ON_BOUNDARY, OUTSIDE
+from cadcnc.trim import BOUNDARY, INSIDE, OUTSIDE
 
 V = cq.Vector
 
@@ -251,7 +251,7 @@ def test_periodic_wrap_and_classification():
     np.testing.assert_allclose(fs.point(-0.5, 3.0), fs.point(u, w), atol=1e-12)
     assert fs.classify(1.0, 5.0) == INSIDE
     assert fs.classify(1.0 + 4 * math.pi, 5.0) == INSIDE  # wrapped
-    assert fs.classify(1.0, 10.0) == ON_BOUNDARY
+    assert fs.classify(1.0, 10.0) == BOUNDARY
     assert fs.classify(1.0, 10.5) == OUTSIDE
 
 
@@ -265,7 +265,7 @@ def test_trimmed_face_classification_follows_the_trim_not_the_box():
     u2, w2, _ = top.project((15, 15, 2.5))
     assert top.classify(u2, w2) == INSIDE
     u3, w3, _ = top.project((5, 0, 2.5))
-    assert top.classify(u3, w3) == ON_BOUNDARY
+    assert top.classify(u3, w3) == BOUNDARY
 
 
 def test_cone_apex_is_singular():

@@ -14,7 +14,7 @@ from OCP.gp import gp_Pnt
 
 import cadcnc
 from cadcnc.interp.cycle import CLOSED, END
-from cadcnc.ops.pair_path import _stepper, plan_path
+from cadcnc.ops.pair_path import pair_job, plan_path, stepper_for
 from cadcnc.interp.stepper import Stepper, Tangency
 from cadcnc.tolerances import DEFAULT
 
@@ -113,15 +113,15 @@ def test_umbilic_excess_is_fourth_order():
                                       ("torus_cone", 1, 2)])
 def test_initial_error_decays_to_steady_state(name, i, j):
     part = load_fixture(name)
-    plan = plan_path(part.face(i), part.face(j), radius=R, feed=FEED, period=PERIOD)
+    plan = plan_path(*pair_job(part.face(i), part.face(j), radius=R, feed=FEED, period=PERIOD))
     n1 = plan.s1.normal(*plan.start.uv1)
     n2 = plan.s2.normal(*plan.start.uv2)
     off = (n1 - n2) / np.linalg.norm(n1 - n2) * 0.05      # 0.05 mm off the true tangency
     start = Tangency(tuple(np.array(plan.start.p) + off), plan.start.uv1, plan.start.uv2)
-    stepper = _stepper(replace(plan, start=start), DEFAULT, max_cycles=100, record=True).run()
+    stepper = stepper_for(replace(plan, start=start), max_cycles=100, record=True).run()
     from cadcnc.program.toolpath import toolpath_from_record
 
-    tp = toolpath_from_record(stepper.record, plan.offsets, stepper.stop_reason)
+    tp = toolpath_from_record(stepper.record, plan.job, stepper.stop_reason)
     for b in tp.bounds:
         assert b.eps[0] == pytest.approx(0.05, rel=1e-6)
         settled = np.nonzero(b.eps <= b.eps_ss)[0]
@@ -221,5 +221,5 @@ def test_interpolator_on_plain_python_surfaces_without_occt():
     st = Stepper(s1, s2, (Rp, Rp), start, feed=FEED, period=PERIOD, direction=(0, 1, 0),
                  closed=True).run()
     assert st.stop_reason == CLOSED
-    pts = np.array([row[0] for row in st.record.rows])
+    pts = st.record.points
     assert crossing_deviation(pts, Rp, A, B).max() <= 1e-4

@@ -11,7 +11,7 @@ import pytest
 import cadcnc
 from cadcnc.interp.error_bounds import SurfaceBounds
 from cadcnc.errors import InputError, OutputError
-from cadcnc.io.writers import (
+from cadcnc.io import (
     ARRAYS, CSV_COLUMNS, atomic_write, check_output, read_csv, read_json, toolpath_from_dict,
     toolpath_to_dict, write_csv, write_json, write_toolpaths,
 )
@@ -31,7 +31,7 @@ def assert_same_path(a, b):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
     assert a.offsets == b.offsets and a.faces == b.faces
     assert (a.stop_reason, a.stop_detail) == (b.stop_reason, b.stop_detail)
-    assert a.inputs == b.inputs
+    assert a.job == b.job
     for ba, bb in zip(a.bounds, b.bounds):
         for f in fields(SurfaceBounds):
             np.testing.assert_array_equal(getattr(ba, f.name), getattr(bb, f.name))

@@ -12,7 +12,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.BRepGProp import BRepGProp
 from OCP.BRepTools import BRepTools
 from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.GeomAbs import (
@@ -27,13 +29,16 @@ from OCP.GeomAbs import (
     GeomAbs_SurfaceOfRevolution,
     GeomAbs_Torus,
 )
+from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
+from OCP.GProp import GProp_GProps
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
 from OCP.TopoDS import TopoDS, TopoDS_Face
 
 from . import differential as dg
-from ..errors import InputError, SingularPointError
+from ..errors import GeometryError, InputError, SingularPointError
 from ..tolerances import DEFAULT, Tolerances
+from ..trim import BOUNDARY, INSIDE, OUTSIDE
 
 SURFACE_KINDS = {
     GeomAbs_Plane: "plane",
@@ -48,7 +53,6 @@ SURFACE_KINDS = {
     GeomAbs_OffsetSurface: "offset",
 }
 
-INSIDE, ON_BOUNDARY, OUTSIDE = "inside", "boundary", "outside"
 
 
 @dataclass(frozen=True)
@@ -129,7 +133,7 @@ class FaceSurface:
         state = self._classifier.Perform(gp_Pnt2d(*self.wrap(u, w)))
         if state == TopAbs_IN:
             return INSIDE
-        return ON_BOUNDARY if state == TopAbs_ON else OUTSIDE
+        return BOUNDARY if state == TopAbs_ON else OUTSIDE
 
     def contains(self, u: float, w: float) -> bool:
         """True for points inside the trimmed face or on its boundary."""
@@ -180,8 +184,6 @@ class FaceSurface:
         OCCT's exact projection (GeomAPI_ProjectPointOnSurf), restricted to the face's
         parameter box when ``within_face_box``. Raises GeometryError when it finds none.
         """
-        from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
-
         pnt = gp_Pnt(*map(float, point))
         if within_face_box:
             proj = GeomAPI_ProjectPointOnSurf(pnt, self.geom_surface, *self.u_range,
@@ -189,8 +191,6 @@ class FaceSurface:
         else:
             proj = GeomAPI_ProjectPointOnSurf(pnt, self.geom_surface)
         if not proj.IsDone() or proj.NbPoints() == 0:
-            from ..errors import GeometryError
-
             raise GeometryError(f"{self!r}: no projection of point {tuple(point)} found")
         u, w = proj.LowerDistanceParameters()
         return u, w, proj.LowerDistance()
@@ -251,15 +251,10 @@ class FaceSurface:
     @property
     def geom_surface(self):
         """The face's Geom_Surface handle, with the face's location applied."""
-        from OCP.BRep import BRep_Tool
-
         return BRep_Tool.Surface_s(self.topods)
 
     def area(self) -> float:
         """Face area, mm^2."""
-        from OCP.BRepGProp import BRepGProp
-        from OCP.GProp import GProp_GProps
-
         props = GProp_GProps()
         BRepGProp.SurfaceProperties_s(self.topods, props)
         return props.Mass()

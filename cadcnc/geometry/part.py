@@ -14,8 +14,11 @@ import os
 from dataclasses import dataclass, field
 
 import numpy as np
+from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
+from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
+from OCP.GCPnts import GCPnts_AbscissaPoint
 from OCP.gp import gp_Pnt, gp_Vec
 from OCP.IFSelect import IFSelect_RetDone
 from OCP.STEPControl import STEPControl_Reader
@@ -105,6 +108,7 @@ class Part:
         self._fmap = fmap
         self._faces: dict[int, FaceSurface] = {}
         self._edges: dict[tuple[int, int], list[SharedEdge]] | None = None
+        self._bbox: tuple[np.ndarray, np.ndarray] | None = None
 
     @classmethod
     def from_cadquery(cls, obj, tol: Tolerances = DEFAULT) -> "Part":
@@ -132,6 +136,20 @@ class Part:
     @property
     def faces(self) -> list[FaceSurface]:
         return [self.face(i) for i in range(1, len(self) + 1)]
+
+    def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lo (3,), hi (3,)) of the part's optimal axis-aligned bounding box, mm."""
+        if self._bbox is None:
+            box = Bnd_Box()
+            BRepBndLib.AddOptimal_s(self.shape, box, True, False)
+            xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
+            self._bbox = np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
+        return self._bbox
+
+    @property
+    def top(self) -> float:
+        """Highest Z of the part, mm (rapid moves clear it by a margin)."""
+        return float(self.bounding_box()[1][2])
 
     def face_number(self, face) -> int:
         """The 1-based number of a TopoDS/CadQuery face of this part (0 if not found)."""
@@ -207,11 +225,9 @@ class Part:
             cls = CONVEX
         else:
             cls = TANGENT
-        from OCP.GCPnts import GCPnts_AbscissaPoint
-
         length = GCPnts_AbscissaPoint.Length_s(curve)
         (start, t_start), (end, t_end) = _point_and_tangent(curve, t0), _point_and_tangent(curve, t1)
-        closed = bool(np.linalg.norm(start - end) < 1e-7)
+        closed = bool(np.linalg.norm(start - end) < self.tol.closed)
         return SharedEdge((i, j), edge, cls, angles, np.array(points), length, closed,
                           start, end, t_start, t_end)
 

@@ -51,7 +51,7 @@ class Contact:
     """
 
     __slots__ = ("surface", "offset", "u", "w", "r", "ru", "rw", "n",
-                 "E", "F", "G", "L", "M", "N", "quality")
+                 "E", "F", "G", "L", "M", "N", "singularity")
 
     def __init__(self, surface: SurfaceLike, offset: float, u: float, w: float):
         self.surface = surface
@@ -65,8 +65,8 @@ class Contact:
         c = cross(ru, rw)
         cn = norm(c)
         E, F, G = dot(ru, ru), dot(ru, rw), dot(rw, rw)
-        # quality: |r_u x r_w| / (|r_u|^2 + |r_w|^2); 0 at a singular point
-        self.quality = cn / (E + G + 1e-300)
+        # the singularity ratio |r_u x r_w| / (|r_u|^2 + |r_w|^2): 0 at a singular point
+        self.singularity = cn / (E + G + 1e-300)
         n = scale(c, self.surface.normal_sign / cn) if cn > 0.0 else (0.0, 0.0, 0.0)
         self.u, self.w, self.r, self.ru, self.rw, self.n = u, w, r, ru, rw, n
         self.E, self.F, self.G = E, F, G

@@ -9,18 +9,17 @@ Kernel-free, like :mod:`cadcnc.interpolator`.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
-from ..errors import InputError
+from ..job import check_number
 from .cycle import (
     BOUNDARY, CLOSED, DIVERGED, END, MAX_CYCLES, SINGULAR, Contact, StopCycle, SurfaceLike,
     check_curvature, cycle,
 )
 from ..tolerances import DEFAULT, Tolerances
+from ..trim import OUTSIDE
+from .record import PathRecord
 from .vec3 import Vec, dot, norm, scale, sub
-
-OUTSIDE = "outside"
 
 
 @dataclass(frozen=True)
@@ -46,10 +45,8 @@ class Stepper:
                  end: Tangency | None = None, closed: bool = False,
                  tol: Tolerances = DEFAULT, max_cycles: int = 1_000_000,
                  record: bool = True, check_boundary: bool = True):
-        if not period > 0.0:
-            raise InputError(f"period must be > 0 s, got {period!r}")
         self.tol = tol
-        self.period = float(period)
+        self.period = check_number("period", period, "s")
         self.feed = self._check_feed(feed)
         self.c1 = Contact(s1, float(offsets[0]), *start.uv1)
         self.c2 = Contact(s2, float(offsets[1]), *start.uv2)
@@ -70,10 +67,9 @@ class Stepper:
         if self.record is not None:
             self.record.add(self.p, self.c1, self.c2, 0.0, 0.0)
 
-    def _check_feed(self, feed: float) -> float:
-        if not (isinstance(feed, (int, float)) and math.isfinite(feed) and feed > 0.0):
-            raise InputError(f"feed must be a positive number of mm/min, got {feed!r}")
-        return float(feed)
+    @staticmethod
+    def _check_feed(feed: float) -> float:
+        return check_number("feed", feed, "mm/min")
 
     @property
     def step_length(self) -> float:
@@ -111,7 +107,7 @@ class Stepper:
         p_e, t, uv1, uv2 = cycle(self.p, self.c1, self.c2, self.t, f, self.tol)
         for spare, uv, label in ((self._n1, uv1, 1), (self._n2, uv2, 2)):
             spare.move_to(*uv)
-            if spare.quality < self.tol.near_singular:
+            if spare.singularity < self.tol.near_singular:
                 raise StopCycle(SINGULAR, f"surface {label}: contact reaches a singular "
                                           f"parameter point (u={spare.u:.6g}, w={spare.w:.6g})")
             eps = norm(sub(p_e, spare.centre()))
@@ -218,26 +214,3 @@ class Stepper:
             if progress is not None and self.cycles % every == 0:
                 progress(self.cycles, self.travelled)
         return self
-
-
-class PathRecord:
-    """Per-point log of the cutter centre and both contacts' geometry (for toolpaths/bounds).
-
-    Row K holds the state after cycle K (row 0: the start) and the commanded step f and
-    actual step |dp| of the cycle that led to it (0 for the start).
-    """
-
-    __slots__ = ("rows",)
-
-    def __init__(self):
-        self.rows: list[tuple] = []
-
-    def add(self, p: Vec, c1: Contact, c2: Contact, f: float, step: float) -> None:
-        self.rows.append((p, _contact_row(c1), _contact_row(c2), f, step))
-
-    def __len__(self) -> int:
-        return len(self.rows)
-
-
-def _contact_row(c: Contact) -> tuple:
-    return (c.u, c.w, c.r, c.ru, c.rw, c.n, c.E, c.F, c.G, c.L, c.M, c.N)

@@ -24,6 +24,7 @@ import re
 import numpy as np
 
 from ..errors import InputError
+from .atomic import write_text
 
 DEFAULT_TOLERANCE = 0.001  # mm
 CLEARANCE = 2.0  # mm above the first point where the rapid approach ends
@@ -92,7 +93,7 @@ def programmed_points(path, tool_tip: bool = False) -> np.ndarray:
     """The path's points as programmed: ball centres, or tips (Z - R) with ``tool_tip``."""
     pts = np.array(path.points, dtype=float)
     if tool_tip:
-        pts[:, 2] -= float(path.inputs.get("radius", 0.0))
+        pts[:, 2] -= path.job.tool.radius
     return pts
 
 
@@ -120,9 +121,6 @@ def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
     elif safe_z < top + clearance:
         raise InputError(f"safe Z {safe_z:g} mm is below the path's highest point "
                          f"{top:g} mm plus the clearance {clearance:g} mm")
-    feeds = {float(p.inputs.get("feed", 0.0)) for p in paths}
-    if any(not f > 0 for f in feeds):
-        raise InputError("a toolpath has no feed in its inputs")
     n = lambda v: _num(v, digits)  # noqa: E731
     point_name = "tool tip (ball centre Z - R)" if tool_tip else "ball centre"
     lines = [
@@ -139,8 +137,7 @@ def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
         lines.append(f"S{_num(spindle, 0)} M3")
     for k, (path, pts) in enumerate(zip(paths, programmed), 1):
         keep = simplify(pts, tolerance) if tolerance else np.arange(len(pts))
-        r = float(path.inputs.get("radius", float("nan")))
-        c = float(path.inputs.get("allowance", 0.0))
+        r, c = path.job.tool.radius, path.job.tool.allowance
         lines.append(_comment(
             f"path {k}: faces {path.faces[0]} {path.faces[1]}, ball R {r:g} mm, allowance "
             f"{c:g} mm, {len(keep)} of {len(pts)} points, stop: {path.stop_reason}"))
@@ -148,7 +145,7 @@ def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
         lines += [
             f"G0 X{n(first[0])} Y{n(first[1])}",
             f"G0 Z{n(first[2] + clearance)}",
-            f"F{_num(float(path.inputs['feed']), 3)}",
+            f"F{_num(path.job.feed, 3)}",
             f"G1 Z{n(first[2])}",
         ]
         lines += [f"G1 X{n(x)} Y{n(y)} Z{n(z)}" for x, y, z in pts[keep[1:]]]
@@ -161,6 +158,4 @@ def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
 
 def write_ngc(paths, out, **options) -> None:
     """Write :func:`to_ngc` to ``out`` atomically."""
-    from .writers import write_text
-
     write_text(out, to_ngc(paths, **options))

@@ -10,20 +10,16 @@ length, beside the paper's eq. 16 bound drawn as an over-cut limit. GLB: the par
 from __future__ import annotations
 
 import io
+from pathlib import Path
 
 import numpy as np
 
+from ..errors import OutputError
+from ..geometry.mesh import tessellate
+from .atomic import write_bytes
+
 FACE_COLOURS = ((0.35, 0.55, 0.85), (0.85, 0.55, 0.30))
 PATH_COLOUR = (0.80, 0.10, 0.10)
-
-
-def _mesh(topods, tolerance: float = 0.05):
-    """(vertices (n, 3), triangles (m, 3)) of a face or shape, via CadQuery."""
-    import cadquery as cq
-
-    verts, tris = cq.Shape.cast(topods).tessellate(tolerance, 0.2)
-    v = np.array([x.toTuple() for x in verts], dtype=float).reshape(-1, 3)
-    return v, np.array(tris, dtype=int).reshape(-1, 3)
 
 
 def _crop(v, t, lo, hi):
@@ -48,7 +44,7 @@ def figure(path, part, title: str = ""):
     for k, number in enumerate(path.faces):
         if number is None or part is None:
             continue
-        v, t = _mesh(part.face(number).topods, tolerance=max(span / 400, 0.01))
+        v, t = tessellate(part.face(number).topods, tolerance=max(span / 400, 0.01))
         t = _crop(v, t, lo, hi)
         if len(t):
             ax.plot_trisurf(v[:, 0], v[:, 1], v[:, 2], triangles=t, color=FACE_COLOURS[k],
@@ -119,7 +115,7 @@ def scene(path, part):
     if part is not None:
         pair = {n: FACE_COLOURS[k] for k, n in enumerate(path.faces) if n is not None}
         for face in part.faces:
-            v, t = _mesh(face.topods, tolerance=0.05)
+            v, t = tessellate(face.topods, tolerance=0.05)
             if not len(t):
                 continue
             rgb = pair.get(face.number, (0.75, 0.75, 0.75))
@@ -141,10 +137,6 @@ def glb_bytes(path, part) -> bytes:
 
 def write_picture(path, part, out, title: str = "") -> None:
     """Write ``out`` by suffix: .png (matplotlib) or .glb (trimesh scene), atomically."""
-    from pathlib import Path
-
-    from ..errors import OutputError
-    from .writers import write_bytes
 
     suffix = Path(out).suffix.lower()
     if suffix == ".png":

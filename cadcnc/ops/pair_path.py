@@ -8,8 +8,7 @@ points in mm; feed in mm/min; period in s.
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -18,6 +17,7 @@ from ..geometry.face_surface import FaceSurface
 from ..geometry.part import CONCAVE
 from ..interp.stepper import Stepper, Tangency
 from ..interp.tangency import solve_tangency
+from ..job import Job, PairPath, Tool
 from ..tolerances import DEFAULT, Tolerances
 from ..program.toolpath import Toolpath, toolpath_from_record
 
@@ -28,34 +28,20 @@ class PathPlan:
 
     s1: FaceSurface
     s2: FaceSurface
-    offsets: tuple[float, float]
+    job: Job
     start: Tangency
     end: Tangency | None
     closed: bool
     direction: tuple[float, float, float]
-    inputs: dict
     check_boundary: bool = True
+
+    @property
+    def offsets(self) -> tuple[float, float]:
+        return self.job.offsets
 
 
 def _surface(face, tol: Tolerances) -> FaceSurface:
     return face if isinstance(face, FaceSurface) else FaceSurface(face, tol=tol)
-
-
-def _positive(name: str, value, unit: str, allow_zero: bool = False) -> float:
-    ok = isinstance(value, (int, float, np.floating)) and math.isfinite(value)
-    if not ok or value < 0 or (value == 0 and not allow_zero):
-        need = ">= 0" if allow_zero else "> 0"
-        raise InputError(f"{name} must be a number {need} {unit}, got {value!r}")
-    return float(value)
-
-
-def _point(name: str, value) -> np.ndarray | None:
-    if value is None:
-        return None
-    arr = np.asarray(value, dtype=float).reshape(-1)
-    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise InputError(f"{name} must be a point x, y, z in mm, got {value!r}")
-    return arr
 
 
 def _label(s: FaceSurface, fallback: str) -> str:
@@ -90,24 +76,27 @@ def shared_edge_for(s1: FaceSurface, s2: FaceSurface, edge: int = 0):
     return concave[edge]
 
 
-def plan_path(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,
-              period: float, start=None, end=None, offsets=None, edge: int = 0,
-              tol: Tolerances = DEFAULT) -> PathPlan:
-    """Validate the inputs and solve the start/end tangencies (Newton, to ``tol.start``)."""
-    radius = _positive("radius", radius, "mm", allow_zero=True)
-    allowance = _positive("allowance", allowance, "mm", allow_zero=True)
-    feed = _positive("feed", feed, "mm/min")
-    period = _positive("period", period, "s")
+def pair_job(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,
+             period: float, start=None, end=None, offsets=None, edge: int = 0,
+             tol: Tolerances = DEFAULT) -> tuple[FaceSurface, FaceSurface, Job]:
+    """The two faces as surfaces and the validated :class:`Job` of keyword arguments."""
+    tool = Tool(radius, allowance)
+    op = PairPath(offsets=(None, None) if offsets is None else offsets, start=start, end=end,
+                  edge=edge)
+    job = Job(tool, feed, period, op, tolerances=tol)
     s1, s2 = _surface(face_a, tol), _surface(face_b, tol)
-    r_prime = radius + allowance
-    offs = tuple(r_prime if o is None else _positive("offset", o, "mm", True)
-                 for o in (offsets or (None, None)))
-    start, end = _point("start", start), _point("end", end)
+    op = replace(op, faces=(s1.number, s2.number))
+    return s1, s2, replace(job, operation=op, source=getattr(s1.part, "source", None))
+
+
+def plan_path(s1: FaceSurface, s2: FaceSurface, job: Job) -> PathPlan:
+    """Solve the start/end tangencies of ``job`` on two surfaces (Newton, to ``tol.start``)."""
+    tol, op = job.tolerances, job.operation
+    offs = job.offsets
+    start, end = op.start, op.end
     closed = False
     if start is None:
-        if end is not None:
-            raise InputError("an end point needs a start point too")
-        e = shared_edge_for(s1, s2, edge)
+        e = shared_edge_for(s1, s2, op.edge)
         anchors = [(e.start, e.start_tangent), (None if e.closed else (e.end, e.end_tangent))]
         direction, closed = e.start_tangent, e.closed
     else:
@@ -141,15 +130,11 @@ def plan_path(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: fl
         if t_end is not None and m @ (np.array(t_end.p) - np.array(t_start.p)) < 0:
             m = -m
         direction = m
-    inputs = dict(radius=radius, allowance=allowance, feed=feed, period=period,
-                  start=None if start is None else start.tolist(),
-                  end=None if end is None else end.tolist(), offsets=list(offs), edge=edge,
-                  source=getattr(s1.part, "source", None))
     # With both offsets 0 along a shared edge the contacts run on the faces' common
     # boundary by construction: the boundary rule cannot apply, the edge's ends bound it.
     on_edge = start is None and offs == (0.0, 0.0)
-    return PathPlan(s1, s2, offs, t_start, t_end, closed,
-                    tuple(map(float, direction)), inputs, check_boundary=not on_edge)
+    return PathPlan(s1, s2, job, t_start, t_end, closed, tuple(map(float, direction)),
+                    check_boundary=not on_edge)
 
 
 def make_stepper(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,
@@ -157,16 +142,29 @@ def make_stepper(face_a, face_b, *, radius: float, allowance: float = 0.0, feed:
                  tol: Tolerances = DEFAULT, max_cycles: int = 1_000_000,
                  record: bool = True) -> Stepper:
     """A :class:`Stepper` ready to be driven one period at a time (real-time use)."""
-    plan = plan_path(face_a, face_b, radius=radius, allowance=allowance, feed=feed,
-                     period=period, start=start, end=end, offsets=offsets, edge=edge, tol=tol)
-    return _stepper(plan, tol, max_cycles, record)
+    s1, s2, job = pair_job(face_a, face_b, radius=radius, allowance=allowance, feed=feed,
+                           period=period, start=start, end=end, offsets=offsets, edge=edge,
+                           tol=tol)
+    return stepper_for(plan_path(s1, s2, job), max_cycles, record)
 
 
-def _stepper(plan: PathPlan, tol: Tolerances, max_cycles: int, record: bool) -> Stepper:
-    return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=plan.inputs["feed"],
-                   period=plan.inputs["period"], direction=plan.direction, end=plan.end,
-                   closed=plan.closed, tol=tol, max_cycles=max_cycles, record=record,
-                   check_boundary=plan.check_boundary)
+def stepper_for(plan: PathPlan, max_cycles: int = 1_000_000, record: bool = True) -> Stepper:
+    """The stepper of a solved plan."""
+    job = plan.job
+    return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
+                   period=job.period, direction=plan.direction, end=plan.end,
+                   closed=plan.closed, tol=job.tolerances, max_cycles=max_cycles,
+                   record=record, check_boundary=plan.check_boundary)
+
+
+def run_plan(plan: PathPlan, max_cycles: int = 1_000_000, progress=None) -> Toolpath:
+    """Run the stepper of a plan to its stop; the toolpath with its error bounds."""
+    stepper = stepper_for(plan, max_cycles, True).run(progress)
+    if stepper.cycles == 0:
+        raise GeometryError(f"no path: the interpolator stopped at the start point "
+                            f"({stepper.stop_reason}): {stepper.stop_detail}")
+    return toolpath_from_record(stepper.record, plan.job, stepper.stop_reason,
+                                stepper.stop_detail)
 
 
 def intersection_path(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,
@@ -178,20 +176,23 @@ def intersection_path(face_a, face_b, *, radius: float, allowance: float = 0.0, 
     ``face_a``/``face_b``: part faces (``part.face(n)``), CadQuery faces or TopoDS faces.
     ``radius``, ``allowance`` in mm; ``feed`` in mm/min; ``period`` in s (feed 1500 and
     period 0.004 give the paper's 0.1 mm step). ``start``/``end``: points (mm) near the
-    intersection; by default the ends of the faces' shared concave edge (a closed edge is
-    followed once around). ``offsets``: per-surface offset distance, None meaning R + C;
-    0 makes that face a guide surface carrying the cutter centre itself.
-    ``progress(cycles, mm)`` is called every 10 000 cycles.
+    intersection; by default the ends of the faces' shared concave edge number ``edge``
+    (0-based; a closed edge is followed once around). ``offsets``: per-surface offset
+    distance, None meaning R + C; 0 makes that face a guide surface carrying the cutter
+    centre. ``progress(cycles, mm)`` is called every 10 000 cycles.
     """
-    plan = plan_path(face_a, face_b, radius=radius, allowance=allowance, feed=feed,
-                     period=period, start=start, end=end, offsets=offsets, edge=edge, tol=tol)
-    stepper = _stepper(plan, tol, max_cycles, True).run(progress)
-    if stepper.cycles == 0:
-        raise GeometryError(f"no path: the interpolator stopped at the start point "
-                            f"({stepper.stop_reason}): {stepper.stop_detail}")
-    return toolpath_from_record(
-        stepper.record, plan.offsets, stepper.stop_reason, stepper.stop_detail,
-        faces=(plan.s1.number, plan.s2.number), inputs=plan.inputs)
+    s1, s2, job = pair_job(face_a, face_b, radius=radius, allowance=allowance, feed=feed,
+                           period=period, start=start, end=end, offsets=offsets, edge=edge,
+                           tol=tol)
+    return run_plan(plan_path(s1, s2, job), max_cycles, progress)
+
+
+def path_for_job(part, job: Job, max_cycles: int = 1_000_000, progress=None) -> Toolpath:
+    """The toolpath of a ``job`` whose operation names two faces of ``part``."""
+    i, j = job.operation.faces
+    if i is None or j is None:
+        raise InputError("the job names no faces: give the two face numbers")
+    return run_plan(plan_path(part.face(i), part.face(j), job), max_cycles, progress)
 
 
 def intersection_paths(face_a, face_b, **kwargs) -> list[Toolpath]:

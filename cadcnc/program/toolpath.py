@@ -1,19 +1,22 @@
-"""A computed toolpath: arrays per cycle plus the inputs and the reason it stopped.
+"""A computed toolpath: arrays per cycle, the job that produced it and why it stopped.
 
 Shapes (N = number of points, row 0 the start): points (N, 3) cutter centres in mm;
 contacts (N, 2, 3) contact points on surface 1 and 2; normals (N, 2, 3); uv (N, 2, 2) the
-contacts' native surface parameters; steps (N,) the length of the step that led to each
+contacts' native (u, w) parameters; steps (N,) the length of the step that led to each
 point (0 for the start), commanded (N,) the commanded step f = F Ts of that cycle (mm).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..interp.error_bounds import SurfaceBounds, bounds_for_surface, mp_length, surface_curvatures
-from ..interp.stepper import PathRecord
+from ..interp.error_bounds import (
+    SurfaceBounds, bounds_for_surface, mp_length, surface_curvatures,
+)
+from ..interp.record import PathRecord
+from ..job import Job
 
 
 @dataclass
@@ -24,11 +27,9 @@ class Toolpath:
     uv: np.ndarray
     steps: np.ndarray
     commanded: np.ndarray
-    offsets: tuple[float, float]
+    job: Job
     stop_reason: str
     stop_detail: str = ""
-    faces: tuple[int | None, int | None] = (None, None)
-    inputs: dict = field(default_factory=dict)
     bounds: tuple[SurfaceBounds, SurfaceBounds] | None = None
 
     def __len__(self) -> int:
@@ -39,6 +40,16 @@ class Toolpath:
                 f"stop: {self.stop_reason}>")
 
     @property
+    def faces(self) -> tuple[int | None, int | None]:
+        """The two face numbers followed (None for a face given directly)."""
+        return self.job.operation.faces
+
+    @property
+    def offsets(self) -> tuple[float, float]:
+        """Each surface's offset R' (mm), as the job resolved it."""
+        return self.job.offsets
+
+    @property
     def length(self) -> float:
         """Polyline length through the cutter centres, mm."""
         return float(self.steps.sum())
@@ -46,7 +57,7 @@ class Toolpath:
     @property
     def duration(self) -> float:
         """Machining time in s: one interpolation period per cycle."""
-        return (len(self) - 1) * float(self.inputs.get("period", float("nan")))
+        return (len(self) - 1) * self.job.period
 
     @property
     def tangents(self) -> np.ndarray:
@@ -56,8 +67,8 @@ class Toolpath:
         if len(self) > 1:
             d = np.diff(self.points, axis=0)
             d = np.vstack([d, d[-1:]])
-            m *= np.sign(np.einsum("ij,ij->i", m, d))[:, None] + (np.einsum(
-                "ij,ij->i", m, d) == 0)[:, None]
+            along = np.einsum("ij,ij->i", m, d)
+            m *= (np.sign(along) + (along == 0))[:, None]
         return m
 
     @property
@@ -69,36 +80,28 @@ class Toolpath:
         return float(vals.max()) if len(vals) else float("nan")
 
 
-def toolpath_from_record(record: PathRecord, offsets: tuple[float, float], stop_reason: str,
-                         stop_detail: str = "", faces=(None, None),
-                         inputs: dict | None = None) -> Toolpath:
-    """Arrays and the paper's error bounds from the stepper's per-cycle record."""
-    rows = record.rows
-    points = np.array([r[0] for r in rows], dtype=float)
-    cs = [[r[1 + i] for r in rows] for i in (0, 1)]
-    uv = np.array([[[c[0], c[1]] for c in side] for side in cs]).transpose(1, 0, 2)
-    contacts = np.array([[c[2] for c in side] for side in cs]).transpose(1, 0, 2)
-    normals = np.array([[c[5] for c in side] for side in cs]).transpose(1, 0, 2)
+def toolpath_from_record(record: PathRecord, job: Job, stop_reason: str,
+                         stop_detail: str = "") -> Toolpath:
+    """Arrays (copied) and the paper's error bounds from the stepper's per-cycle record."""
     path = Toolpath(
-        points=points, contacts=contacts, normals=normals, uv=uv,
-        steps=np.array([r[4] for r in rows], dtype=float),
-        commanded=np.array([r[3] for r in rows], dtype=float),
-        offsets=tuple(map(float, offsets)), stop_reason=stop_reason, stop_detail=stop_detail,
-        faces=tuple(faces), inputs=dict(inputs or {}))
-    path.bounds = compute_bounds(path, cs)
+        points=record.points.copy(), contacts=record.contacts.copy(),
+        normals=record.normals.copy(), uv=record.uv.copy(), steps=record.steps.copy(),
+        commanded=record.commanded.copy(), job=job, stop_reason=stop_reason,
+        stop_detail=stop_detail)
+    path.bounds = compute_bounds(path, record.ru, record.rw, record.forms)
     return path
 
 
-def compute_bounds(path: Toolpath, contact_rows) -> tuple[SurfaceBounds, SurfaceBounds]:
-    """Per point, the bounds for the step leaving it (f = the next cycle's commanded step)."""
+def compute_bounds(path: Toolpath, ru: np.ndarray, rw: np.ndarray,
+                   forms: np.ndarray) -> tuple[SurfaceBounds, SurfaceBounds]:
+    """Per point, the bounds for the step leaving it (f = the next cycle's commanded step).
+
+    ``ru``, ``rw`` (N, 2, 3) and ``forms`` (N, 2, 6: E, F, G, L, M, N) per surface.
+    """
     t = path.tangents
     f = np.append(path.commanded[1:], path.commanded[-1] if len(path) > 1 else 0.0)
-    curv = []
-    for i, side in enumerate(contact_rows):
-        ru = np.array([c[3] for c in side], dtype=float)
-        rw = np.array([c[4] for c in side], dtype=float)
-        ff = np.array([c[6:12] for c in side], dtype=float)
-        curv.append(surface_curvatures(ru, rw, path.normals[:, i], ff, t))
+    curv = [surface_curvatures(ru[:, i], rw[:, i], path.normals[:, i], forms[:, i], t)
+            for i in (0, 1)]
     out = []
     for i in (0, 1):
         R = path.offsets[i]

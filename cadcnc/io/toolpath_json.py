@@ -1,0 +1,144 @@
+"""A toolpath as JSON and back (everything round-trips); written atomically.
+
+JSON layout (``format: "cadcnc-toolpath"``, ``version: 1``): ``faces``, ``inputs`` (every
+parameter of the run: radius, allowance mm; feed mm/min; period s; start, end, offsets,
+edge, source), ``offsets``, ``stop_reason``, ``stop_detail``, ``summary`` (points,
+length_mm, duration_s, worst_predicted_mm) and the per-point arrays ``points`` (N, 3),
+``contacts`` (N, 2, 3), ``normals`` (N, 2, 3), ``uv`` (N, 2, 2), ``steps`` (N,),
+``commanded`` (N,), ``bounds`` (two objects of (N,) arrays, one per surface). Non-finite
+numbers are written as the strings ``"Infinity"``, ``"-Infinity"``, ``"NaN"`` (JSON has no
+literal for them).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, fields
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..interp.error_bounds import SurfaceBounds
+from ..job import Job
+from ..program.toolpath import Toolpath
+from .atomic import write_text
+
+FORMAT = "cadcnc-toolpath"
+VERSION = 1
+ARRAYS = ("points", "contacts", "normals", "uv", "steps", "commanded")
+
+
+def _encode(arr) -> list:
+    """Nested lists of floats; non-finite values as JSON-legal strings."""
+    a = np.asarray(arr, dtype=float)
+    if np.all(np.isfinite(a)):
+        return a.tolist()
+    out = a.astype(object)
+    out[np.isnan(a)] = "NaN"
+    out[np.isposinf(a)] = "Infinity"
+    out[np.isneginf(a)] = "-Infinity"
+    return out.tolist()
+
+
+def _decode(data, shape_tail: tuple = ()) -> np.ndarray:
+    a = np.array(data, dtype=object)
+    a = a.astype(float) if a.size else np.zeros((0, *shape_tail))
+    return a
+
+
+def _plain(value):
+    """Inputs as JSON: numpy scalars and arrays to Python numbers and lists."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    return value
+
+
+def toolpath_to_dict(path: Toolpath) -> dict:
+    """Everything in a :class:`Toolpath` as JSON-ready Python objects (see module doc)."""
+    d = {
+        "format": FORMAT,
+        "version": VERSION,
+        "faces": list(path.faces),
+        "inputs": _plain(path.job.to_inputs()),
+        "offsets": list(map(float, path.offsets)),
+        "stop_reason": path.stop_reason,
+        "stop_detail": path.stop_detail,
+        "summary": _plain({
+            "points": len(path),
+            "length_mm": path.length,
+            "duration_s": path.duration,
+            "worst_predicted_mm": path.worst_predicted_mm,
+        }),
+    }
+    for name in ARRAYS:
+        d[name] = _encode(getattr(path, name))
+    d["bounds"] = None if path.bounds is None else [
+        {k: _encode(v) for k, v in asdict(b).items()} for b in path.bounds]
+    return d
+
+
+def toolpath_from_dict(d: dict) -> Toolpath:
+    """The :class:`Toolpath` written by :func:`toolpath_to_dict` (bounds included)."""
+    if not isinstance(d, dict) or d.get("format") != FORMAT:
+        raise InputError("not a cadcnc toolpath (no \"format\": \"cadcnc-toolpath\")")
+    if d.get("version") != VERSION:
+        raise InputError(f"toolpath format version {d.get('version')!r} is not supported "
+                         f"(this cadcnc reads version {VERSION})")
+    try:
+        arrays = {
+            "points": _decode(d["points"], (3,)),
+            "contacts": _decode(d["contacts"], (2, 3)),
+            "normals": _decode(d["normals"], (2, 3)),
+            "uv": _decode(d["uv"], (2, 2)),
+            "steps": _decode(d["steps"]),
+            "commanded": _decode(d["commanded"]),
+        }
+        bounds = None
+        if d.get("bounds") is not None:
+            names = [f.name for f in fields(SurfaceBounds)]
+            bounds = tuple(SurfaceBounds(**{k: _decode(b[k]) for k in names})
+                           for b in d["bounds"])
+        faces = tuple(None if f is None else int(f) for f in d["faces"])
+        inputs = dict(d.get("inputs") or {})
+        inputs.setdefault("offsets", d["offsets"])
+        path = Toolpath(**arrays, job=Job.from_inputs(inputs, faces),
+                        stop_reason=d["stop_reason"], stop_detail=d.get("stop_detail", ""),
+                        bounds=bounds)
+    except (KeyError, TypeError, ValueError) as e:
+        raise InputError(f"toolpath JSON is incomplete or malformed ({type(e).__name__}: "
+                         f"{e})") from None
+    n = len(path.points)
+    if path.points.shape != (n, 3) or path.contacts.shape != (n, 2, 3):
+        raise InputError(f"toolpath JSON arrays disagree in shape: points "
+                         f"{path.points.shape}, contacts {path.contacts.shape}")
+    return path
+
+
+def write_json(path: Toolpath, out) -> None:
+    """Write ``path`` to ``out`` as JSON (atomic)."""
+    write_text(out, json.dumps(toolpath_to_dict(path), separators=(",", ":")) + "\n")
+
+
+def read_json(file) -> Toolpath:
+    """Read a toolpath JSON file; errors name the file."""
+    file = Path(file)
+    try:
+        data = json.loads(file.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(f"{file}: no such file") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise InputError(f"{file}: not a toolpath JSON file ({e})") from None
+    try:
+        return toolpath_from_dict(data)
+    except InputError as e:
+        raise InputError(f"{file}: {e}") from None

@@ -1,0 +1,198 @@
+"""What the user asked for: one typed, validated record per machining job.
+
+A :class:`Job` holds what every operation shares (the part's source, the tool, feed,
+period, clearance height, tolerances) and one operation record (today :class:`PairPath`,
+the path along the intersection of two faces; pencil and finishing add theirs). It is
+validated once, where it is built; everything downstream (the API, the toolpath, the
+APT-like programs, the CLI, the JSON writer and reader) reads its fields, never string
+keys. Units: lengths mm, feed mm/min, period s.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass, field
+
+from .errors import InputError
+from .tolerances import DEFAULT, Tolerances
+
+SHANK_LENGTH_RADII = 10.0  # default shank length, in ball radii
+Point = tuple[float, float, float]
+
+
+def check_number(name: str, value, unit: str, *, allow_zero: bool = False) -> float:
+    """``value`` as a float if it is a real finite number > 0 (>= 0 with ``allow_zero``).
+
+    Booleans are refused (``radius=True`` is a mistake, not 1 mm); numpy scalars are
+    numbers. The error names the parameter and its unit.
+    """
+    ok = (isinstance(value, numbers.Real) and not isinstance(value, bool)
+          and math.isfinite(float(value)))
+    if not ok or value < 0 or (value == 0 and not allow_zero):
+        need = ">= 0" if allow_zero else "> 0"
+        raise InputError(f"{name} must be a number {need} {unit}, got {_show(value)}")
+    return float(value)
+
+
+def check_point(name: str, value) -> Point | None:
+    """A point (x, y, z) in mm as a float tuple, or None."""
+    if value is None:
+        return None
+    try:
+        xyz = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        xyz = ()
+    if isinstance(value, (str, bytes)) or len(xyz) != 3 or not all(map(math.isfinite, xyz)):
+        raise InputError(f"{name} must be a point (x, y, z) in mm, got {_show(value)}")
+    return xyz
+
+
+def _show(value) -> str:
+    """A value as a user reads it: plain numbers, not numpy reprs."""
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        return f"{float(value):g}"
+    return repr(value)
+
+
+@dataclass(frozen=True)
+class Tool:
+    """A ball-end cutter: ball radius R on a cylindrical shank of radius R along +Z.
+
+    ``radius`` R and ``allowance`` C (stock left on the faces) in mm; the ball's offset from
+    the faces is R' = R + C. ``shank_length`` (mm) above the ball centre, default 10 R.
+    """
+
+    radius: float
+    allowance: float = 0.0
+    shank_length: float | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "radius", check_number("radius", self.radius, "mm",
+                                                        allow_zero=True))
+        object.__setattr__(self, "allowance", check_number("allowance", self.allowance,
+                                                           "mm", allow_zero=True))
+        if self.shank_length is not None:
+            object.__setattr__(self, "shank_length", check_number(
+                "shank length", self.shank_length, "mm", allow_zero=True))
+
+    @property
+    def offset(self) -> float:
+        """R' = R + C, mm: the ball centre's distance from a face it touches."""
+        return self.radius + self.allowance
+
+    @property
+    def shank(self) -> float:
+        """Shank length above the ball centre, mm (default 10 R)."""
+        return SHANK_LENGTH_RADII * self.radius if self.shank_length is None \
+            else self.shank_length
+
+
+@dataclass(frozen=True)
+class PairPath:
+    """The ``path`` operation: the ball follows the intersection of two offset surfaces.
+
+    ``faces``: the two face numbers of the part (None for a face given directly).
+    ``offsets``: each surface's offset, None meaning R'; 0 makes that surface a guide
+    surface carrying the ball centre. ``start``/``end``: points (mm) near the intersection;
+    by default the ends of the faces' shared concave edge number ``edge`` (0-based).
+    """
+
+    faces: tuple[int | None, int | None] = (None, None)
+    offsets: tuple[float | None, float | None] = (None, None)
+    start: Point | None = None
+    end: Point | None = None
+    edge: int = 0
+
+    def __post_init__(self):
+        faces = tuple(self.faces)
+        if len(faces) != 2:
+            raise InputError(f"a path needs two faces, got {_show(self.faces)}")
+        for n in faces:
+            if n is not None and (isinstance(n, bool) or not isinstance(n, numbers.Integral)
+                                  or n < 1):
+                raise InputError(f"face numbers are integers from 1, got {_show(n)}")
+        object.__setattr__(self, "faces", tuple(None if n is None else int(n) for n in faces))
+        offsets = tuple(self.offsets) if self.offsets is not None else (None, None)
+        if len(offsets) != 2:
+            raise InputError(f"offsets needs one value per surface, got {_show(self.offsets)}")
+        object.__setattr__(self, "offsets", tuple(
+            None if o is None else check_number("offset", o, "mm", allow_zero=True)
+            for o in offsets))
+        object.__setattr__(self, "start", check_point("start", self.start))
+        object.__setattr__(self, "end", check_point("end", self.end))
+        if self.end is not None and self.start is None:
+            raise InputError("an end point needs a start point too")
+        if isinstance(self.edge, bool) or not isinstance(self.edge, numbers.Integral) \
+                or self.edge < 0:
+            raise InputError(f"edge must be an index >= 0 among the shared concave edges, "
+                             f"got {_show(self.edge)}")
+        object.__setattr__(self, "edge", int(self.edge))
+
+    def resolved_offsets(self, tool: Tool) -> tuple[float, float]:
+        """Each surface's offset in mm, None resolved to the tool's R'."""
+        return tuple(tool.offset if o is None else o for o in self.offsets)
+
+
+@dataclass(frozen=True)
+class Job:
+    """One machining job: tool, feed (mm/min), period (s), operation, part, tolerances.
+
+    ``source``: the part's STEP file (None for a CadQuery object). ``clearance``: the Z
+    height (mm) of rapid moves, None for the part's top plus a margin.
+    """
+
+    tool: Tool
+    feed: float
+    period: float
+    operation: PairPath = field(default_factory=PairPath)
+    source: str | None = None
+    clearance: float | None = None
+    tolerances: Tolerances = DEFAULT
+
+    def __post_init__(self):
+        object.__setattr__(self, "feed", check_number("feed", self.feed, "mm/min"))
+        object.__setattr__(self, "period", check_number("period", self.period, "s"))
+        if self.clearance is not None:
+            c = self.clearance
+            if isinstance(c, bool) or not isinstance(c, numbers.Real) or not math.isfinite(c):
+                raise InputError(f"clearance must be a finite height in mm, got {_show(c)}")
+            object.__setattr__(self, "clearance", float(c))
+        if self.source is not None:
+            object.__setattr__(self, "source", str(self.source))
+
+    @property
+    def step(self) -> float:
+        """f = F Ts, mm: the commanded step per interpolation period."""
+        return self.feed * self.period / 60.0
+
+    @property
+    def offsets(self) -> tuple[float, float]:
+        """The operation's surface offsets resolved against the tool, mm."""
+        return self.operation.resolved_offsets(self.tool)
+
+    def to_inputs(self) -> dict:
+        """The JSON ``inputs`` object (keys of format version 1, plus the newer ones)."""
+        op = self.operation
+        return dict(radius=self.tool.radius, allowance=self.tool.allowance, feed=self.feed,
+                    period=self.period, start=None if op.start is None else list(op.start),
+                    end=None if op.end is None else list(op.end),
+                    offsets=list(self.offsets), edge=op.edge, source=self.source,
+                    shank_length=self.tool.shank_length, clearance=self.clearance)
+
+    @classmethod
+    def from_inputs(cls, inputs: dict, faces=(None, None)) -> "Job":
+        """The job recorded in a toolpath JSON's ``inputs`` (InputError if malformed)."""
+        try:
+            tool = Tool(inputs["radius"], inputs.get("allowance", 0.0),
+                        inputs.get("shank_length"))
+            # offsets are recorded resolved: R' itself means "the tool's offset"
+            offsets = tuple(None if o == tool.offset else o
+                            for o in (inputs.get("offsets") or (None, None)))
+            op = PairPath(faces=tuple(faces), offsets=offsets,
+                          start=inputs.get("start"), end=inputs.get("end"),
+                          edge=inputs.get("edge", 0))
+            return cls(tool, inputs["feed"], inputs["period"], op, inputs.get("source"),
+                       inputs.get("clearance"))
+        except KeyError as e:
+            raise InputError(f"the recorded job has no {e.args[0]!r}") from None
