@@ -1,21 +1,22 @@
-"""``cadcnc``: argparse subcommands; each command imports the library when it runs.
+"""``cadcnc``: argparse subcommands, then one library call, then printing.
 
 Errors the library raises on purpose (:class:`cadcnc.errors.CadcncError`) become one line
 ``cadcnc: error: <message>`` on stderr and the error's exit code (2 input, 3 geometry,
-4 output; argparse usage errors are 2 as well; a failed ``verify`` gate is 5). ``--debug``
-shows the traceback instead.
+4 output; argparse usage errors are 2 as well; a refused gouge is 5). ``--debug`` shows the
+traceback instead. Every option is defined once here; the commands live in
+:mod:`cadcnc.cli.commands` and :mod:`cadcnc.cli.demo`.
 """
 
 from __future__ import annotations
 
+import argparse
+import os
 import sys
 
 UNITS = "Units: lengths mm, feed mm/min, period with a unit (4ms, 0.004s, 250us)."
 
 
-def _common(debug_quiet: bool = True):
-    import argparse
-
+def _common() -> argparse.ArgumentParser:
     common = argparse.ArgumentParser(add_help=False)
     g = common.add_argument_group("general")
     g.add_argument("-q", "--quiet", action="store_true", default=argparse.SUPPRESS,
@@ -25,13 +26,8 @@ def _common(debug_quiet: bool = True):
     return common
 
 
-def _job_args(p):
-    p.add_argument("step", metavar="PART.step", help="the part (STEP file, mm)")
-    _job_options(p, required=True)
-
-
-def _job_options(p, required: bool):
-    """The machining job's options (faces, cutter, feed, period, start/end, edge)."""
+def _job_options(p, required: bool) -> None:
+    """The machining job: faces, cutter, feed, period, start/end, edge."""
     p.add_argument("--faces", nargs=2, type=int, required=required, metavar=("I", "J"),
                    help="the two faces, numbered as `cadcnc faces` (FreeCAD's FaceN)")
     p.add_argument("--radius", required=required, metavar="R", help="ball radius, mm")
@@ -48,34 +44,31 @@ def _job_options(p, required: bool):
                    help="which shared concave edge when the faces share several (1, 2, ...)")
 
 
-def _gouge_args(p):
+def _gouge_options(p, gate: bool = True) -> None:
     p.add_argument("--gouge-tolerance", default="0.001", metavar="MM",
-                   help="refuse (exit 5, nothing written) a path whose ball cuts any face of "
-                        "the part deeper than this, mm (default 0.001)")
-    p.add_argument("--allow-gouge", action="store_true",
-                   help="write the path even when the whole-part check finds a gouge")
+                   help="the gouge limit: a ball cutting any face of the part deeper than "
+                        "this fails (exit 5), mm (default 0.001)")
+    if gate:
+        p.add_argument("--allow-gouge", action="store_true",
+                       help="write the path even when the whole-part check finds a gouge")
 
 
-def _gcode_args(p):
+def _gcode_options(p) -> None:
     g = p.add_argument_group("G-code (.ngc output)")
     g.add_argument("--tolerance", metavar="MM",
-                   help="drop points whose removal moves the path less than this, mm; also "
-                        "the G64 P blending tolerance and the print precision (default: keep "
-                        "every point, 0.001 mm for G64 P and digits)")
+                   help="chord tolerance: drop points whose removal moves the path less "
+                        "than this, mm; also the G64 P blending tolerance and the print "
+                        "precision (default: keep every point, 0.001 mm for G64 P and digits)")
     g.add_argument("--tool-tip", action="store_true",
                    help="program the ball's tip (Z - R) instead of its centre")
-    g.add_argument("--safe-z", metavar="Z",
-                   help="height for rapid moves, mm in programmed coordinates (default: "
-                        "the part's top plus 10 mm)")
+    g.add_argument("--clearance", "--safe-z", dest="clearance", metavar="Z",
+                   help="height of rapid moves, mm in programmed coordinates (default: the "
+                        "part's top plus 10 mm); --safe-z is an alias")
     g.add_argument("--spindle", metavar="RPM", type=float,
                    help="spindle speed; adds S<RPM> M3 ... M5 (default: none)")
 
 
-def build_parser():
-    import argparse
-
-    from . import commands
-
+def build_parser() -> argparse.ArgumentParser:
     common = _common()
     parser = argparse.ArgumentParser(
         prog="cadcnc", parents=[common],
@@ -85,30 +78,29 @@ def build_parser():
     parser.add_argument("--version", action="version", version=_version())
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
-    def add(name, func, help_, description=None):
-        p = sub.add_parser(name, parents=[common], help=help_,
-                           description=(description or help_) + " " + UNITS)
-        p.set_defaults(func=func)
-        return p
+    def add(name, help_, description=None):
+        return sub.add_parser(name, parents=[common], help=help_,
+                              description=(description or help_) + " " + UNITS)
 
-    p = add("faces", commands.faces, "list faces, neighbours and the concave pairs to follow",
+    p = add("faces", "list faces, neighbours and the concave pairs to follow",
             "List every face (number, kind, area in mm^2) and its neighbours with the edge "
             "class and material-side dihedral angle (deg); concave pairs are the candidates "
             "for an intersection path.")
     p.add_argument("step", metavar="PART.step")
     p.add_argument("--json", action="store_true", help="machine-readable output")
 
-    p = add("path", commands.path, "compute a path and write it (.json, .csv, .ngc)",
+    p = add("path", "compute a path and write it (.json, .csv, .ngc)",
             "Compute the ball-end path along the intersection of faces I and J and write it; "
             "the format follows each output's suffix.")
-    _job_args(p)
+    p.add_argument("step", metavar="PART.step", help="the part (STEP file, mm)")
+    _job_options(p, required=True)
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
                    help="output file: .json (everything), .csv (a row per cycle) or .ngc "
                         "(G-code); repeat for several")
-    _gouge_args(p)
-    _gcode_args(p)
+    _gouge_options(p)
+    _gcode_options(p)
 
-    p = add("run", commands.run, "execute an APT-like part program (PATH = P/[...])",
+    p = add("run", "execute an APT-like part program (PATH = P/[...])",
             "Execute an APT-like part program (grammar: docs/cli.md). Prints a summary per "
             "path, streams the per-period increments, or writes outputs.")
     p.add_argument("program", metavar="PROGRAM.apt")
@@ -117,32 +109,34 @@ def build_parser():
     p.add_argument("-o", "--output", action="append", metavar="OUT",
                    help=".ngc: one program for all paths; .json/.csv: one file per path "
                         "(OUT-NAME.json when the program has several)")
-    _gouge_args(p)
-    _gcode_args(p)
+    _gouge_options(p)
+    _gcode_options(p)
 
-    p = add("demo", commands.demo, "run the main job on a bundled part and write everything",
+    p = add("demo", "run the main job on a bundled part and write everything",
             "Compute the path around the boss of the bundled bspline_boss part (faces 4 and "
             "5, R 3 mm, 1500 mm/min, 4 ms), verify it, and write JSON, CSV, G-code, a "
             "verification report and a picture to a folder.")
     p.add_argument("--out", default="cadcnc-demo", metavar="DIR",
                    help="output folder (default: ./cadcnc-demo)")
 
-    p = add("plot", commands.plot, "picture of a saved path (.png) or a 3-D scene (.glb)")
+    p = add("plot", "picture of a saved path (.png) or a 3-D scene (.glb)")
     p.add_argument("path_json", metavar="PATH.json", help="a path written by `cadcnc path`")
     p.add_argument("--part", metavar="PART.step",
                    help="the part (default: the STEP file recorded in the path)")
     p.add_argument("-o", "--output", required=True, metavar="OUT",
                    help=".png (matplotlib) or .glb (glTF scene)")
 
-    p = add("verify", commands.verify, "check a path against OCCT (gouge gate for pipelines)",
+    p = add("verify", "check a path against OCCT (gouge gate for pipelines)",
             "Verify a path against geometry computed independently by OCCT: either compute it "
             "(PART.step --faces I J --radius R --feed F --period T) or read it (PATH.json "
-            "[--part PART.step]). Exit 5 when the over-cut exceeds --tolerance.")
+            "[--part PART.step]). Exit 5 when the ball cuts the part deeper than "
+            "--gouge-tolerance.")
     p.add_argument("input", metavar="PART.step|PATH.json")
     p.add_argument("--part", metavar="PART.step", help="the part of a saved PATH.json")
     _job_options(p, required=False)
-    p.add_argument("--tolerance", default="0.001", metavar="MM",
-                   help="largest acceptable over-cut, mm (default 0.001 = 1 um)")
+    _gouge_options(p, gate=False)
+    # the old spelling of --gouge-tolerance, kept so that scripts keep working
+    p.add_argument("--tolerance", dest="gouge_tolerance", help=argparse.SUPPRESS)
     p.add_argument("--json", action="store_true", help="the report as JSON")
     return parser
 
@@ -160,23 +154,24 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     debug = getattr(args, "debug", False)
     args.quiet = getattr(args, "quiet", False)
-    from cadcnc.errors import CadcncError
-
     try:
-        return int(args.func(args) or 0)
-    except CadcncError as e:
-        if debug:
-            raise
-        print(f"cadcnc: error: {e}", file=sys.stderr)
-        return e.exit_code
-    except BrokenPipeError:  # `cadcnc run --stream ... | head`: the reader left, fine
-        import os
+        # importing the library (OCCT) takes ~1.5 s: `--help` and usage errors don't pay it
+        from . import commands
 
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
+        return int(commands.COMMANDS[args.command](args) or 0)
     except KeyboardInterrupt:
         print("cadcnc: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # `cadcnc run --stream ... | head`: the reader left, fine
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except Exception as e:  # noqa: BLE001 - one line for the library's own errors
+        from cadcnc.errors import CadcncError
+
+        if debug or not isinstance(e, CadcncError):
+            raise
+        print(f"cadcnc: error: {e}", file=sys.stderr)
+        return e.exit_code
 
 
 if __name__ == "__main__":

@@ -1,20 +1,25 @@
-"""Every command run as a user runs it: a subprocess of ``python -m cadcnc.cli``.
+"""Every command as a user runs it, in-process through ``main(argv)``.
 
 Outputs are parsed and compared with the Python API; error cases check the documented
 one-line messages and exit codes (docs/cli.md "Errors"). Expensive runs are module-scoped.
+The console script itself is exercised by the subprocess smoke tests in
+test_cli_smoke.py.
 """
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
+import os
 import shutil
-import subprocess
-import sys
+from dataclasses import dataclass
 
 import numpy as np
 import pytest
 
 import cadcnc
+from cadcnc.cli.main import main
 from cadcnc.io import read_csv, read_json
 
 from conftest import FIXTURES, load_fixture
@@ -25,21 +30,35 @@ POCKET = str(FIXTURES / "pocket.step")
 JOB = ["--radius", "3", "--feed", "1500", "--period", "4ms"]
 
 
-def cadcnc_cli(*args, cwd=None, check=None):
-    """Run ``cadcnc ARGS``; returns the CompletedProcess (text)."""
-    run = subprocess.run([sys.executable, "-m", "cadcnc.cli", *map(str, args)], cwd=cwd,
-                         capture_output=True, text=True, timeout=120)
+@dataclass
+class Run:
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+@contextlib.contextmanager
+def _cwd(path):
+    old = os.getcwd()
+    os.chdir(path or old)
+    try:
+        yield
+    finally:
+        os.chdir(old)
+
+
+def cadcnc_cli(*args, cwd=None, check=None) -> Run:
+    """Run ``cadcnc ARGS`` in this process; returns its exit code, stdout and stderr."""
+    out, err = io.StringIO(), io.StringIO()
+    with _cwd(cwd), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main([str(a) for a in args])
+        except SystemExit as e:  # argparse: --help, usage errors
+            code = e.code
+    run = Run(code, out.getvalue(), err.getvalue())
     if check is not None:
         assert run.returncode == check, (run.returncode, run.stdout, run.stderr)
     return run
-
-
-def has_verification() -> bool:
-    try:
-        import cadcnc.verification  # noqa: F401
-    except ImportError:
-        return False
-    return True
 
 
 # -- help and faces ----------------------------------------------------------------------------
@@ -151,9 +170,9 @@ def test_errors_are_one_line_with_exit_codes(tmp_path, args, code, message):
     assert list(tmp_path.iterdir()) == []  # nothing half-written
 
 
-def test_debug_shows_the_traceback(tmp_path):
-    run = cadcnc_cli("faces", "nope.step", "--debug", cwd=tmp_path)
-    assert run.returncode != 0 and "Traceback" in run.stderr and "StepFileError" in run.stderr
+def test_debug_raises_instead_of_one_line(tmp_path):
+    with _cwd(tmp_path), pytest.raises(cadcnc.StepFileError, match="nope.step"):
+        main(["faces", "nope.step", "--debug"])
 
 
 # -- run ---------------------------------------------------------------------------------------
@@ -242,10 +261,9 @@ def test_demo_writes_everything(demo_run, boss_api):
     assert f"wrote {out}/" in run.stdout
     np.testing.assert_array_equal(read_json(out / "path.json").points, boss_api.points)
     assert (out / "path.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    if has_verification():
-        assert {"verification.txt", "verification.json"} <= names
-        data = json.loads((out / "verification.json").read_text())
-        assert data["max_overcut_mm"] < 1e-3 and "verified" in run.stdout
+    assert {"verification.txt", "verification.json"} <= names
+    data = json.loads((out / "verification.json").read_text())
+    assert data["max_overcut_mm"] < 1e-3 and "verified" in run.stdout
 
 
 def test_demo_program_runs(demo_run, boss_api, tmp_path):
@@ -276,8 +294,6 @@ def test_plot_bad_suffix(boss_outputs, tmp_path):
 
 
 def test_verify_computed_path_json():
-    if not has_verification():
-        pytest.skip("cadcnc.verification not available")
     run = cadcnc_cli("verify", SADDLE, "--faces", "1", "2", *JOB, "--json", check=0)
     data = json.loads(run.stdout)
     for key in ("max_overcut_mm", "max_undercut_mm", "hausdorff_mm", "coverage",
@@ -287,12 +303,10 @@ def test_verify_computed_path_json():
 
 
 def test_verify_saved_path_and_gate(boss_outputs):
-    if not has_verification():
-        pytest.skip("cadcnc.verification not available")
     d, _ = boss_outputs
     ok = cadcnc_cli("verify", d / "p.json", "--part", BOSS, check=0)
     assert "over-cut" in ok.stdout
-    strict = cadcnc_cli("verify", d / "p.json", "--tolerance", "1e-9", "--quiet")
+    strict = cadcnc_cli("verify", d / "p.json", "--gouge-tolerance", "1e-9", "--quiet")
     assert strict.returncode == 5
     assert strict.stderr.startswith("cadcnc: verify: gouge") and "1e-09 mm" in strict.stderr
 
@@ -317,12 +331,25 @@ def test_docs_examples_run(example, tmp_path):
 def test_path_refuses_a_path_that_gouges_a_third_face(tmp_path):
     """A 3 mm ball in the 4 mm slot cuts the opposite wall: refused, nothing written."""
     out = tmp_path / "slot.json"
-    args = [sys.executable, "-m", "cadcnc.cli", "path", str(FIXTURES / "narrow_slot.step"),
-            "--faces", "3", "4", "--radius", "3", "--feed", "1500", "--period", "4ms",
-            "-o", str(out)]
-    run = subprocess.run(args, capture_output=True, text=True)
+    args = ["path", FIXTURES / "narrow_slot.step", "--faces", "3", "4", *JOB, "-o", out]
+    run = cadcnc_cli(*args)
     assert run.returncode == 5, run.stderr
     assert "refused" in run.stderr and "face 5 by 2 mm" in run.stderr
     assert not out.exists()
-    run = subprocess.run(args + ["--allow-gouge", "--quiet"], capture_output=True, text=True)
+    run = cadcnc_cli(*args, "--allow-gouge", "--quiet")
     assert run.returncode == 0 and out.exists()
+
+
+def test_verify_old_tolerance_spelling_still_gates(boss_outputs):
+    d, _ = boss_outputs
+    strict = cadcnc_cli("verify", d / "p.json", "--tolerance", "1e-9", "--quiet")
+    assert strict.returncode == 5 and "1e-09 mm" in strict.stderr
+
+
+def test_safe_z_is_an_alias_of_clearance(boss_outputs, tmp_path):
+    d, _ = boss_outputs
+    for flag in ("--clearance", "--safe-z"):
+        out = tmp_path / f"{flag[2:]}.ngc"
+        cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", out, flag, "80",
+                   "--quiet", check=0)
+        assert "G0 Z80\n" in out.read_text()

@@ -1,0 +1,38 @@
+"""The console script as users start it: a few subprocess runs (each pays ~2 s of imports)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from conftest import FIXTURES
+
+
+def cadcnc(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "cadcnc.cli", *map(str, args)], cwd=cwd,
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_help_without_importing_occt():
+    run = cadcnc("--help")
+    assert run.returncode == 0 and "verify" in run.stdout
+    probe = subprocess.run([sys.executable, "-c", "import sys; from cadcnc.cli.main import "
+                            "build_parser; build_parser(); print('OCP' in sys.modules)"],
+                           capture_output=True, text=True, timeout=60)
+    assert probe.stdout.strip() == "False", probe.stderr
+
+
+def test_path_end_to_end(tmp_path):
+    out = tmp_path / "p.json"
+    run = cadcnc("path", FIXTURES / "bspline_boss.step", "--faces", "4", "5", "--radius", "3",
+                 "--feed", "1500", "--period", "4ms", "-o", out)
+    assert run.returncode == 0, run.stderr
+    assert "points     697" in run.stdout and out.read_bytes().startswith(b"{")
+
+
+def test_error_is_one_line_with_exit_code(tmp_path):
+    run = cadcnc("faces", "nope.step", cwd=tmp_path)
+    assert run.returncode == 2
+    assert run.stderr == "cadcnc: error: nope.step: no such file\n"
+    debug = cadcnc("faces", "nope.step", "--debug", cwd=tmp_path)
+    assert debug.returncode == 1 and "Traceback" in debug.stderr

@@ -1,0 +1,38 @@
+"""Every fixture pair's path is pinned: a change of behaviour shows, in either direction.
+
+fixtures/pinned_paths.npz was written by fixtures/build_pinned_paths.py (R 3 mm, 1.5 in
+narrow_slot; f = 0.1 mm). Points and contact parameters must agree to 1e-12 (mm, or
+native parameter units); the eq. 16 bounds to 1e-12 relative. A change made on purpose
+regenerates the file in the same commit.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import FIXTURES, load_fixture
+
+sys.path.insert(0, str(FIXTURES))
+from build_pinned_paths import compute, pinned_cases  # noqa: E402
+
+PINNED = np.load(FIXTURES / "pinned_paths.npz")
+CASES = list(pinned_cases())
+
+
+def test_every_concave_pair_is_pinned():
+    assert {f"{key}_points" for key, *_ in CASES} == {k for k in PINNED.files
+                                                      if k.endswith("_points")}
+
+
+@pytest.mark.parametrize("key, name, i, j", CASES, ids=[c[0] for c in CASES])
+def test_fixture_path_is_unchanged(key, name, i, j):
+    tp = compute(load_fixture(name), name, i, j)
+    points, uv = PINNED[f"{key}_points"], PINNED[f"{key}_uv"]
+    assert tp.points.shape == points.shape
+    np.testing.assert_allclose(tp.points, points, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(tp.uv, uv, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.stack([b.eq16 for b in tp.bounds]), PINNED[f"{key}_eq16"],
+                               rtol=1e-12, atol=0)
