@@ -18,6 +18,8 @@ def test_api_examples_run(monkeypatch):
     for block in blocks:
         exec(compile(block, "docs/api.md", "exec"), namespace)
     assert namespace["path"].stop_reason == "closed"
+    assert (namespace["same"].points == namespace["path"].points).all()
+    assert namespace["job"].step == 0.1 and namespace["same"].job.operation.faces == (4, 5)
     assert namespace["stepper"].stop_reason == "closed"
     assert len(sent) == namespace["stepper"].cycles
     assert os.path.exists(ROOT / "fixtures" / "bspline_boss.step")
