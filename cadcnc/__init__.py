@@ -4,26 +4,49 @@ Data flow (docs/architecture.md): STEP/CadQuery shape -> :class:`Part` (faces, a
 -> :class:`FaceSurface` (derivatives, normals, curvature, trims) -> interpolation core
 (one cycle at a time, :class:`Stepper`) -> :class:`Toolpath` -> writers, verification,
 plots. Units: mm, mm/min, s.
+
+The names below are loaded on first use: importing OCCT takes about 1.5 s, which
+``import cadcnc`` (and ``cadcnc --help``) should not pay before it is needed.
 """
+
+from __future__ import annotations
+
+import importlib
 
 from .errors import (
     CadcncError, FaceNumberError, FacePairError, GeometryError, InputError, OutputError,
     SingularPointError, StartPointError, StepFileError,
 )
-from .geometry.face_surface import FaceSurface
-from .geometry.part import Part, SharedEdge, load_step
-from .interp.stepper import Stepper, Tangency
-from .ops.pair_path import intersection_path, intersection_paths, make_stepper
-from .program.toolpath import Toolpath
+from .job import Job, PairPath, Tool
 from .tolerances import Tolerances
-from .verification import VerificationReport, verify
 
 __version__ = "0.1.0"
 
+_LAZY = {
+    "FaceSurface": "geometry.face_surface",
+    "Part": "geometry.part", "SharedEdge": "geometry.part", "load_step": "geometry.part",
+    "Stepper": "interp.stepper", "Tangency": "interp.stepper",
+    "intersection_path": "ops.pair_path", "intersection_paths": "ops.pair_path",
+    "make_stepper": "ops.pair_path", "path_for_job": "ops.pair_path",
+    "Toolpath": "program.toolpath",
+    "VerificationReport": "verification", "verify": "verification",
+    "gouge_gate": "verification",
+}
+
 __all__ = [
     "CadcncError", "FaceNumberError", "FacePairError", "GeometryError", "InputError",
-    "OutputError", "SingularPointError", "StartPointError", "StepFileError", "FaceSurface",
-    "Part", "SharedEdge", "load_step", "intersection_path", "intersection_paths",
-    "make_stepper", "Stepper", "Tangency", "Tolerances", "Toolpath", "VerificationReport",
-    "verify",
+    "OutputError", "SingularPointError", "StartPointError", "StepFileError", "Job",
+    "PairPath", "Tool", "Tolerances", *_LAZY,
 ]
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'cadcnc' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

@@ -30,3 +30,19 @@ def load_fixture(name: str):
 @pytest.fixture
 def fixture_part():
     return load_fixture
+
+
+_paths: dict = {}
+
+
+def fixture_path(name: str, i: int, j: int, *, radius: float = 3.0, feed: float = 1500.0,
+                 period: float = 0.004, **kwargs):
+    """The toolpath of a fixture pair, computed once per test session (do not modify it)."""
+    key = (name, i, j, radius, feed, period, tuple(sorted(kwargs.items())))
+    if key not in _paths:
+        import cadcnc
+
+        part = load_fixture(name)
+        _paths[key] = cadcnc.intersection_path(part.face(i), part.face(j), radius=radius,
+                                               feed=feed, period=period, **kwargs)
+    return _paths[key]

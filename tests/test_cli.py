@@ -22,7 +22,7 @@ import cadcnc
 from cadcnc.cli.main import main
 from cadcnc.io import read_csv, read_json
 
-from conftest import FIXTURES, load_fixture
+from conftest import FIXTURES, fixture_path, load_fixture
 
 BOSS = str(FIXTURES / "bspline_boss.step")
 SADDLE = str(FIXTURES / "crossing_cylinders.step")
@@ -100,9 +100,7 @@ def boss_outputs(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def boss_api():
-    part = load_fixture("bspline_boss")
-    return cadcnc.intersection_path(part.face(4), part.face(5), radius=3.0, feed=1500.0,
-                                    period=0.004)
+    return fixture_path("bspline_boss", 4, 5)
 
 
 def test_path_summary(boss_outputs, boss_api):

@@ -13,7 +13,7 @@ import pytest
 import cadcnc
 from cadcnc.io.gcode import DEFAULT_TOLERANCE, digits_for, programmed_points, simplify, to_ngc
 
-from conftest import load_fixture
+from conftest import fixture_path, load_fixture
 
 RS274 = shutil.which("rs274")
 needs_rs274 = pytest.mark.skipif(RS274 is None, reason="LinuxCNC rs274 not installed "
@@ -24,11 +24,9 @@ RS274_DECIMALS = 4  # rs274's canonical output prints 4 decimals in mm
 
 @pytest.fixture(scope="module")
 def paths():
-    boss = load_fixture("bspline_boss")
     saddle = load_fixture("crossing_cylinders")
     return {
-        "boss": [cadcnc.intersection_path(boss.face(4), boss.face(5), radius=3.0,
-                                          feed=1500.0, period=0.004)],
+        "boss": [fixture_path("bspline_boss", 4, 5)],
         "saddles": cadcnc.intersection_paths(saddle.face(1), saddle.face(2), radius=3.0,
                                              allowance=0.2, feed=1500.0, period=0.004),
     }

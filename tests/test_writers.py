@@ -8,7 +8,6 @@ from dataclasses import fields
 import numpy as np
 import pytest
 
-import cadcnc
 from cadcnc.interp.error_bounds import SurfaceBounds
 from cadcnc.errors import InputError, OutputError
 from cadcnc.io import (
@@ -16,14 +15,12 @@ from cadcnc.io import (
     toolpath_to_dict, write_csv, write_json, write_toolpaths,
 )
 
-from conftest import load_fixture
+from conftest import fixture_path
 
 
 @pytest.fixture(scope="module")
 def saddle():
-    part = load_fixture("crossing_cylinders")
-    return cadcnc.intersection_path(part.face(1), part.face(2), radius=3.0, feed=1500.0,
-                                    period=0.004)
+    return fixture_path("crossing_cylinders", 1, 2)
 
 
 def assert_same_path(a, b):
