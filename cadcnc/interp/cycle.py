@@ -2,8 +2,9 @@
 
 Kernel-free: a surface is anything with ``derivative_tuples(u, w)`` (r and its first and
 second partials as float 3-tuples), ``normal_sign``, ``wrap(u, w)`` and ``classify(u, w)``
-(:class:`cadcnc.face_surface.FaceSurface` is one). See ALGORITHM.md "One interpolation
-cycle" and docs/interpolator.md. Lengths mm, curvatures 1/mm, feed mm/min, period s.
+(:class:`cadcnc.geometry.face_surface.FaceSurface` is one). See docs/method.md section 3
+(the equation numbers below) and docs/interpolator.md. Lengths mm, curvatures 1/mm, feed
+mm/min, period s.
 
 The cycle from state (p, contacts q1, q2) with step f (mm):
   1. track    p* = p + f t,  t = n1 x n2 / |n1 x n2| (sign kept from the previous cycle)

@@ -1,4 +1,4 @@
-"""The paper's error theory (ALGORITHM.md "Error theory"), evaluated per cycle, vectorised.
+"""The paper's error theory (docs/method.md section 4), evaluated per cycle, vectorised.
 
 Inputs are per-point arrays from the interpolator's record; outputs are bounds in mm.
 R in the paper's formulas is each surface's offset distance (R + C, or 0 for a guide
@@ -41,7 +41,8 @@ def _rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def surface_curvatures(ru, rw, n, ff, t):
     """k along t, principal k_max/k_min and geodesic torsion tau along t, per row.
 
-    ``ff`` is (N, 6): E, F, G, L, M, N. Vectorised forms of cadcnc.differential.
+    ``ff`` is (N, 6): E, F, G, L, M, N. Vectorised forms of cadcnc.geometry.differential (tests/test_curvature_copies.py
+    ties them together).
     """
     E, F, G, L, M, N = ff.T
     det = E * G - F * F

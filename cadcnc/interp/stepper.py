@@ -4,7 +4,7 @@ A real-time caller builds a :class:`Stepper` and calls :meth:`Stepper.step` once
 interpolation period; each call returns the axis increment dp_K (mm) for the next period,
 or None once the path has stopped (``stop_reason`` says why). The feed may change between
 calls (override, ramps). :func:`cadcnc.intersection_path` is a loop over this class.
-Kernel-free, like :mod:`cadcnc.interpolator`.
+Kernel-free, like :mod:`cadcnc.interp.cycle`.
 """
 
 from __future__ import annotations
