@@ -22,7 +22,7 @@ from cadcnc.verification import gouge_gate, verify as run_verify
 
 from . import demo as demo_command
 from .feedback import progress, say_error
-from .options import gcode_options, job_from_args, tolerances, wants_gcode
+from .options import clearance, gcode_options, job_from_args, tolerances, wants_gcode
 
 GOUGE_REFUSED = 5  # exit code: the whole-part check found a gouge deeper than the limit
 
@@ -100,7 +100,7 @@ def run(args) -> int:
     for out in outputs:
         check_output(out)
     source = args.program
-    entries, title = apt.read_program(source, tolerances(args))
+    entries, title = apt.read_program(source, tolerances(args), clearance(args))
     checked = apt.check(entries, source)
     if args.stream:
         return _stream(checked, source)

@@ -5,11 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import cadcnc
 from cadcnc import apt
-from cadcnc.errors import FacePairError, ProgramSyntaxError, StepFileError
+from cadcnc.errors import FacePairError, InputError, ProgramSyntaxError, StepFileError
+from cadcnc.job import Job
+from cadcnc.tolerances import DEFAULT, Tolerances
 
-from conftest import FIXTURES, load_fixture
+from conftest import FIXTURES, fixture_path, load_fixture
 
 GOOD = f"""$$ both saddle edges, then part of one at a higher feed
 PARTNO/'saddle'
@@ -26,22 +27,58 @@ PERIOD/250us
 PART3 = P/[1, 2, EDGE, (5, 11.2, 22)]
 FINI
 """
+SETTINGS = "PART='x.step'\nCUTTER/R=3\nFEED/1500\nPERIOD/4ms\n"
 
 
-def test_parse_and_jobs():
+def cylinders(_file):
+    return load_fixture("crossing_cylinders")
+
+
+@pytest.fixture(scope="module")
+def good():
+    return apt.entries(apt.parse(GOOD, "good.apt"), ".", "good.apt")
+
+
+@pytest.fixture(scope="module")
+def checked(good):
+    return apt.check(good, "good.apt", load=cylinders)
+
+
+@pytest.fixture(scope="module")
+def program_paths(checked):
+    return [apt.run_job(entry, part) for entry, part in checked]
+
+
+def test_parse_and_entries(good):
     statements = apt.parse(GOOD, "good.apt")
     assert [s.keyword for s in statements] == [
         "PARTNO", "PART", "CUTTER", "FEED", "PERIOD", "PATH", "PATH", "CUTTER", "FEED",
         "PERIOD", "PATH", "FINI"]
-    jobs = apt.jobs(statements, ".", "good.apt")
-    assert [j.name for j in jobs] == ["SADDLE1", "SADDLE2", "PART3"]
-    assert [j.line for j in jobs] == [7, 8, 13]
-    j1, j2, j3 = jobs
-    assert (j1.radius, j1.allowance, j1.feed, j1.period) == (3.0, 0.1, 1500.0, 0.004)
-    assert j1.faces == (1, 2) and j1.edge == 0 and j2.edge == 1
-    assert (j3.radius, j3.allowance, j3.feed) == (3.0, 0.0, 3000.0)
+    assert apt.title(statements) == "saddle"
+    assert [e.name for e in good] == ["SADDLE1", "SADDLE2", "PART3"]
+    assert [e.line for e in good] == [7, 8, 13]
+    assert all(isinstance(e.job, Job) and e.job.tolerances is DEFAULT for e in good)
+    j1, j2, j3 = (e.job for e in good)
+    assert j1.source == str(FIXTURES / "crossing_cylinders.step")
+    assert (j1.tool.radius, j1.tool.allowance, j1.feed, j1.period) == (3.0, 0.1, 1500.0, 0.004)
+    assert j1.operation.faces == (1, 2) and j1.operation.edge == 0 and j2.operation.edge == 1
+    assert j1.operation.start is None and good[0].pending is None  # EDGE, EDGE: the default
+    assert (j3.tool.radius, j3.tool.allowance, j3.feed) == (3.0, 0.0, 3000.0)
     assert j3.period == pytest.approx(250e-6)
-    assert j3.end == (5.0, 11.2, 22.0) and j1.title == "saddle"
+    # one EDGE end: the ends wait in `pending` until check() knows the edge
+    assert j3.operation.start is None and good[2].pending[1].point == (5.0, 11.2, 22.0)
+    assert good[2].pending[0].edge == 1
+
+
+def test_program_options_go_into_every_job():
+    tol = Tolerances(gouge=0.01)
+    got = apt.entries(apt.parse(SETTINGS + "A = P/[F1, F2, EDGE, EDGE]\n"), tolerances=tol,
+                      clearance=40)
+    assert got[0].job.tolerances is tol and got[0].job.clearance == 40.0
+    with pytest.raises(InputError, match="^clearance must be a finite height") as info:
+        apt.entries(apt.parse(SETTINGS + "A = P/[F1, F2, EDGE, EDGE]\n"),
+                    clearance=float("inf"))
+    assert not isinstance(info.value, ProgramSyntaxError)  # not the program's fault
 
 
 @pytest.mark.parametrize("text, line, column, message", [
@@ -53,16 +90,33 @@ def test_parse_and_jobs():
     ("A = P/[F4, F5, (1, 2), EDGE]\n", 1, 21, "after the y coordinate"),
     ("A = P/[F4, G5, EDGE, EDGE]\n", 1, 12, "expected face S2 as F<number>"),
     ("A = P/[F4, F5, EDGE, EDGE\n", 2, 1, "expected ']'"),
+    ("A = P/[F4, F5, EDGE(0), EDGE]\n", 1, 21, "edge number must be an integer >= 1"),
     ("PART = boss\n", 1, 8, "quoted string"),
     ("GOTO/1, 2, 3\n", 1, 1, "unknown statement 'GOTO'"),
     ("FEED/1500 # x\n", 1, 11, "unexpected character '#'"),
-    ("FEED/0\n", 1, 6, "feed must be > 0"),
     ("FINI\nFEED/1\n", 2, 1, "statement after FINI"),
     ("FEED/1500 1500\n", 1, 11, "expected end of statement"),
 ])
 def test_syntax_errors_name_line_and_column(text, line, column, message):
     with pytest.raises(ProgramSyntaxError, match=message) as info:
         apt.parse(text, "bad.apt")
+    assert (info.value.line, info.value.column) == (line, column)
+    assert str(info.value).startswith(f"bad.apt:{line}:{column}: ")
+
+
+@pytest.mark.parametrize("text, line, column, message", [
+    ("FEED/0\n", 1, 6, "feed must be a number > 0 mm/min, got 0"),
+    ("FEED/1500\nPERIOD/0ms\n", 2, 8, "period must be a number > 0 s, got 0"),
+    ("CUTTER/R=-3\n", 1, 10, "radius must be a number >= 0 mm, got -3"),
+    ("CUTTER/R=3, C=-0.5\n", 1, 15, "allowance must be a number >= 0 mm, got -0.5"),
+    (SETTINGS + "A = P/[F0, F2, EDGE, EDGE]\n", 5, 8, "face numbers are integers from 1"),
+    (SETTINGS + "A = P/[F1, F2, (1, 2, 1e999), EDGE]\n", 5, 16, "start must be a point"),
+    (SETTINGS + "A = P/[F1, F2, EDGE, (1, 2, 1e999)]\n", 5, 22, "end must be a point"),
+])
+def test_values_the_job_refuses_name_line_and_column(text, line, column, message):
+    statements = apt.parse(text, "bad.apt")  # syntax is fine
+    with pytest.raises(ProgramSyntaxError, match=message) as info:
+        apt.entries(statements, ".", "bad.apt")
     assert (info.value.line, info.value.column) == (line, column)
     assert str(info.value).startswith(f"bad.apt:{line}:{column}: ")
 
@@ -76,46 +130,51 @@ def test_syntax_errors_name_line_and_column(text, line, column, message):
 ])
 def test_missing_settings(text, message):
     with pytest.raises(ProgramSyntaxError, match=message):
-        apt.jobs(apt.parse(text, "p.apt"), ".", "p.apt")
+        apt.entries(apt.parse(text, "p.apt"), ".", "p.apt")
 
 
 def test_check_names_the_path_line_before_computing(tmp_path):
     boss = FIXTURES / "bspline_boss.step"
     text = (f"PART = '{boss}'\nCUTTER/R=3\nFEED/1500\nPERIOD/4ms\n"
             "A = P/[F4, F5, EDGE, EDGE]\nB = P/[F5, F6, EDGE, EDGE]\n")
-    jobs = apt.jobs(apt.parse(text, "p.apt"), ".", "p.apt")
+    entries = apt.entries(apt.parse(text, "p.apt"), ".", "p.apt")
     with pytest.raises(FacePairError, match=r"^p.apt:6: PATH B: .*convex edge"):
-        apt.check(jobs, "p.apt")
+        apt.check(entries, "p.apt", load=lambda f: load_fixture("bspline_boss"))
     (tmp_path / "p.apt").write_text(text.replace(str(boss), "nope.step"))
-    jobs, _ = apt.read_program(tmp_path / "p.apt")
-    assert jobs[0].part_file == str(tmp_path / "nope.step")  # relative to the program
+    entries, title = apt.read_program(tmp_path / "p.apt")
+    assert entries[0].job.source == str(tmp_path / "nope.step")  # relative to the program
+    assert title == ""
     with pytest.raises(StepFileError, match="p.apt:5: PATH A: .*nope.step: no such file"):
-        apt.check(jobs, "p.apt")
+        apt.check(entries, "p.apt")
 
 
-def test_execution_matches_the_python_api():
-    jobs = apt.jobs(apt.parse(GOOD, "good.apt"), ".", "good.apt")
-    checked = apt.check(jobs, "good.apt", load=lambda f: load_fixture("crossing_cylinders"))
+def test_execution_matches_the_python_api(checked, program_paths):
     part = load_fixture("crossing_cylinders")
-    paths = [apt.run_job(j, p) for j, p in checked]
-    direct = cadcnc.intersection_paths(part.face(1), part.face(2), radius=3.0,
-                                       allowance=0.1, feed=1500.0, period=0.004)
-    for got, want in zip(paths[:2], direct):
+    assert sum(e.edge_class == "concave" for e in part.shared_edges(1, 2)) == 2
+    for k, got in enumerate(program_paths[:2]):
+        want = fixture_path("crossing_cylinders", 1, 2, allowance=0.1, edge=k)
         np.testing.assert_array_equal(got.points, want.points)
+        assert got.job.source == str(FIXTURES / "crossing_cylinders.step")
     # a lone EDGE end becomes the shared edge's start point
     edge = part.shared_edges(1, 2)[0]
-    assert checked[2][0].start == pytest.approx(tuple(edge.start))
-    assert paths[2].stop_reason == "end"
+    entry = checked[2][0]
+    assert entry.pending is None
+    assert entry.job.operation.start == pytest.approx(tuple(edge.start))
+    assert entry.job.operation.end == (5.0, 11.2, 22.0)
+    assert program_paths[2].stop_reason == "end"
 
 
-def test_stream_increments_sum_to_the_path():
-    jobs = apt.jobs(apt.parse(GOOD, "good.apt"), ".", "good.apt")
-    (job, part), = apt.check(jobs[:1], "good.apt",
-                             load=lambda f: load_fixture("crossing_cylinders"))
-    stepper, increments = apt.stream_job(job, part)
+def test_an_unchecked_lone_edge_end_is_refused(good):
+    with pytest.raises(InputError, match="good.apt:13: PATH PART3: .*check"):
+        apt.run_job(good[2], load_fixture("crossing_cylinders"), source="good.apt")
+
+
+def test_stream_increments_sum_to_the_path(checked, program_paths):
+    entry, part = checked[0]
+    stepper, increments = apt.stream_job(entry, part)
     start = np.array(stepper.p)
     dps = np.array(list(increments))
-    path = apt.run_job(job, part)
+    path = program_paths[0]
     assert len(dps) == len(path) - 1
     np.testing.assert_allclose(start + np.cumsum(dps, axis=0), path.points[1:], atol=1e-12)
     assert np.allclose(np.linalg.norm(dps[:-1], axis=1), 0.1, rtol=1e-3)
