@@ -40,6 +40,8 @@ def refuse_gouge(tp, part, what: str) -> str:
 def faces(args) -> int:
     part = cadcnc.load_step(args.step)
     data = faces_report(part)
+    for line in part.warnings:
+        say_error(f"cadcnc: faces: OCCT's STEP reader: {line}")
     if args.json:
         print(json.dumps(data, indent=1))
         return 0

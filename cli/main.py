@@ -150,8 +150,24 @@ def _version() -> str:
         return "cadcnc (version unknown)"
 
 
+POINT_OPTIONS = ("--start", "--end")
+
+
+def _negative_points_joined(argv: list[str]) -> list[str]:
+    """``--start -6,6,5`` as ``--start=-6,6,5``: argparse takes a value that starts with a
+    minus sign for an option."""
+    out: list[str] = []
+    for arg in argv:
+        if out and out[-1] in POINT_OPTIONS and arg.startswith("-") and arg[1:2].isdigit():
+            out[-1] = f"{out[-1]}={arg}"
+        else:
+            out.append(arg)
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser().parse_args(_negative_points_joined(argv))
     debug = getattr(args, "debug", False)
     args.quiet = getattr(args, "quiet", False)
     try:

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 
 from cadcnc.errors import InputError
 from cadcnc.io.gcode import SAFE_MARGIN
-from cadcnc.job import Job, PairPath, Tool
+from cadcnc.job import Job, PairPath, Tool, check_number
 from cadcnc.tolerances import DEFAULT, Tolerances
 from cadcnc.units import parse_duration, parse_feed, parse_length, parse_point
 
@@ -41,10 +42,12 @@ def clearance(args) -> float | None:
     if getattr(args, "clearance", None) is None:
         return None
     try:
-        return float(args.clearance)
+        z = float(args.clearance)
     except ValueError:
-        raise InputError(f"--clearance: expected a height in mm, got {args.clearance!r}") \
-            from None
+        z = float("nan")
+    if not math.isfinite(z):
+        raise InputError(f"--clearance: expected a finite height in mm, got {args.clearance!r}")
+    return z
 
 
 def wants_gcode(outputs) -> bool:
@@ -57,5 +60,5 @@ def gcode_options(args, clearance_z: float | None, parts) -> dict:
     tol = None if args.tolerance is None else parse_length(args.tolerance, "tolerance", False)
     if clearance_z is None:
         clearance_z = max(part.top for part in parts) + SAFE_MARGIN
-    return dict(tolerance=tol, tool_tip=args.tool_tip, safe_z=clearance_z,
-                spindle=args.spindle)
+    spindle = None if args.spindle is None else check_number("--spindle", args.spindle, "rpm")
+    return dict(tolerance=tol, tool_tip=args.tool_tip, safe_z=clearance_z, spindle=spindle)

@@ -209,7 +209,10 @@ class FaceSurface:
         return float(math.sqrt(c @ c) / (ru @ ru + rw @ rw + 1e-300))
 
     def normal(self, u: float, w: float) -> np.ndarray:
-        """Unit normal out of the material, (3,). Raises SingularPointError where undefined."""
+        """Unit normal out of the material, (3,). Raises SingularPointError where undefined
+        and InputError for non-finite parameters: it never returns NaN."""
+        if not (math.isfinite(u) and math.isfinite(w)):
+            raise InputError(f"{self!r}: parameters must be finite, got (u={u}, w={w})")
         d = self.derivatives(u, w)
         return self._normal_from(d.ru, d.rw, u, w)
 

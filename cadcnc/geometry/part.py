@@ -20,8 +20,6 @@ from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
 from OCP.GCPnts import GCPnts_AbscissaPoint
 from OCP.gp import gp_Pnt, gp_Vec
-from OCP.IFSelect import IFSelect_RetDone
-from OCP.STEPControl import STEPControl_Reader
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_SOLID
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Shape
@@ -29,6 +27,7 @@ from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_Ind
 
 from ..errors import FaceNumberError, StepFileError
 from .face_surface import FaceSurface
+from .step_file import read_step
 from ..tolerances import DEFAULT, Tolerances
 
 CONCAVE, CONVEX, TANGENT, MIXED = "concave", "convex", "tangent", "mixed"
@@ -60,34 +59,35 @@ class SharedEdge:
 
 
 def load_step(path: str | os.PathLike, tol: Tolerances = DEFAULT) -> "Part":
-    """Read a STEP file into a :class:`Part`; errors name the file and the problem."""
+    """Read a STEP file into a :class:`Part`; errors name the file and the problem.
+
+    What OCCT's reader printed is kept in ``part.warnings`` (never on standard output).
+    """
     path = os.fspath(path)
-    if not os.path.exists(path):
-        raise StepFileError(f"{path}: no such file")
-    if os.path.isdir(path):
-        raise StepFileError(f"{path}: is a directory, not a STEP file")
-    with open(path, "rb") as fh:
-        head = fh.read(64)
-    if b"ISO-10303-21" not in head:
-        raise StepFileError(f"{path}: not a STEP file (no ISO-10303-21 header)")
-    reader = STEPControl_Reader()
-    if reader.ReadFile(path) != IFSelect_RetDone:
-        raise StepFileError(f"{path}: STEP file could not be read (syntax or schema error)")
-    reader.TransferRoots()
-    shape = reader.OneShape()
-    return Part(shape, source=path, tol=tol)
+    shape, warnings = read_step(path)
+    part = Part(shape, source=path, tol=tol)
+    part.warnings = warnings
+    return part
 
 
 def _shape_of(obj) -> TopoDS_Shape:
-    """A TopoDS_Shape from a CadQuery Workplane, Shape, or OCP shape."""
+    """A TopoDS_Shape from a CadQuery Workplane, Shape or Assembly, or an OCP shape."""
     if hasattr(obj, "vals") and hasattr(obj, "toOCC"):  # cq.Workplane
         vals = obj.vals()
         if len(vals) == 1:
             return _shape_of(vals[0])
-        import cadquery as cq
+        import cadquery as cq  # ~3 s to import: only CadQuery users, who have it loaded
 
         return cq.Compound.makeCompound([v for v in vals if hasattr(v, "wrapped")]).wrapped
-    return getattr(obj, "wrapped", obj)
+    if hasattr(obj, "toCompound"):  # cq.Assembly
+        return obj.toCompound().wrapped
+    shape = getattr(obj, "wrapped", obj)
+    if not isinstance(shape, TopoDS_Shape):
+        raise StepFileError(
+            f"cannot machine a {type(obj).__name__}: give a CadQuery Workplane, Shape or "
+            "Assembly, an OCP TopoDS_Shape, or a STEP file (a Sketch is 2-D: extrude it "
+            "first)")
+    return shape
 
 
 class Part:
@@ -109,6 +109,7 @@ class Part:
         self._faces: dict[int, FaceSurface] = {}
         self._edges: dict[tuple[int, int], list[SharedEdge]] | None = None
         self._bbox: tuple[np.ndarray, np.ndarray] | None = None
+        self.warnings: list[str] = []  # what OCCT printed while reading the file
 
     @classmethod
     def from_cadquery(cls, obj, tol: Tolerances = DEFAULT) -> "Part":
@@ -123,9 +124,12 @@ class Part:
 
     def face(self, number: int) -> FaceSurface:
         """Face ``number`` (1-based, FreeCAD's FaceN)."""
-        if not isinstance(number, (int, np.integer)) or not 1 <= number <= len(self):
+        if isinstance(number, bool) or not isinstance(number, (int, np.integer)) \
+                or not 1 <= number <= len(self):
+            shown = number if isinstance(number, (int, np.integer)) and not isinstance(
+                number, bool) else repr(number)
             raise FaceNumberError(
-                f"{self.source}: face number {number!r} out of range: the part has faces "
+                f"{self.source}: face number {shown} out of range: the part has faces "
                 f"1..{len(self)}")
         number = int(number)
         if number not in self._faces:

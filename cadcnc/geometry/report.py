@@ -12,7 +12,8 @@ def _angle_range(edges) -> list[float]:
 
 
 def faces_report(part: Part) -> dict:
-    """{"file", "n_faces", "faces": [...], "pairs": [...], "concave_pairs"}; areas mm^2,
+    """{"file", "n_faces", "faces": [...], "pairs": [...], "concave_pairs", "warnings"}
+    (what OCCT's reader printed); areas mm^2,
     angles deg (material-side dihedral: < 180 convex, > 180 concave), lengths mm."""
     out = {"file": str(part.source), "n_faces": len(part), "faces": [], "pairs": []}
     for f in part.faces:
@@ -27,6 +28,7 @@ def faces_report(part: Part) -> dict:
             {"class": e.edge_class, "angle_deg": _angle_range([e]),
              "length_mm": round(e.length, 6), "closed": bool(e.closed)} for e in edges]})
     out["concave_pairs"] = [list(p) for p in part.concave_pairs()]
+    out["warnings"] = list(part.warnings)
     return out
 
 

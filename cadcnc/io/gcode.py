@@ -24,6 +24,7 @@ import re
 import numpy as np
 
 from ..errors import InputError
+from ..job import check_number
 from .atomic import write_text
 
 DEFAULT_TOLERANCE = 0.001  # mm
@@ -112,12 +113,21 @@ def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
         raise InputError("no toolpath to write")
     tol = DEFAULT_TOLERANCE if tolerance is None else float(tolerance)
     digits = digits_for(tol)
-    if clearance < 0:
-        raise InputError(f"clearance must be >= 0 mm, got {clearance!r}")
+    check_number("G-code approach clearance", clearance, "mm", allow_zero=True)
+    if spindle is not None:
+        check_number("spindle speed", spindle, "rpm")
     programmed = [programmed_points(p, tool_tip) for p in paths]
+    for k, (path, pts) in enumerate(zip(paths, programmed), 1):
+        if not np.all(np.isfinite(pts)):
+            raise InputError(f"path {k} has a non-finite point: nothing written")
+        if float(_num(path.job.feed, 3)) <= 0:
+            raise InputError(f"path {k}: feed {path.job.feed:g} mm/min prints as F0: too "
+                             "slow for G-code")
     top = max(float(p[:, 2].max()) for p in programmed)
     if safe_z is None:
         safe_z = top + SAFE_MARGIN
+    elif not math.isfinite(safe_z):
+        raise InputError(f"rapid height must be a finite Z in mm, got {safe_z}")
     elif safe_z < top + clearance:
         raise InputError(f"safe Z {safe_z:g} mm is below the path's highest point "
                          f"{top:g} mm plus the clearance {clearance:g} mm")

@@ -71,8 +71,8 @@ def shared_edge_for(s1: FaceSurface, s2: FaceSurface, edge: int = 0):
             f"{lo:.1f}..{hi:.1f} deg): a ball cannot sit in that corner; pick a concave pair "
             "(material angle > 180 deg) from `cadcnc faces`")
     if not 0 <= edge < len(concave):
-        raise InputError(f"edge index {edge} out of range: faces {i} and {j} share "
-                         f"{len(concave)} concave edge(s)")
+        raise InputError(f"there is no concave edge number {edge + 1} (index {edge}): faces "
+                         f"{i} and {j} share {len(concave)} concave edge(s)")
     return concave[edge]
 
 
