@@ -1,0 +1,394 @@
+"""O(1) trim check: a uniform (u, w) grid of cells labelled inside / outside / mixed.
+
+``TrimGrid.build(face_surface).classify(u, w)`` returns exactly ``FaceSurface.classify(u,
+w)`` (FClass2d.Perform on the wrapped point, same tolerance); only MIXED cells call FClass2d.
+
+Why the labels are exact: FClass2d classifies against its own polygon per wire (pcurve
+samples, ``NbSamples`` x 4 per edge, re-sampled by ``GCPnts_QuasiUniformDeflection`` on thin
+wires) with a band of half-widths Tu = max(FlecheU, tol), Tv = max(FlecheV, tol): a point is
+ON (sent to BRepClass_FaceClassifier) only if the polygon meets the box p +- (Tu, Tv); off the
+bands the answer is ray-crossing parity, constant on any connected set meeting no band;
+``Perform`` also tries the point shifted by whole periods. ``_bands`` rebuilds FClass2d's
+polygons and bands (same OCCT calls and parameter arithmetic); every cell touched by a band, a
+copy of one whole periods away or the wrap's seam (+ 1e-12 relative round-off) is MIXED; the
+other cells form 4-connected regions, each labelled by one exact call at a cell centre,
+confirmed by two more (disagreement or ON: the region stays MIXED, counted in
+``stats["suspect"]``). Where FClass2d uses BRepClass for every point (bad wire, <= 3 points,
+no pcurve, flat box) or its periods differ from FaceSurface's, the grid is one MIXED cell
+(``stats["exact_only"]``).
+
+Resolution rule: a boundary with total variations Lu = sum |du_k|, Lw = sum |dw_k| makes about
+Lu dw + Lw du of MIXED area, so N cells over the grid box Du x Dw are best shaped du = sqrt(C
+Lu / Lw), dw = sqrt(C Lw / Lu), C = Du Dw / N, for a MIXED share of the face box Fu x Fw of
+about 2 sqrt(Lu Lw C) / (Fu Fw); N makes that ``target_share`` (2 %), within [256,
+``max_cells`` = 65536] (64 KiB; benchmarks/bench_trim_grid.py). A periodic direction whose
+bands cover over 3/4 of the period spans exactly the wrap range; any other spans the bands +
+1.1 clear cells each side (periodic ones inside a one-period window centred on them), so a
+point beyond the grid takes its nearest border cell's label.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from itertools import product
+
+import numpy as np
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
+from OCP.BRepTools import BRepTools_WireExplorer
+from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
+from OCP.GCPnts import GCPnts_QuasiUniformDeflection
+from OCP.Geom2dInt import Geom2dInt_Geom2dCurveTool
+from OCP.gp import gp_Pnt2d
+from OCP.TopAbs import (TopAbs_FORWARD, TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED,
+                        TopAbs_WIRE)
+from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopoDS import TopoDS
+
+from ..trim import BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE
+
+_CONFUSION = 1e-7  # OCCT Precision::Confusion(), mm
+
+
+def classifier_tolerance(face_surface) -> float:
+    """FaceSurface's FClass2d tolerance in (u, w): ``tol.on_boundary`` mm via the resolutions."""
+    adaptor, tol = BRepAdaptor_Surface(face_surface.topods, True), face_surface.tol.on_boundary
+    return min(adaptor.UResolution(tol), adaptor.VResolution(tol))
+
+
+def _fleche(seq: list, fu: float, fv: float) -> tuple[float, float]:
+    """FClass2d's sag estimate at the last three points: middle one against the chord."""
+    (ax, ay), (bx, by), (cx, cy) = seq[-3:]
+    n = math.hypot(cx - ax, cy - ay)
+    if n == 0.0:
+        return fu, fv
+    dx, dy = (cx - ax) / n, (cy - ay) / n
+    t = (bx - ax) * dx + (by - ay) * dy
+    return max(fu, abs(ax + t * dx - bx)), max(fv, abs(ay + t * dy - by))
+
+
+def _is_degenerated(c3: BRepAdaptor_Curve, first: float, last: float) -> bool:
+    """FClass2d's test: no 3-D sample farther than Confusion (squared!) from the start."""
+    step, start, u = (last - first) * 0.1, c3.Value(first), first
+    while u < last:
+        if start.SquareDistance(c3.Value(u)) > _CONFUSION:
+            return False
+        u = u + step if u + step != u else math.nextafter(u, last)
+    return True
+
+
+def _edges(wire, face):
+    """(edge, orientation, first, last) along the wire as FClass2d walks it; None if a
+    FORWARD/REVERSED edge has no pcurve (FClass2d stops building there)."""
+    explorer = BRepTools_WireExplorer()
+    explorer.Init(wire, face)
+    while explorer.More():
+        edge = explorer.Current()
+        orient = edge.Orientation()
+        if orient not in (TopAbs_FORWARD, TopAbs_REVERSED):
+            yield edge, orient, 0.0, 0.0  # skipped, as FClass2d does: an empty range
+        elif BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 0.0) is None:
+            yield None
+            return
+        else:
+            yield edge, orient, *BRep_Tool.Range_s(edge, face)
+        explorer.Next()
+
+
+def _sample(wire, face, box: list, defl: float = 0.0) -> tuple[list, float, float, int] | None:
+    """FClass2d's polygon of one wire: (points, FlecheU, FlecheV, edges walked). ``defl`` > 0:
+    its re-sampling pass (quasi-uniform deflection, no 3-D test, ``box`` left alone)."""
+    seq, fu, fv, first_point, walked, last3d = [], 0.0, 0.0, 1, 0, None
+    for item in _edges(wire, face):
+        if item is None:
+            return None
+        walked += 1
+        edge, orient, pf, pl = item
+        if abs(pl - pf) < 1e-9:
+            continue
+        c2, c3 = BRepAdaptor_Curve2d(edge, face), BRepAdaptor_Curve(edge, face)
+        if defl:
+            discr = GCPnts_QuasiUniformDeflection(c2, defl)
+            if not discr.IsDone():
+                break
+            idx = list(range(1, discr.NbPoints() + 1))[::1 if orient == TopAbs_FORWARD else -1]
+            seq += [c2.Value(discr.Parameter(i)).Coord() for i in idx[first_point - 1:]]
+            fu, fv = _fleche(seq, fu, fv) if len(idx) > 2 else (fu, fv)
+            first_point = 2
+            continue
+        degenerated = (BRep_Tool.Degenerated_s(edge) or BRep_Tool.IsClosed_s(edge, face)
+                       or TopExp.FirstVertex_s(edge).IsNull()
+                       or TopExp.LastVertex_s(edge).IsNull() or _is_degenerated(c3, pf, pl))
+        nbs = Geom2dInt_Geom2dCurveTool.NbSamples_s(c2)
+        nbs = nbs * 4 if nbs > 2 else nbs
+        du = (pl - pf) / (nbs - 1) * (1.0 if orient == TopAbs_FORWARD else -1.0)
+        u = (pf if orient == TopAbs_FORWARD else pl) + (du if first_point == 2 else 0.0)
+        before = len(seq)
+        for _ in range(first_point, nbs + 1):
+            x, y = c2.Value(u).Coord()
+            box[:] = min(box[0], x), max(box[1], x), min(box[2], y), max(box[3], y)
+            real = True
+            if not degenerated:  # skip points that repeat the last one in 3-D
+                p3 = c3.Value(u)
+                if len(seq) > 1 and last3d is not None and p3.Distance(last3d) < _CONFUSION:
+                    real = p3.Distance(c3.Value(u - du / 2.0)) >= _CONFUSION
+                last3d = p3 if real else last3d
+            if real:
+                seq.append((x, y))
+            u += du
+            if len(seq) > before + 4 and seq[-3] != seq[-1]:
+                fu, fv = _fleche(seq, fu, fv)
+        first_point = 2
+    return seq, fu, fv, walked
+
+
+def _thickness(seq: list) -> float:
+    """FClass2d's 2 |area| / perimeter (its loop skips the last point; NaN if no perimeter)."""
+    b = np.roll(a := np.asarray(seq)[:-1], 1, axis=0)
+    square = float(np.sum((a[:, 0] - b[:, 0]) * (a[:, 1] + b[:, 1]) * 0.5))
+    per = float(np.sum(np.hypot(*(a - b).T)))
+    return max(2.0 * abs(square) / per, 1e-7) if per > 0.0 else math.nan
+
+
+def _bands(face_surface, tol_uv: float) -> tuple[np.ndarray, ...] | None:
+    """FClass2d's bands: segment starts, ends, half-widths, each (k, 2) in (u, w); None where
+    it uses BRepClass for every point. Each wire's closed polygon, plus its CSLib_Class2d box
+    outline where a re-sampled polygon leaves that box (the quick rejection then cuts it)."""
+    face = TopoDS.Face_s(face_surface.topods.Oriented(TopAbs_FORWARD))
+    surface = BRepAdaptor_Surface(face, False)  # FClass2d's view of the periods
+    if (surface.IsUPeriodic(), surface.IsVPeriodic()) != (
+            face_surface.u_period is not None, face_surface.w_period is not None):
+        return None
+    box = [0.0, 0.0, 0.0, 0.0]  # FClass2d starts its box at the origin
+    p, q, h = [], [], []
+    wires = TopExp_Explorer(face, TopAbs_WIRE)
+    while wires.More():
+        wire = TopoDS.Wire_s(wires.Current())
+        wires.Next()
+        first = _sample(wire, face, box)
+        if first is None or first[3] != wire.NbChildren():  # the explorer missed edges
+            return None
+        seq, fu, fv, _ = first
+        if not seq:
+            continue
+        if len(seq) <= 3:
+            return None
+        thick, defl = _thickness(seq), max(fu, fv)
+        discr = min(defl * 0.1, thick * 10.0)
+        while defl > thick and discr > 1e-7:
+            seq, fu, fv, _ = _sample(wire, face, box, discr)
+            thick, defl = _thickness(seq), max(fu, fv)
+            discr = min(discr * 0.1, thick * 10.0)
+        if box[1] <= box[0] or box[3] <= box[2] or len(seq) < 3:
+            return None  # CSLib_Class2d without points: every call goes to BRepClass
+        pts, tu, tv = np.asarray(seq, dtype=float), max(fu, tol_uv), max(fv, tol_uv)
+        outline = np.array([[box[0] - tu, box[2] - tv], [box[1] + tu, box[2] - tv],
+                            [box[1] + tu, box[3] + tv], [box[0] - tu, box[3] + tv]])
+        loops = [(pts, (tu, tv))]
+        if np.any(pts < outline[0]) or np.any(pts > outline[2]):
+            loops.append((outline, (0.0, 0.0)))
+        for loop, half in loops:
+            p.append(loop)
+            q.append(np.roll(loop, -1, axis=0))
+            h.append(np.tile(half, (len(loop), 1)))
+    return tuple(np.vstack(x) if x else np.zeros((0, 2)) for x in (p, q, h))
+
+
+def _layout(lo, hi, p, q, face_surface, max_cells: int, target: float) -> tuple[list, list]:
+    """Per direction (origin, cell size, count) by the module's rule, and the window (start,
+    period, seam): periodic points are wrapped into [start, start + period) before lookup
+    (period 0: not periodic); ``seam`` is where FaceSurface.wrap jumps inside a window that
+    the grid does not span (lo, hi are widened to hold it), else None."""
+    windows = []
+    for k, (period, start) in enumerate(((face_surface.u_period, face_surface.u_range[0]),
+                                        (face_surface.w_period, face_surface.w_range[0]))):
+        window = 0.5 * (lo[k] + hi[k] - (period or 0.0))
+        seam = None if period is None else window + (start - window) % period
+        if period is None:
+            windows.append((0.0, 0.0, None))
+        elif max(hi[k], seam) - min(lo[k], seam) > 0.75 * period:
+            windows.append((start, period, None))  # the grid spans the wrap range
+        else:
+            lo[k], hi[k] = min(lo[k], seam), max(hi[k], seam)
+            windows.append((window, period, seam))
+    full = [w[1] if w[1] and w[2] is None else 0.0 for w in windows]
+    span = [hi[k] - lo[k] for k in range(2)]
+    domain = [full[k] or span[k] for k in range(2)]
+    var = [max(float(np.abs(q[:, k] - p[:, k]).sum()), 1e-9 * span[k]) for k in range(2)]
+    n = 4.0 * var[0] * var[1] * domain[0] * domain[1] / (target * span[0] * span[1]) ** 2
+    c = domain[0] * domain[1] / min(max(n, 256.0), float(max_cells))
+    # the best cell shape, but no direction finer than max_cells / 16 cells
+    cell = [max(math.sqrt(c * var[k] / var[1 - k]), 16.0 * domain[k] / max_cells)
+            for k in range(2)]
+    while True:
+        axes = []
+        for k in range(2):
+            if full[k]:  # exactly the wrap range [start, start + period)
+                count = max(1, math.ceil(full[k] / cell[k]))
+                axes.append((windows[k][0], full[k] / count, count))
+            else:  # the bands plus >= 1.1 clear cells each side
+                count = max(3, math.ceil(span[k] / cell[k]) + 3)
+                axes.append((lo[k] - 1.1 * span[k] / (count - 2.2), span[k] / (count - 2.2),
+                             count))
+        if axes[0][2] * axes[1][2] <= 2 * max_cells:  # counts round up; memory stays bounded
+            return axes, windows
+        cell = [x * 1.25 for x in cell]
+
+
+def _mark(mask: np.ndarray, p, q, h, origin, size, eps) -> None:
+    """Set every cell of ``mask`` (nu, nw) that a segment's band (box-inflated) touches: the
+    inflated bounding boxes of pieces no longer than a cell, summed in a difference array."""
+    shape = np.array(mask.shape)
+    steps = np.maximum(np.ceil(np.max(np.abs(q - p) / size, axis=1)), 1).astype(np.int64)
+    seg = np.repeat(np.arange(len(p)), steps)
+    k = (np.arange(len(seg)) - np.repeat(np.cumsum(steps) - steps, steps))[:, None]
+    a = p[seg] + k / steps[seg, None] * (q[seg] - p[seg])
+    b = p[seg] + (k + 1) / steps[seg, None] * (q[seg] - p[seg])
+    i0 = np.floor((np.minimum(a, b) - h[seg] - eps - origin) / size)
+    i1 = np.floor((np.maximum(a, b) + h[seg] + eps - origin) / size)
+    keep = np.all((i1 >= 0) & (i0 < shape), axis=1)
+    i0 = np.clip(i0[keep], 0, shape - 1).astype(np.int64)
+    i1 = np.clip(i1[keep], 0, shape - 1).astype(np.int64) + 1
+    acc = np.zeros(shape + 1, dtype=np.int32)
+    for (r, c), sign in (((i0, i0), 1), ((i0, i1), -1), ((i1, i0), -1), ((i1, i1), 1)):
+        np.add.at(acc, (r[:, 0], c[:, 1]), sign)
+    mask |= acc.cumsum(0).cumsum(1)[:-1, :-1] > 0
+
+
+def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
+    """(origin (2,), cell size (2,), free (nu, nw) bool, windows): the layout, and the cells
+    that no band, nor its copies whole periods away, nor the wrap's seam touches."""
+    p, q, h = bands
+    lo, hi = (np.minimum(p, q) - h).min(axis=0), (np.maximum(p, q) + h).max(axis=0)
+    axes, windows = _layout(lo, hi, p, q, face_surface, max_cells, target)
+    origin, size = np.array([a[0] for a in axes]), np.array([a[1] for a in axes])
+    shape = np.array([axes[0][2], axes[1][2]])
+    eps = 1e-12 * (np.abs(origin) + shape * size) + 1e-300
+    shifts = [[k * t for k in range(math.ceil((o - b) / t) - 1,
+                                    math.floor((o + n * s - a) / t) + 2)] if t else [0.0]
+              for a, b, o, s, n, (_, t, _) in zip(lo, hi, origin, size, shape, windows)]
+    mask = np.zeros(shape, dtype=bool)
+    for shift in product(*shifts):
+        _mark(mask, p + shift, q + shift, h, origin, size, eps)
+    for k, (_, _, seam) in enumerate(windows):
+        if seam is not None:  # a line across the grid
+            a, b = origin - size, origin + (shape + 1) * size
+            a[k] = b[k] = seam
+            _mark(mask, a[None], b[None], np.zeros((1, 2)), origin, size, eps)
+    return origin, size, ~mask, windows
+
+
+def _regions(free: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Runs of free cells along w, (row, start, stop), and each run's 4-connected region."""
+    d = np.diff(np.pad(free.astype(np.int8), ((0, 0), (1, 1))), axis=1)
+    (row, start), stop = np.nonzero(d == 1), np.nonzero(d == -1)[1]
+    parent = list(range(len(row)))
+
+    def root(x: int) -> int:
+        while parent[x] != x:
+            parent[x] = x = parent[parent[x]]
+        return x
+
+    first = np.searchsorted(row, np.arange(free.shape[0] + 1)).tolist()
+    s, e = start.tolist(), stop.tolist()
+    for r in range(free.shape[0] - 1):  # merge overlapping runs of neighbouring rows
+        a, b, a_end, b_end = first[r], first[r + 1], first[r + 1], first[r + 2]
+        while a < a_end and b < b_end:
+            if s[a] < e[b] and s[b] < e[a]:
+                parent[root(a)] = root(b)
+            a, b = (a + 1, b) if e[a] < e[b] else (a, b + 1)
+    return row, start, stop, np.array([root(x) for x in range(len(row))], dtype=np.int64)
+
+
+_STATE_CODE = {TopAbs_IN: CELL_INSIDE, TopAbs_OUT: CELL_OUTSIDE}
+_CODE_STATE = {CELL_INSIDE: INSIDE, CELL_OUTSIDE: OUTSIDE}
+
+
+class TrimGrid:
+    """Cell labels (nu, nw) int8 over [u0, u0 + nu du] x [w0, w0 + nw dw] of one face.
+
+    ``classify(u, w)`` is ``face_surface.classify(u, w)``, O(1) outside MIXED cells. The
+    kernel: ``lookup(*kernel_args, *to_window(u, w))`` (``window`` = (u start, u period,
+    w start, w period), period 0 where not periodic; ``trim_lookup.wrap`` does to_window).
+    ``stats``: build_s (s), regions, calls (exact calls at build), suspect, exact_only.
+    """
+
+    def __init__(self, face_surface, labels: np.ndarray, origin, size, windows,
+                 classifier, stats: dict):
+        self.face, self.labels, self.stats, self._fc = face_surface, labels, stats, classifier
+        (self.u0, self.w0), (self.du, self.dw) = map(float, origin), map(float, size)
+        self.window = tuple(float(x) for win in windows for x in win[:2])
+        self.nu, self.nw = labels.shape
+        self._flat = labels.tobytes()  # C order: cell (i, j) at i * nw + j
+
+    @classmethod
+    def build(cls, face_surface, max_cells: int = 65536, target_share: float = 0.02,
+              checks: int = 3) -> "TrimGrid":
+        """Label a grid for ``face_surface`` (a FaceSurface) by the module's rule, with
+        ``checks`` (1..3) exact calls per region (the first decides, the others confirm)."""
+        t_start = time.perf_counter()
+        tol_uv = classifier_tolerance(face_surface)
+        fc = BRepTopAdaptor_FClass2d(face_surface.topods, tol_uv)
+        bands = _bands(face_surface, tol_uv)
+        stats = {"exact_only": bands is None, "regions": 0, "suspect": 0, "calls": 0}
+        if bands is None or not len(bands[0]):  # exact only, or no wire (all IN): one cell
+            origin, size, free = (0.0, 0.0), (1.0, 1.0), np.full((1, 1), bands is not None)
+            windows = [(0.0, 0.0)] * 2
+        else:
+            origin, size, free, windows = _free_cells(bands, face_surface, max_cells,
+                                                      target_share)
+        grid = cls(face_surface, np.full(free.shape, CELL_MIXED, np.int8), origin, size,
+                   windows, fc, stats)
+        grid._label_regions(free, checks)
+        stats["build_s"] = time.perf_counter() - t_start
+        return grid
+
+    def _label_regions(self, free: np.ndarray, checks: int) -> None:
+        """One exact call per 4-connected region of free cells (plus confirmations)."""
+        row, start, stop, region = _regions(free)
+        if not len(row):
+            return
+        order = np.argsort(region, kind="stable")
+        code = np.empty(len(row), dtype=np.int8)
+        groups = np.split(order, np.flatnonzero(np.diff(region[order])) + 1)
+        for runs in groups:
+            picks = [runs[0], runs[len(runs) // 2], runs[-1]][:max(1, checks)]
+            states = {_STATE_CODE.get(self._fc.Perform(gp_Pnt2d(*self.face.wrap(
+                self.u0 + (row[r] + 0.5) * self.du,
+                self.w0 + ((start[r] + stop[r] - 1) // 2 + 0.5) * self.dw))), CELL_MIXED)
+                for r in picks}
+            code[runs] = label = states.pop() if len(states) == 1 else CELL_MIXED
+            self.stats["suspect"] += label == CELL_MIXED
+        self.stats.update(regions=len(groups), calls=len(groups) * len(picks))
+        lengths = stop - start
+        offset = np.repeat(np.cumsum(lengths) - lengths, lengths)
+        flat = np.arange(lengths.sum()) - offset + np.repeat(row * self.nw + start, lengths)
+        self.labels.flat[flat] = np.repeat(code, lengths)
+        self._flat = self.labels.tobytes()
+
+    def to_window(self, u: float, w: float) -> tuple[float, float]:
+        """(u, w) moved by whole periods into the grid's window, as ``lookup`` expects."""
+        us, pu, ws, pw = self.window
+        return (us + (u - us) % pu if pu else u), (ws + (w - ws) % pw if pw else w)
+
+    def cell(self, u: float, w: float) -> int:
+        """The label of the cell holding (u, w), given in the window (CELL_MIXED if not finite)."""
+        x, y = (u - self.u0) / self.du, (w - self.w0) / self.dw
+        if not (abs(x) < 1e15 and abs(y) < 1e15):
+            return CELL_MIXED
+        i = min(max(math.floor(x), 0), self.nu - 1)
+        return self._flat[i * self.nw + min(max(math.floor(y), 0), self.nw - 1)]
+
+    def classify(self, u: float, w: float) -> str:
+        """inside / boundary / outside, exactly as ``FaceSurface.classify``."""
+        code = self.cell(*self.to_window(u, w))
+        if code != CELL_MIXED:
+            return _CODE_STATE[code]
+        state = self._fc.Perform(gp_Pnt2d(*self.face.wrap(u, w)))
+        return INSIDE if state == TopAbs_IN else BOUNDARY if state == TopAbs_ON else OUTSIDE
+
+    @property
+    def kernel_args(self) -> tuple:
+        """(labels, u0, w0, du, dw, nu, nw): the leading arguments of ``trim_lookup.lookup``."""
+        return self.labels, self.u0, self.w0, self.du, self.dw, self.nu, self.nw

@@ -1,0 +1,104 @@
+"""The trim grid answers exactly as FaceSurface.classify (FClass2d), mostly without it.
+
+Contract: ``TrimGrid.classify(u, w) == FaceSurface.classify(u, w)`` for every (u, w),
+"boundary" included: MIXED cells defer to the same FClass2d call, so the only possible
+disagreement is a cell wrongly labelled INSIDE or OUTSIDE, and any disagreement fails.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+from OCP.TopAbs import TopAbs_EDGE
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
+
+import cadcnc
+from cadcnc.geometry import trim_grid
+from cadcnc.geometry.trim_grid import CELL_MIXED, TrimGrid, classifier_tolerance
+from cadcnc.interp.kernel import trim_lookup
+from cadcnc.interp.kernel.trim_lookup import lookup, wrap
+
+FIXTURES = Path(__file__).resolve().parents[1] / "fixtures"
+STEPS = sorted(FIXTURES.glob("*.step"))
+N_RANDOM = 10_000
+N_SHARE = 3_000  # of the random points, for the O(1) share
+
+
+def box_points(face, rng, n: int) -> np.ndarray:
+    """(n, 2) uniform over the face's (u, w) box enlarged 5 % each side, plus 1 % far out."""
+    (u0, u1), (w0, w1) = face.u_range, face.w_range
+    du, dw = u1 - u0, w1 - w0
+    pts = np.column_stack([rng.uniform(u0 - 0.05 * du, u1 + 0.05 * du, n),
+                           rng.uniform(w0 - 0.05 * dw, w1 + 0.05 * dw, n)])
+    far = n // 100
+    pts[:far] = np.column_stack([rng.uniform(u0 - 10 * du, u1 + 10 * du, far),
+                                 rng.uniform(w0 - 10 * dw, w1 + 10 * dw, far)])
+    return pts
+
+
+def boundary_points(face, rng, per_edge: int = 24) -> np.ndarray:
+    """Pcurve samples offset by tiny amounts: multiples of the classifier tolerance and
+    fractions of the box, in random directions; shape (k, 2)."""
+    tol = classifier_tolerance(face)
+    size = max(face.u_range[1] - face.u_range[0], face.w_range[1] - face.w_range[0])
+    steps = np.array([0.0, 0.5 * tol, tol, 2 * tol, 10 * tol, 1e-7 * size, 1e-4 * size,
+                      1e-2 * size])
+    samples = []
+    edges = TopExp_Explorer(face.topods, TopAbs_EDGE)
+    while edges.More():
+        curve = BRepAdaptor_Curve2d(TopoDS.Edge_s(edges.Current()), face.topods)
+        for t in np.linspace(curve.FirstParameter(), curve.LastParameter(), per_edge):
+            samples.append(curve.Value(float(t)).Coord())
+        edges.Next()
+    base = np.repeat(np.array(samples), len(steps), axis=0)
+    angle = rng.uniform(0, 2 * np.pi, len(base))
+    radius = np.tile(steps, len(samples))
+    return base + radius[:, None] * np.column_stack([np.cos(angle), np.sin(angle)])
+
+
+@pytest.mark.parametrize("path", STEPS, ids=[p.stem for p in STEPS])
+def test_grid_agrees_with_fclass2d_on_every_face(path):
+    part = cadcnc.load_step(path)
+    rng = np.random.default_rng(7)
+    bad, o1 = [], []
+    for face in part.faces:
+        grid = TrimGrid.build(face)
+        assert not grid.stats["exact_only"] and grid.stats["suspect"] == 0, (face, grid.stats)
+        assert grid.labels.dtype == np.int8 and grid.labels.size <= 2 * 65536
+        pts = np.vstack([box_points(face, rng, N_RANDOM), boundary_points(face, rng)])
+        for u, w in pts.tolist():
+            expected, got = face.classify(u, w), grid.classify(u, w)
+            if got != expected:
+                bad.append((face.number, u, w, expected, got))
+        windowed = [grid.to_window(u, w) for u, w in pts[:N_SHARE].tolist()]
+        o1.append(np.mean([grid.cell(u, w) != CELL_MIXED for u, w in windowed]))
+        # the kernel reads the same cells
+        us, pu, ws, pw = grid.window
+        for (u, w), (uw, ww) in zip(pts[:300].tolist(), windowed):
+            assert (wrap(u, us, pu), wrap(w, ws, pw)) == (uw, ww)
+            assert lookup(*grid.kernel_args, uw, ww) == grid.cell(uw, ww)
+    assert bad == [], f"{len(bad)} disagreements, first: {bad[:5]}"
+    # the O(1) path answers almost everything (a regression to 'all MIXED' fails here)
+    assert min(o1) > 0.85, o1
+    assert np.mean(np.array(o1) > 0.90) >= 0.9, o1
+
+
+def test_wrap_moves_by_whole_periods():
+    assert wrap(7.0, 1.0, 5.0) == 2.0
+    assert wrap(-0.5, 0.0, 2.0) == 1.5
+    assert wrap(123.0, 1.0, 0.0) == 123.0  # not periodic
+
+
+def test_lookup_clamps_and_defers_on_nonfinite():
+    grid = np.array([[0, 1], [2, 1]], dtype=np.int8)
+    args = (grid, 0.0, 0.0, 1.0, 1.0, 2, 2)
+    assert lookup(*args, 0.5, 1.5) == 1
+    assert lookup(*args, 1.5, 0.5) == 2
+    assert lookup(*args, -5.0, -5.0) == 0  # beyond the grid: the nearest border cell
+    assert lookup(*args, 99.0, 99.0) == 1
+    for bad in (float("nan"), float("inf"), -float("inf")):
+        assert lookup(*args, bad, 0.5) == trim_lookup.CELL_MIXED
