@@ -49,6 +49,8 @@ class Tolerances:
     - ``classify`` (mm): boundary tolerance of verification's 2-D face classifier.
     - ``classify_loose`` (mm): the looser classifier used to say where a stopped path's
       last contacts lie.
+    - ``intersection`` (mm): the tolerance OCCT's GeomAPI_IntSS is given for the reference
+      intersection of the offset surfaces.
     """
 
     singular: float = 1e-9
@@ -67,6 +69,7 @@ class Tolerances:
     noise: float = 1e-8
     classify: float = 1e-7
     classify_loose: float = 1e-4
+    intersection: float = 1e-7
 
     def __post_init__(self):
         for f in fields(self):

@@ -32,8 +32,8 @@ def refuse_gouge(tp, part, what: str) -> str:
     gate = gouge_gate(tp, part, tp.job.tolerances)
     if gate.ok:
         return ""
-    return (f"cadcnc: {what}: {gate.message}. A smaller --radius may fit; --allow-gouge "
-            "writes it anyway")
+    hint = "A smaller --radius may fit; " if math.isfinite(gate.depth_mm) else ""
+    return f"cadcnc: {what}: {gate.message}. {hint}--allow-gouge writes it anyway"
 
 
 # -- faces -----------------------------------------------------------------------------------

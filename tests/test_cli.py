@@ -119,7 +119,7 @@ def test_path_json_agrees_with_the_api(boss_outputs, boss_api):
     np.testing.assert_array_equal(tp.points, boss_api.points)
     np.testing.assert_array_equal(tp.uv, boss_api.uv)
     np.testing.assert_array_equal(tp.bounds[1].eq16, boss_api.bounds[1].eq16)
-    assert tp.inputs["period"] == 0.004 and tp.inputs["feed"] == 1500.0
+    assert tp.job.period == 0.004 and tp.job.feed == 1500.0
     assert tp.faces == (4, 5) and tp.stop_reason == boss_api.stop_reason
 
 

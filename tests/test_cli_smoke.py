@@ -34,5 +34,3 @@ def test_error_is_one_line_with_exit_code(tmp_path):
     run = cadcnc("faces", "nope.step", cwd=tmp_path)
     assert run.returncode == 2
     assert run.stderr == "cadcnc: error: nope.step: no such file\n"
-    debug = cadcnc("faces", "nope.step", "--debug", cwd=tmp_path)
-    assert debug.returncode == 1 and "Traceback" in debug.stderr

@@ -9,6 +9,7 @@ to a temporary file; what it printed is returned as warnings for the caller to r
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import os
 import re
 import shutil
@@ -16,11 +17,13 @@ import sys
 import tempfile
 
 from OCP.IFSelect import IFSelect_RetDone
+from OCP.Message import Message, Message_Gravity
 from OCP.STEPControl import STEPControl_Reader
 from OCP.TopoDS import TopoDS_Shape
 
 from ..errors import StepFileError
 
+_LIBC = ctypes.CDLL(None)
 HEADER = b"ISO-10303-21"
 BOM = b"\xef\xbb\xbf"
 ANSI_ESCAPE = re.compile(r"\x1b\[[0-9;]*m")  # OCCT colours its messages
@@ -37,12 +40,28 @@ def native_stdout_captured(lines: list[str]):
         try:
             yield
         finally:
+            _LIBC.fflush(None)  # C stdio buffers what OCCT wrote (std::cout) when not a tty
             os.dup2(saved, 1)
             os.close(saved)
             tmp.seek(0)
             text = tmp.read().decode("utf-8", "replace")
             text = ANSI_ESCAPE.sub("", text)
             lines += [ln.strip() for ln in text.splitlines() if ln.strip()]
+
+
+@contextlib.contextmanager
+def occt_messages_from(level):
+    """OCCT's printers report messages of ``level`` and above while the block runs (CadQuery
+    raises the level to failures only when imported; the reader's warnings are wanted)."""
+    printers = list(Message.DefaultMessenger_s().Printers())
+    saved = [pr.GetTraceLevel() for pr in printers]
+    for pr in printers:
+        pr.SetTraceLevel(level)
+    try:
+        yield
+    finally:
+        for pr, old in zip(printers, saved):
+            pr.SetTraceLevel(old)
 
 
 def check_step_file(path: str) -> bool:
@@ -77,7 +96,7 @@ def read_step(path: str) -> tuple[TopoDS_Shape, list[str]]:
 def _read(file: str, name: str) -> tuple[TopoDS_Shape, list[str]]:
     warnings: list[str] = []
     reader = STEPControl_Reader()
-    with native_stdout_captured(warnings):
+    with native_stdout_captured(warnings), occt_messages_from(Message_Gravity.Message_Info):
         status = reader.ReadFile(file)
         if status == IFSelect_RetDone:
             reader.TransferRoots()

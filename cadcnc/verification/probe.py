@@ -26,57 +26,67 @@ from OCP.GeomAPI import GeomAPI_IntSS, GeomAPI_ProjectPointOnCurve, GeomAPI_Proj
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
 
-IN, ON, OUT = "in", "on", "out"
-_STATES = {TopAbs_IN: IN, TopAbs_ON: ON}
+from ..tolerances import DEFAULT, Tolerances
+from ..trim import BOUNDARY, INSIDE, OUTSIDE
+
+_STATES = {TopAbs_IN: INSIDE, TopAbs_ON: BOUNDARY}
+NEWTON_PARAMETER_PRECISION = 1e-12
+"""Convergence of the seeded Newton search in (u, w): a solver precision, not a threshold."""
 
 
 class FaceProbe:
     """Distances from points to one trimmed B-rep face and to its untrimmed surface.
 
-    ``offset`` is the face's offset distance along its out-of-material normal.
-    ``classify_tol`` (mm) is the 2-D classifier's boundary tolerance.
+    Parameters are the surface's native (u, w). ``tol``: ``classify`` is the 2-D
+    classifier's boundary tolerance, ``classify_loose`` the loose one of
+    ``state(..., loose=True)``, ``noise`` the distance below which a point is on the face.
     """
 
-    def __init__(self, topods_face, classify_tol: float = 1e-7):
+    def __init__(self, topods_face, tol: Tolerances = DEFAULT):
         self.face = topods_face
         self.sign = -1.0 if topods_face.Orientation() == TopAbs_REVERSED else 1.0
         self.surface = BRep_Tool.Surface_s(topods_face)
         self.adaptor = GeomAdaptor_Surface(self.surface)
-        umin, umax, vmin, vmax = BRepTools.UVBounds_s(topods_face)
-        self.box = (umin, umax, vmin, vmax)
+        umin, umax, wmin, wmax = BRepTools.UVBounds_s(topods_face)
+        self.box = (umin, umax, wmin, wmax)
         self.u_period = self.adaptor.UPeriod() if self.adaptor.IsUPeriodic() else None
-        self.v_period = self.adaptor.VPeriod() if self.adaptor.IsVPeriodic() else None
-        self.classify_tol = classify_tol
-        self._locate = Extrema_GenLocateExtPS(self.adaptor, 1e-12, 1e-12)
+        self.w_period = self.adaptor.VPeriod() if self.adaptor.IsVPeriodic() else None
+        self.tol = tol
+        self._locate = Extrema_GenLocateExtPS(self.adaptor, NEWTON_PARAMETER_PRECISION,
+                                              NEWTON_PARAMETER_PRECISION)
         self._dss = BRepExtrema_DistShapeShape()
         self._dss.LoadS2(topods_face)
-        self._p, self._du, self._dv = gp_Pnt(), gp_Vec(), gp_Vec()
+        self._p, self._du, self._dw = gp_Pnt(), gp_Vec(), gp_Vec()
 
     # -- surface -----------------------------------------------------------------------
-    def normal(self, u: float, v: float) -> np.ndarray:
-        """Unit out-of-material normal at (u, v) (zero vector at a singular point)."""
-        self.adaptor.D1(u, v, self._p, self._du, self._dv)
-        n = np.cross(self._du.Coord(), self._dv.Coord())
-        length = np.linalg.norm(n)
-        return self.sign * n / length if length > 0 else n
+    def normal(self, u: float, w: float) -> np.ndarray:
+        """Unit out-of-material normal at (u, w) (zero vector at a singular point).
 
-    def wrap(self, u: float, v: float) -> tuple[float, float]:
+        Leaves the surface point at (u, w) in ``self._p``.
+        """
+        self.adaptor.D1(u, w, self._p, self._du, self._dw)
+        n = self._du.Crossed(self._dw)
+        length = n.Magnitude()
+        return self.sign / length * np.array(n.Coord()) if length > 0 else np.zeros(3)
+
+    def wrap(self, u: float, w: float) -> tuple[float, float]:
+        """(u, w) brought into the face's parameter box along periodic directions."""
         if self.u_period:
             u = self.box[0] + (u - self.box[0]) % self.u_period
-        if self.v_period:
-            v = self.box[2] + (v - self.box[2]) % self.v_period
-        return u, v
+        if self.w_period:
+            w = self.box[2] + (w - self.box[2]) % self.w_period
+        return u, w
 
-    def project_seeded(self, point, u0: float, v0: float):
-        """(u, v, distance) by a local Newton search started at (u0, v0), or None."""
-        self._locate.Perform(gp_Pnt(*point), float(u0), float(v0))
+    def project_seeded(self, point, u0: float, w0: float):
+        """(u, w, distance) by a local Newton search started at (u0, w0), or None."""
+        self._locate.Perform(gp_Pnt(*point), float(u0), float(w0))
         if not self._locate.IsDone():
             return None
-        u, v = self._locate.Point().Parameter()
-        return u, v, math.sqrt(self._locate.SquareDistance())
+        u, w = self._locate.Point().Parameter()
+        return u, w, math.sqrt(self._locate.SquareDistance())
 
     def project_global(self, point, whole_surface: bool = False):
-        """(u, v, distance) of the nearest point found by OCCT's global search, or None.
+        """(u, w, distance) of the nearest point found by OCCT's global search, or None.
 
         Restricted to the face's parameter box unless ``whole_surface``.
         """
@@ -87,21 +97,25 @@ class FaceProbe:
             proj = GeomAPI_ProjectPointOnSurf(pnt, self.surface, *self.box)
         if not proj.IsDone() or proj.NbPoints() == 0:
             return None
-        u, v = proj.LowerDistanceParameters()
-        return u, v, proj.LowerDistance()
+        u, w = proj.LowerDistanceParameters()
+        return u, w, proj.LowerDistance()
 
-    def signed(self, point, u: float, v: float, dist: float) -> float:
+    def signed(self, point, u: float, w: float, dist: float) -> float:
         """``dist`` signed by the side of the surface the point is on (+ out of material)."""
-        foot = np.array(self.adaptor.Value(u, v).Coord())
-        side = (np.asarray(point) - foot) @ self.normal(u, v)
+        n = self.normal(u, w)
+        side = (np.asarray(point) - self._p.Coord()) @ n  # _p: the foot point
         return dist if side >= 0 else -dist
 
     # -- trimmed face ------------------------------------------------------------------
-    def state(self, u: float, v: float) -> str:
-        """in / on / out of the trimmed face (BRepClass_FaceClassifier)."""
-        u, v = self.wrap(u, v)
-        fc = BRepClass_FaceClassifier(self.face, gp_Pnt2d(u, v), self.classify_tol)
-        return _STATES.get(fc.State(), OUT)
+    def state(self, u: float, w: float, loose: bool = False) -> str:
+        """INSIDE / BOUNDARY / OUTSIDE the trimmed face (BRepClass_FaceClassifier).
+
+        Boundary tolerance ``tol.classify``, or ``tol.classify_loose`` with ``loose``.
+        """
+        u, w = self.wrap(u, w)
+        eps = self.tol.classify_loose if loose else self.tol.classify
+        fc = BRepClass_FaceClassifier(self.face, gp_Pnt2d(u, w), eps)
+        return _STATES.get(fc.State(), OUTSIDE)
 
     def face_distance(self, point) -> tuple[float, float]:
         """(signed distance, unsigned) from ``point`` to the trimmed face, boundary included.
@@ -116,7 +130,7 @@ class FaceProbe:
         if not self._dss.IsDone() or self._dss.NbSolution() == 0:
             return math.nan, math.nan
         d = self._dss.Value()
-        if d < 1e-12:
+        if d < self.tol.noise:  # on the face: no side to speak of
             return d, d
         # only a nearest point inside the face has a meaningful side: at an edge or a
         # vertex the face's normal says nothing about where the material is
@@ -124,13 +138,14 @@ class FaceProbe:
         for k in range(1, self._dss.NbSolution() + 1):
             if self._dss.SupportTypeShape2(k) != BRepExtrema_IsInFace:
                 return d, d
-            u, v = self._dss.ParOnFaceS2(k)
+            u, w = self._dss.ParOnFaceS2(k)
             q = np.array(self._dss.PointOnShape2(k).Coord())
-            if (np.asarray(point) - q) @ self.normal(u, v) < 0:
+            if (np.asarray(point) - q) @ self.normal(u, w) < 0:
                 sign = -1.0
         return sign * d, d
 
     def bbox(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi) corners of the face's optimal bounding box, mm."""
         box = Bnd_Box()
         BRepBndLib.AddOptimal_s(self.face, box, False, False)
         xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
@@ -148,8 +163,8 @@ def offset_surface(probe: FaceProbe, offset: float):
     return Geom_OffsetSurface(probe.surface, probe.sign * offset)
 
 
-def intersect(surface_a, surface_b, tol: float = 1e-7):
-    """(list of Geom_Curve handles, seconds) from GeomAPI_IntSS."""
+def intersect(surface_a, surface_b, tol: float):
+    """(list of Geom_Curve handles, seconds) from GeomAPI_IntSS with 3-D tolerance ``tol``."""
     t0 = time.perf_counter()
     inter = GeomAPI_IntSS(surface_a, surface_b, tol)
     seconds = time.perf_counter() - t0

@@ -10,42 +10,14 @@ path's own points. Lengths in mm.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..tolerances import DEFAULT, Tolerances
 from . import probe as occt
+from .records import ReferenceCheck
 
 
-@dataclass
-class ReferenceCheck:
-    """The path against OCCT's intersection curve (its branch), all lengths mm.
-
-    ``points_to_branch`` (N,): exact distance of each cutter centre to the branch.
-    ``path_to_branch_mm``: max of that and of the path's segment midpoints (chord sag
-    included); ``branch_to_path_mm``: max distance of the branch, within the path's span,
-    to the path polyline; ``hausdorff_mm`` the larger of the two. ``coverage`` in [0, 1]:
-    the fraction of the branch between the path's start and its intended end lying
-    within ``cover_radius_mm`` of a cutter centre; ``gaps`` the uncovered stretches
-    (from, to) in mm of arc length from the start. ``residual_mm``: how far OCCT's own
-    curve is from the offset surfaces (the reference's accuracy).
-    """
-
-    n_curves: int = 0
-    branch_curves: list = field(default_factory=list)
-    occt_seconds: float = math.nan
-    points_to_branch: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    points_max_mm: float = math.nan
-    points_worst_cycle: int = -1
-    path_to_branch_mm: float = math.nan
-    branch_to_path_mm: float = math.nan
-    hausdorff_mm: float = math.nan
-    coverage: float = math.nan
-    cover_radius_mm: float = math.nan
-    span_mm: float = math.nan
-    gaps: list = field(default_factory=list)
-    residual_mm: float = math.nan
-    note: str = ""
 
 
 def nearest(a: np.ndarray, b: np.ndarray, chunk: int = 64) -> np.ndarray:
@@ -59,19 +31,21 @@ def nearest(a: np.ndarray, b: np.ndarray, chunk: int = 64) -> np.ndarray:
     return out
 
 
-def polyline_distance(points: np.ndarray, poly: np.ndarray, closed: bool = False) -> np.ndarray:
+def polyline_distance(points: np.ndarray, poly: np.ndarray, closed: bool = False,
+                      same: float = DEFAULT.closed) -> np.ndarray:
     """Distance from each point to the polyline ``poly`` (M, 3).
 
     The segments near the one with the nearest midpoint are measured exactly (midpoints,
     unlike vertices, stay distinct where a closed polyline returns to its start).
-    ``closed``: the last vertex joins the first, neighbours wrap around.
+    ``closed``: the last vertex joins the first, neighbours wrap around. Vertices closer
+    than ``same`` mm are one vertex.
     """
     if len(poly) > 1:  # repeated vertices would hide a neighbouring segment
-        keep = np.concatenate([[True], np.linalg.norm(np.diff(poly, axis=0), axis=1) > 1e-9])
+        keep = np.concatenate([[True], np.linalg.norm(np.diff(poly, axis=0), axis=1) > same])
         poly = poly[keep]
     if len(poly) < 2:
         return np.linalg.norm(points - poly[0], axis=1)
-    if closed and np.linalg.norm(poly[-1] - poly[0]) > 1e-9:
+    if closed and np.linalg.norm(poly[-1] - poly[0]) > same:
         poly = np.vstack([poly, poly[:1]])
     a_all, b_all = poly[:-1], poly[1:]
     idx = nearest(points, 0.5 * (a_all + b_all))
@@ -84,7 +58,7 @@ def polyline_distance(points: np.ndarray, poly: np.ndarray, closed: bool = False
     return best
 
 
-def _sample(curve, points, extra, spacing):
+def _sample(curve, points, extra, spacing, tol: Tolerances):
     """Parameters and points of a curve densely sampled where the path can be."""
     t0, t1 = curve.FirstParameter(), curve.LastParameter()
     if not (math.isfinite(t0) and math.isfinite(t1)) or max(abs(t0), abs(t1)) > 1e50:
@@ -97,28 +71,29 @@ def _sample(curve, points, extra, spacing):
     length = float(np.linalg.norm(np.diff(coarse, axis=0), axis=1).sum())
     n = int(min(max(length / spacing, 400), 200_000))
     ts, pts = occt.sample_curve(curve, t0, t1, n)
-    closed = bool(np.linalg.norm(pts[0] - pts[-1]) < 1e-6)
+    closed = bool(np.linalg.norm(pts[0] - pts[-1]) < tol.closed)
     return ts, pts, closed
 
 
 def check_reference(surface_a, surface_b, points: np.ndarray, *, span: str,
                     target=None, cover_radius: float, spacing: float = 0.01,
-                    residual_probes=()) -> ReferenceCheck:
+                    residual_probes=(), tol: Tolerances = DEFAULT) -> ReferenceCheck:
     """Compare ``points`` (N, 3) with the intersection of two (offset) Geom surfaces.
 
     ``span``: "closed" (the branch once around), "end" (the path's own end is the
     intended end), or "target" (``target`` (3,) is the intended end, the path may have
     stopped short of it). ``residual_probes``: (FaceProbe, offset) pairs to measure how
-    far OCCT's curve is from the offset surfaces.
+    far OCCT's curve is from the offset surfaces. ``tol.closed``: a sampled curve whose
+    ends are closer than this is a loop; polyline vertices closer than this coincide.
     """
-    curves, seconds = occt.intersect(surface_a, surface_b)
+    curves, seconds = occt.intersect(surface_a, surface_b, tol.intersection)
     rep = ReferenceCheck(n_curves=len(curves), occt_seconds=seconds,
                          cover_radius_mm=cover_radius)
     if not curves:
         rep.note = "OCCT found no intersection of the offset surfaces"
         return rep
     extra = np.zeros((0, 3)) if target is None else np.asarray(target, float)[None]
-    sampled = [_sample(c, points, extra, spacing) for c in curves]
+    sampled = [_sample(c, points, extra, spacing, tol) for c in curves]
     allpts = np.vstack([s[1] for s in sampled])
     owner = np.concatenate([np.full(len(s[1]), k) for k, s in enumerate(sampled)])
     local = np.concatenate([np.arange(len(s[1])) for s in sampled])
@@ -160,7 +135,8 @@ def check_reference(surface_a, surface_b, points: np.ndarray, *, span: str,
     rep.points_worst_cycle = int(np.argmax(d))
     rep.points_max_mm = float(d.max())
     mids = 0.5 * (points[1:] + points[:-1])
-    mid_d = polyline_distance(mids, chain, span == "closed") if len(mids) else np.zeros(0)
+    mid_d = (polyline_distance(mids, chain, span == "closed", tol.closed) if len(mids)
+             else np.zeros(0))
     rep.path_to_branch_mm = float(max(d.max(), mid_d.max() if len(mid_d) else 0.0))
     # the span: from the path's start to its intended end along the branch
     s_path = s[nearest(points, chain)]
@@ -178,7 +154,8 @@ def check_reference(surface_a, surface_b, points: np.ndarray, *, span: str,
     lo, hi = min(s0, s_last), max(s0, s_last)
     own = chain[(s >= lo) & (s <= hi)]
     if len(own) and len(points) > 1:
-        rep.branch_to_path_mm = float(polyline_distance(own, points, closed_path).max())
+        rep.branch_to_path_mm = float(polyline_distance(own, points, closed_path,
+                                                        tol.closed).max())
     else:
         rep.branch_to_path_mm = 0.0
     rep.hausdorff_mm = max(rep.path_to_branch_mm, rep.branch_to_path_mm)
@@ -196,7 +173,8 @@ def check_reference(surface_a, surface_b, points: np.ndarray, *, span: str,
     ss = s[keep] - lo
     ds = np.diff(ss)
     both = covered[1:] & covered[:-1]
-    rep.coverage = float(ds[both].sum() / max(ds.sum(), 1e-300))
+    total = float(ds.sum())
+    rep.coverage = float(ds[both].sum() / total) if total > 0 else 0.0
     gaps, run = [], None
     for i, c in enumerate(covered):
         if not c and run is None:

@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import math
 
+FIXED_FROM_MM = 1e-3  # lengths from 1 um up print as 0.0123, smaller ones as 1.23e-05
+
 
 def _mm(x) -> str:
     if x is None or (isinstance(x, float) and not math.isfinite(x)):
         return "-"
-    return f"{x:.3g}" if abs(x) >= 1e-3 or x == 0 else f"{x:.2e}"
+    return f"{x:.3g}" if abs(x) >= FIXED_FROM_MM or x == 0 else f"{x:.2e}"
 
 
-def format_table(rep, tolerance_mm: float = 1e-3) -> str:
+def format_table(rep, tolerance_mm: float) -> str:
+    """The report ``rep`` as text; the verdict compares its deepest gouge with ``tolerance_mm``."""
     ref = rep.reference
     lines = [
         f"faces {rep.faces[0]} & {rep.faces[1]}: {rep.n_points} points, ball R' "
@@ -39,10 +42,10 @@ def format_table(rep, tolerance_mm: float = 1e-3) -> str:
         f"{s2.unseeded_checked} ({s2.unseeded_disagreements})")
     th1, th2 = rep.theory
     for eq in ("eq11", "eq12", "eq16"):
-        if f"{eq}_max_mm" in th1:
+        if th1.has_bounds and th2.has_bounds:
             row(f"predicted {eq} max (cycles exceeded)",
-                f"{_mm(th1[eq + '_max_mm'])} ({th1[eq + '_exceeded_abs']})",
-                f"{_mm(th2[eq + '_max_mm'])} ({th2[eq + '_exceeded_abs']})")
+                f"{_mm(getattr(th1, eq + '_max_mm'))} ({getattr(th1, eq + '_exceeded_abs')})",
+                f"{_mm(getattr(th2, eq + '_max_mm'))} ({getattr(th2, eq + '_exceeded_abs')})")
     lines += [
         "",
         f"OCCT intersection of the offset surfaces: {ref.n_curves} curve(s), branch "
@@ -59,18 +62,18 @@ def format_table(rep, tolerance_mm: float = 1e-3) -> str:
         lines.append(f"  radius 0: max distance to the shared B-rep edge "
                      f"{_mm(rep.edge_deviation_mm)} mm")
     st = rep.stop
-    lines.append(f"stop: {st['reason']}, last contacts {st['last_contact_states']}, "
-                 f"remaining {st['remaining_mm']:.3f} mm, consistent: {st['consistent']}")
+    lines.append(f"stop: {st.reason}, last contacts {st.last_contact_states}, "
+                 f"remaining {st.remaining_mm:.3f} mm, consistent: {st.consistent}")
     fd = rep.feed
-    lines.append(f"feed: max step error {fd['max_rel_error']:.2e} (relative) @{fd['worst_cycle']}"
-                 + (", last shortened step excluded" if fd.get("excluded_last") else ""))
+    lines.append(f"feed: max step error {fd.max_rel_error:.2e} (relative) @{fd.worst_cycle}"
+                 + (", last shortened step excluded" if fd.excluded_last else ""))
     hits = rep.whole_part_hits
-    lines.append(f"whole part ({rep.whole_part.get('faces_checked', 0)} faces): "
+    lines.append(f"whole part ({rep.whole_part.faces_checked} faces): "
                  + ("no face hit" if not hits else f"{len(hits)} face(s) hit"))
     for h in hits:
-        lines.append(f"  face {h['face']}{' (followed)' if h['followed'] else ''}: depth "
-                     f"{_mm(h['depth_mm'])} mm @{h['worst_cycle']}, {h['n_cycles']} cycles "
-                     f"{h['cycles'][:4]}{'...' if len(h['cycles']) > 4 else ''}")
+        lines.append(f"  face {h.face}{' (followed)' if h.followed else ''}: depth "
+                     f"{_mm(h.depth_mm)} mm @{h.worst_cycle}, {h.n_cycles} cycles "
+                     f"{h.cycles[:4]}{'...' if len(h.cycles) > 4 else ''}")
     verdict = "OK" if rep.ok(tolerance_mm) else "GOUGE"
     lines.append(f"max gouge {_mm(rep.max_gouge_mm)} mm vs tolerance {tolerance_mm:g} mm: "
                  f"{verdict}")

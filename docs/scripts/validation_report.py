@@ -85,9 +85,9 @@ def table(rows, curves) -> str:
             out.append(f"| {name} | {i}/{j} | {radius:g} | {f:g} | {len(tp)} | - | - | - | - | "
                        f"- | - | - | {tp.stop_reason} | - | - |")
             continue
-        exceeded = sum(t.get("eq16_exceeded_abs", 0) for t in rep.theory)
-        hits = ", ".join(f"{h['face']} ({fmt(h['depth_mm'])})" for h in rep.whole_part_hits
-                         if not h["followed"]) or "none"
+        exceeded = sum(t.eq16_exceeded_abs or 0 for t in rep.theory)
+        hits = ", ".join(f"{h.face} ({fmt(h.depth_mm)})" for h in rep.whole_part_hits
+                         if not h.followed) or "none"
         o = order(curves.get((name, i, j), [])) if f == STEPS[-1] else None
         out.append(
             f"| {name} | {i}/{j} | {radius:g} | {f:g} | {len(tp)} | {fmt(rep.max_overcut_mm)} | "

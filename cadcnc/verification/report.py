@@ -1,0 +1,116 @@
+"""The verification report: every check's record, and the JSON of ``cadcnc verify --json``.
+
+:meth:`VerificationReport.to_dict` writes the documented JSON (its keys are those of
+format 1: tests/test_verification.py pins them). Sign convention: a deviation is the
+cutter centre's signed distance from a surface (+ out of the material) minus the
+surface's offset R', so a negative deviation is an over-cut (a gouge). Lengths in mm,
+times in s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..tolerances import DEFAULT, Tolerances
+from .records import (
+    FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, TheoryRow, WholePartCheck,
+    WholePartHit, deepest, strict_max,
+)
+from .table import format_table
+
+
+@dataclass
+class VerificationReport:
+    """Everything :func:`~cadcnc.verification.verify` measured.
+
+    ``to_dict()`` for JSON, ``format_table()`` for people. ``radius`` R and
+    ``ball_radius`` R' = R + C (mm); ``tolerances`` the record the checks used (its
+    ``gouge`` is the default limit of :meth:`ok`).
+    """
+
+    faces: tuple
+    n_points: int
+    radius: float
+    ball_radius: float
+    offsets: tuple
+    stop_reason: str
+    stop_detail: str
+    surfaces: list[SurfaceCheck]
+    reference: ReferenceCheck
+    feed: FeedCheck
+    theory: list[TheoryRow]
+    whole_part: WholePartCheck
+    stop: StopCheck
+    edge_deviation_mm: float | None = None
+    seconds: dict[str, float] = field(default_factory=dict)
+    tolerances: Tolerances = field(default=DEFAULT, repr=False)
+
+    @property
+    def max_overcut_mm(self) -> float:
+        return strict_max(s.max_overcut_mm for s in self.surfaces)
+
+    @property
+    def max_undercut_mm(self) -> float:
+        return strict_max(s.max_undercut_mm for s in self.surfaces)
+
+    @property
+    def hausdorff_mm(self) -> float:
+        return self.reference.hausdorff_mm
+
+    @property
+    def coverage(self) -> float:
+        return self.reference.coverage
+
+    @property
+    def whole_part_hits(self) -> list[WholePartHit]:
+        return self.whole_part.hits
+
+    @property
+    def max_gouge_mm(self) -> float:
+        """Deepest cut of the ball into any face of the part (the pair's included), mm."""
+        return deepest(self.max_overcut_mm, self.whole_part_hits)
+
+    def ok(self, tolerance_mm: float | None = None) -> bool:
+        """True when no face is gouged deeper than ``tolerance_mm`` (default the gouge
+        limit of :attr:`tolerances`); False when the depth could not be measured."""
+        limit = self.tolerances.gouge if tolerance_mm is None else tolerance_mm
+        return self.max_gouge_mm <= limit
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary (no per-cycle arrays; non-finite numbers become None)."""
+        return jsonable(dict(
+            max_overcut_mm=self.max_overcut_mm, max_undercut_mm=self.max_undercut_mm,
+            hausdorff_mm=self.hausdorff_mm, coverage=self.coverage,
+            whole_part_hits=[h.to_dict() for h in self.whole_part_hits],
+            max_gouge_mm=self.max_gouge_mm, faces=list(self.faces), n_points=self.n_points,
+            radius=self.radius, ball_radius=self.ball_radius, offsets=list(self.offsets),
+            stop_reason=self.stop_reason, stop_detail=self.stop_detail,
+            stop=self.stop.to_dict(), surfaces=[s.to_dict() for s in self.surfaces],
+            reference=self.reference.to_dict(), feed=self.feed.to_dict(),
+            theory=[t.to_dict() for t in self.theory], whole_part=self.whole_part.to_dict(),
+            edge_deviation_mm=self.edge_deviation_mm, seconds=self.seconds))
+
+    def format_table(self, tolerance_mm: float | None = None) -> str:
+        """A text table; the verdict against ``tolerance_mm`` (default the gouge limit)."""
+        return format_table(self, self.tolerances.gouge if tolerance_mm is None
+                            else tolerance_mm)
+
+
+def jsonable(obj):
+    """``obj`` with numpy values as Python numbers, tuples as lists, nan/inf as None."""
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (np.floating, float)):
+        return float(obj) if math.isfinite(obj) else None
+    if isinstance(obj, np.integer):
+        return int(obj)
+    return obj
