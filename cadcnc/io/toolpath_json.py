@@ -13,7 +13,6 @@ literal for them).
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import asdict, fields
 from pathlib import Path
 
@@ -22,6 +21,7 @@ import numpy as np
 from ..errors import InputError
 from ..interp.error_bounds import SurfaceBounds
 from ..job import Job
+from ..jsonable import plain
 from ..program.toolpath import Toolpath
 from .atomic import write_text
 
@@ -48,37 +48,22 @@ def _decode(data, shape_tail: tuple = ()) -> np.ndarray:
     return a
 
 
-def _plain(value):
-    """Inputs as JSON: numpy scalars and arrays to Python numbers and lists."""
-    if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _plain(value.tolist())
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return str(value)
-    return value
-
-
 def toolpath_to_dict(path: Toolpath) -> dict:
     """Everything in a :class:`Toolpath` as JSON-ready Python objects (see module doc)."""
     d = {
         "format": FORMAT,
         "version": VERSION,
         "faces": list(path.faces),
-        "inputs": _plain(path.job.to_inputs()),
+        "inputs": plain(path.job.to_inputs(), nonfinite_as_strings=True),
         "offsets": list(map(float, path.offsets)),
         "stop_reason": path.stop_reason,
         "stop_detail": path.stop_detail,
-        "summary": _plain({
+        "summary": plain({
             "points": len(path),
             "length_mm": path.length,
             "duration_s": path.duration,
             "worst_predicted_mm": path.worst_predicted_mm,
-        }),
+        }, nonfinite_as_strings=True),
     }
     for name in ARRAYS:
         d[name] = _encode(getattr(path, name))

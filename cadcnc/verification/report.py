@@ -9,11 +9,9 @@ times in s.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
-import numpy as np
-
+from ..jsonable import plain
 from ..tolerances import DEFAULT, Tolerances
 from .records import (
     FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, TheoryRow, WholePartCheck,
@@ -81,7 +79,7 @@ class VerificationReport:
 
     def to_dict(self) -> dict:
         """JSON-ready summary (no per-cycle arrays; non-finite numbers become None)."""
-        return jsonable(dict(
+        return plain(dict(
             max_overcut_mm=self.max_overcut_mm, max_undercut_mm=self.max_undercut_mm,
             hausdorff_mm=self.hausdorff_mm, coverage=self.coverage,
             whole_part_hits=[h.to_dict() for h in self.whole_part_hits],
@@ -97,20 +95,3 @@ class VerificationReport:
         """A text table; the verdict against ``tolerance_mm`` (default the gouge limit)."""
         return format_table(self, self.tolerances.gouge if tolerance_mm is None
                             else tolerance_mm)
-
-
-def jsonable(obj):
-    """``obj`` with numpy values as Python numbers, tuples as lists, nan/inf as None."""
-    if isinstance(obj, dict):
-        return {str(k): jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return jsonable(obj.tolist())
-    if isinstance(obj, (bool, np.bool_)):
-        return bool(obj)
-    if isinstance(obj, (np.floating, float)):
-        return float(obj) if math.isfinite(obj) else None
-    if isinstance(obj, np.integer):
-        return int(obj)
-    return obj
