@@ -12,6 +12,9 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from importlib.metadata import version
+
+from cadcnc.errors import CadcncError  # light: the package loads OCCT lazily
 
 UNITS = "Units: lengths mm, feed mm/min, period with a unit (4ms, 0.004s, 250us)."
 
@@ -143,8 +146,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _version() -> str:
     try:
-        from importlib.metadata import version
-
         return f"cadcnc {version('cadcnc')}"
     except Exception:  # noqa: BLE001 - not installed: fall back to the source tree's value
         return "cadcnc (version unknown)"
@@ -182,8 +183,6 @@ def main(argv: list[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except Exception as e:  # noqa: BLE001 - one line for the library's own errors
-        from cadcnc.errors import CadcncError
-
         if debug or not isinstance(e, CadcncError):
             raise
         print(f"cadcnc: error: {e}", file=sys.stderr)

@@ -76,7 +76,7 @@ def _shape_of(obj) -> TopoDS_Shape:
         vals = obj.vals()
         if len(vals) == 1:
             return _shape_of(vals[0])
-        import cadquery as cq  # ~3 s to import: only CadQuery users, who have it loaded
+        import cadquery as cq  # ~2.3 s to import: only CadQuery users, who have it loaded
 
         return cq.Compound.makeCompound([v for v in vals if hasattr(v, "wrapped")]).wrapped
     if hasattr(obj, "toCompound"):  # cq.Assembly

@@ -30,7 +30,7 @@ def _crop(v, t, lo, hi):
 
 def figure(path, part, title: str = ""):
     """A matplotlib Figure of ``path`` on ``part`` (faces ``path.faces``)."""
-    import matplotlib
+    import matplotlib  # ~0.5 s with pyplot: only pictures need it
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -109,7 +109,7 @@ def png_bytes(path, part, title: str = "", dpi: int = 110) -> bytes:
 
 def scene(path, part):
     """A trimesh Scene: part faces as meshes (the pair coloured), path and contact lines."""
-    import trimesh
+    import trimesh  # ~0.5 s to import: only .glb scenes need it
 
     sc = trimesh.Scene()
     if part is not None:
