@@ -33,6 +33,8 @@ class Tolerances:
       side) has reached it; no extra zero-length step is emitted.
     - ``diverged`` (mm): the carried error |p - (q + R' n)| above which the interpolator
       stops rather than emit a point computed from a lost state.
+    - ``accuracy`` (mm): the accuracy a written path promises: every point within this of
+      both offset surfaces, and the chord between points within it too.
     - ``closed`` (mm): a curve (edge, intersection branch, polyline) whose ends are closer
       than this is a loop.
 
@@ -62,6 +64,7 @@ class Tolerances:
     on_boundary: float = 1e-6
     end_reached: float = 1e-7
     diverged: float = 0.5
+    accuracy: float = 1e-3
     closed: float = 1e-6
     gouge: float = 1e-3
     hit: float = 1e-6

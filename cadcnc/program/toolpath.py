@@ -12,11 +12,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..interp.cycle import CLOSED, END
 from ..interp.error_bounds import (
     SurfaceBounds, bounds_for_surface, mp_length, surface_curvatures,
 )
 from ..interp.record import PathRecord
 from ..job import Job
+
+
+INTENDED_STOPS = (END, CLOSED)
+"""Stops that end a path where it was meant to end; any other stop leaves it partial."""
 
 
 @dataclass
@@ -48,6 +53,11 @@ class Toolpath:
     def offsets(self) -> tuple[float, float]:
         """Each surface's offset R' (mm), as the job resolved it."""
         return self.job.offsets
+
+    @property
+    def complete(self) -> bool:
+        """True when the path stopped where it was meant to (its end, or once around)."""
+        return self.stop_reason in INTENDED_STOPS
 
     @property
     def length(self) -> float:
