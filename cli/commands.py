@@ -1,7 +1,7 @@
 """The subcommands: build the job from the options, call the library, print, write.
 
 Each function takes the argparse namespace and returns the exit code; library errors
-propagate to :func:`cadcnc.cli.main.main`, which prints them on one line.
+propagate to :func:`cadcnc.cli.app.main`, which prints them on one line.
 """
 
 from __future__ import annotations
@@ -13,10 +13,13 @@ from pathlib import Path
 
 import cadcnc
 from cadcnc import apt
-from cadcnc.errors import InputError, OutputError
+from cadcnc.errors import InputError
 from cadcnc.geometry.report import concave_edges, faces_report
-from cadcnc.io import check_output, read_json, write_picture, write_toolpaths
-from cadcnc.io.summary import summary
+from cadcnc.io import read_json
+from cadcnc.io.plot import PICTURE_SUFFIXES, picture_bytes
+from cadcnc.io.output_set import OutputSet, check_destination
+from cadcnc.io.outputs import SUFFIXES, render
+from cadcnc.io.summary import partial_reason, summary
 from cadcnc.ops.pair_path import path_for_job
 from cadcnc.verification import gouge_gate, verify as run_verify
 
@@ -25,15 +28,7 @@ from .feedback import progress, say_error
 from .options import clearance, gcode_options, job_from_args, tolerances, wants_gcode
 
 GOUGE_REFUSED = 5  # exit code: the whole-part check found a gouge deeper than the limit
-
-
-def refuse_gouge(tp, part, what: str) -> str:
-    """'' when the whole-part gate passes, else the refusal line for stderr."""
-    gate = gouge_gate(tp, part, tp.job.tolerances)
-    if gate.ok:
-        return ""
-    hint = "A smaller --radius may fit; " if math.isfinite(gate.depth_mm) else ""
-    return f"cadcnc: {what}: {gate.message}. {hint}--allow-gouge writes it anyway"
+PARTIAL = 6  # exit code: the path stopped before its intended end
 
 
 # -- faces -----------------------------------------------------------------------------------
@@ -70,8 +65,7 @@ def _angles(rng) -> str:
 
 # -- path ------------------------------------------------------------------------------------
 def path(args) -> int:
-    for out in args.output:
-        check_output(out)
+    outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])
     job = job_from_args(args, args.step)
     part = cadcnc.load_step(args.step)
     for n in job.operation.faces:  # face numbers checked before anything is computed
@@ -79,70 +73,110 @@ def path(args) -> int:
     gopts = gcode_options(args, job.clearance, [part]) if wants_gcode(args.output) else {}
     i, j = job.operation.faces
     tp = path_for_job(part, job, progress=progress(args, f"faces {i} {j}"))
-    if not args.allow_gouge:
-        refused = refuse_gouge(tp, part, "path")
-        if refused:
-            say_error(refused)
-            return GOUGE_REFUSED
+    write, code = judge(args, tp, part, "path")
+    if not write:
+        return code
     title = f"faces {i} {j} of {Path(args.step).name}"
-    for out in args.output:
-        write_toolpaths([tp], out, title=title, **gopts)
+    outputs.write({out: render([tp], out, title=title, **gopts) for out in args.output})
     if not args.quiet:
         print(summary(tp, args.step))
         print(f"  wrote      {', '.join(args.output)}")
-    return 0
+    return code
+
+
+def judge(args, tp, part, what: str) -> tuple[bool, int]:
+    """(write it?, exit code) for a computed path: the exit code is 0 only for a complete
+    path that passed the whole-part gouge gate.
+
+    A partial path exits 6 and is written only with ``--allow-partial``; a gouging one
+    exits 5 and is written only with ``--allow-gouge``. Messages go to stderr.
+    """
+    write, code = True, 0
+    if not tp.complete:
+        write, code = args.allow_partial, PARTIAL
+        say_error(f"cadcnc: {what}: partial: {partial_reason(tp)}"
+                  + ("" if write else "; nothing written (--allow-partial writes it)"))
+    if write:
+        gate = gouge_gate(tp, part, tp.job.tolerances)
+        if not gate.ok:
+            write, code = args.allow_gouge, GOUGE_REFUSED
+            if write:
+                what_cut = gate.message.replace("refused: ", "").replace("; nothing written", "")
+                say_error(f"cadcnc: {what}: {what_cut}; written anyway (--allow-gouge)")
+            else:
+                # a smaller ball helps a side cut, not a centre on (or in) the part
+                shallow = math.isfinite(gate.depth_mm) and gate.depth_mm < tp.job.tool.offset
+                hint = "A smaller --radius may fit; " if shallow else ""
+                say_error(f"cadcnc: {what}: {gate.message}. {hint}--allow-gouge writes it")
+    return write, code
 
 
 # -- run -------------------------------------------------------------------------------------
 def run(args) -> int:
-    outputs = args.output or []
-    if args.stream and outputs:
+    requested = args.output or []
+    if args.stream and requested:
         raise InputError("--stream prints increments instead of writing files: give "
                          "either --stream or -o")
-    for out in outputs:
-        check_output(out)
+    for out in requested:
+        check_destination(out, SUFFIXES, inputs=[args.program])
     source = args.program
     entries, title = apt.read_program(source, tolerances(args), clearance(args))
+    names = _output_names(requested, entries)
+    outputs = OutputSet([n for group in names.values() for n in group], SUFFIXES,
+                        inputs=[source, *{e.job.source for e in entries}])
     checked = apt.check(entries, source)
     if args.stream:
-        return _stream(checked, source)
-    paths = []
+        return _stream(args, checked, source)
+    paths, status = [], 0
     for entry, part in checked:
         tp = apt.run_job(entry, part, progress(args, f"PATH {entry.name}"), source)
         paths.append(tp)
         if not args.quiet:
             print(f"PATH {entry.name} (line {entry.line}): " + summary(tp, entry.job.source))
-        refused = "" if args.allow_gouge or not outputs else refuse_gouge(tp, part, "path")
-        if refused:
-            say_error(f"{source}:{entry.line}: PATH {entry.name}: " + refused)
-            return GOUGE_REFUSED
-    for out in outputs:
-        written = _write_program(args, out, paths, checked, title or Path(source).name)
+        if not requested:
+            status = status or (0 if tp.complete else PARTIAL)
+            continue
+        write, code = judge(args, tp, part, f"{source}:{entry.line}: PATH {entry.name}")
+        if not write:
+            return code
+        status = status or code
+    contents = {}
+    for out, group in names.items():
+        if Path(out).suffix.lower() == ".ngc":
+            gopts = gcode_options(args, checked[0][0].job.clearance, [p for _, p in checked])
+            contents[out] = render(paths, out, title=title or Path(source).name, **gopts)
+        else:
+            contents.update({name: render([tp], name) for name, tp in zip(group, paths)})
+    outputs.write(contents)
+    for out, group in names.items():
         if not args.quiet:
-            print(f"wrote {', '.join(written)}")
-    return 0
+            print(f"wrote {', '.join(group)}")
+    return status
 
 
-def _write_program(args, out, paths, checked, title: str) -> list[str]:
-    """.ngc: one program for all paths; .json/.csv: one file per path (OUT-NAME.json)."""
-    if Path(out).suffix.lower() == ".ngc":
-        gopts = gcode_options(args, checked[0][0].job.clearance, [p for _, p in checked])
-        write_toolpaths(paths, out, title=title, **gopts)
-        return [out]
-    if len(paths) == 1:
-        write_toolpaths(paths, out)
-        return [out]
-    o = Path(out)
-    written = [str(o.with_name(f"{o.stem}-{entry.name}{o.suffix}")) for entry, _ in checked]
-    for tp, name in zip(paths, written):
-        write_toolpaths([tp], name)
-    return written
+def _output_names(requested, entries) -> dict[str, list[str]]:
+    """{OUT: files}: .ngc holds every path; .json/.csv one file per path (OUT-NAME.json
+    when the program has several)."""
+    names = {}
+    for out in requested:
+        o = Path(out)
+        if o.suffix.lower() == ".ngc" or len(entries) == 1:
+            names[out] = [out]
+        else:
+            names[out] = [str(o.with_name(f"{o.stem}-{e.name}{o.suffix}")) for e in entries]
+    return names
 
 
-def _stream(checked, source: str) -> int:
-    """Print each period's increment; a streamed path is gated before its first increment."""
-    write = sys.stdout.write
+def _stream(args, checked, source: str) -> int:
+    """Print each period's increment. Each path is computed and gated first (partial,
+    gouge), then streamed from a fresh stepper: nothing unchecked reaches the axes."""
+    write, status = sys.stdout.write, 0
     for entry, part in checked:
+        tp = apt.run_job(entry, part, None, source)
+        ok, code = judge(args, tp, part, f"{source}:{entry.line}: PATH {entry.name}")
+        if not ok:
+            return code
+        status = status or code
         stepper, increments = apt.stream_job(entry, part, source)
         i, j = entry.job.operation.faces
         write(f"# PATH {entry.name}: faces {i} {j}, period {entry.job.period:g} s, start "
@@ -152,7 +186,7 @@ def _stream(checked, source: str) -> int:
         write(f"# stop after {stepper.cycles} cycles: {stepper.stop_reason}: "
               f"{stepper.stop_detail}\n")
     sys.stdout.flush()
-    return 0
+    return status
 
 
 # -- plot ------------------------------------------------------------------------------------
@@ -170,14 +204,12 @@ def load_saved(path_json: str, part_file: str | None):
 
 
 def plot(args) -> int:
-    if Path(args.output).suffix.lower() not in (".png", ".glb"):
-        raise OutputError(f"{args.output}: unknown picture format "
-                          f"{Path(args.output).suffix or '(no suffix)'!r}; use .png or .glb")
+    outputs = OutputSet([args.output], PICTURE_SUFFIXES, inputs=[args.path_json, args.part])
     tp, part = load_saved(args.path_json, args.part)
     for n in tp.faces:
         if n is not None:
             part.face(n)
-    write_picture(tp, part, args.output)
+    outputs.write({args.output: picture_bytes(tp, part, args.output)})
     if not args.quiet:
         print(f"wrote {args.output}")
     return 0

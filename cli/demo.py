@@ -8,7 +8,9 @@ from pathlib import Path
 
 import cadcnc
 from cadcnc.errors import OutputError, StepFileError
-from cadcnc.io import write_picture, write_text, write_toolpaths
+from cadcnc.io.output_set import OutputSet
+from cadcnc.io.outputs import SUFFIXES, render
+from cadcnc.io.plot import PICTURE_SUFFIXES, picture_bytes
 from cadcnc.io.gcode import SAFE_MARGIN
 from cadcnc.io.summary import summary
 from cadcnc.job import Job, PairPath, Tool
@@ -41,6 +43,10 @@ def demo_program(step: Path, job: Job) -> str:
             f"PERIOD/{job.period * 1000:g}ms\nBOSS = P/[F{i}, F{j}, EDGE, EDGE]\nFINI\n")
 
 
+FILES = ("path.json", "path.csv", "path.ngc", "demo.apt", "verification.txt",
+         "verification.json", "path.png")
+
+
 def demo(args) -> int:
     step = demo_step()
     out = Path(args.out)
@@ -48,6 +54,8 @@ def demo(args) -> int:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise OutputError(f"{out}: cannot create the demo folder ({e.strerror})") from e
+    outputs = OutputSet([out / name for name in FILES],
+                        SUFFIXES + PICTURE_SUFFIXES + (".apt", ".txt"), inputs=[step])
     say = (lambda *a: None) if args.quiet else print
     job = replace(JOB, source=str(step))
     i, j = job.operation.faces
@@ -55,17 +63,18 @@ def demo(args) -> int:
     part = cadcnc.load_step(step)
     tp = path_for_job(part, job, progress=progress(args, "demo"))
     say(summary(tp, step.name))
-    for name in ("path.json", "path.csv", "path.ngc"):
-        write_toolpaths([tp], out / name, title=f"demo: faces {i} {j} of {step.name}",
-                        safe_z=part.top + SAFE_MARGIN)
-    write_text(out / "demo.apt", demo_program(step, job))
     report = verify(tp, part)
-    write_text(out / "verification.txt", report.format_table() + "\n")
     d = report.to_dict()
-    write_text(out / "verification.json", json.dumps(d, indent=1) + "\n")
     say(f"  verified   max over-cut {d['max_overcut_mm']:.3g} mm, max under-cut "
         f"{d['max_undercut_mm']:.3g} mm, Hausdorff to OCCT {d['hausdorff_mm']:.3g} mm")
-    write_picture(tp, part, out / "path.png", title=f"demo: faces {i} and {j} of {step.name}")
-    say(f"wrote {out}/: " + ", ".join(sorted(p.name for p in out.iterdir()
-                                             if not p.name.startswith("."))))
-    return 0
+    title = f"demo: faces {i} {j} of {step.name}"
+    contents = {out / name: render([tp], name, title=title, safe_z=part.top + SAFE_MARGIN)
+                for name in ("path.json", "path.csv", "path.ngc")}
+    contents[out / "demo.apt"] = demo_program(step, job)
+    contents[out / "verification.txt"] = report.format_table() + "\n"
+    contents[out / "verification.json"] = json.dumps(d, indent=1) + "\n"
+    contents[out / "path.png"] = picture_bytes(tp, part, "path.png",
+                                               title=f"demo: faces {i} and {j} of {step.name}")
+    outputs.write(contents)
+    say(f"wrote {out}/: " + ", ".join(sorted(FILES)))
+    return 0 if report.ok() else 5

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.cli.main import main
+from cadcnc.cli.app import main
 from cadcnc.io import read_csv, read_json
 
 from conftest import FIXTURES, fixture_path, load_fixture
@@ -335,7 +335,8 @@ def test_path_refuses_a_path_that_gouges_a_third_face(tmp_path):
     assert "refused" in run.stderr and "face 5 by 2 mm" in run.stderr
     assert not out.exists()
     run = cadcnc_cli(*args, "--allow-gouge", "--quiet")
-    assert run.returncode == 0 and out.exists()
+    assert run.returncode == 5 and out.exists()  # written, and the exit code still says so
+    assert "written anyway" in run.stderr
 
 
 def test_verify_old_tolerance_spelling_still_gates(boss_outputs):

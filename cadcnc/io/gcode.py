@@ -169,3 +169,26 @@ def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
 def write_ngc(paths, out, **options) -> None:
     """Write :func:`to_ngc` to ``out`` atomically."""
     write_text(out, to_ngc(paths, **options))
+
+
+_WORD = re.compile(r"([XYZ])(-?\d+(?:\.\d*)?)")
+
+
+def programmed_moves(text: str, tool_tip_offset: float = 0.0) -> np.ndarray:
+    """(M, 3) ball-centre positions of every G0/G1 move of a program written by
+    :func:`to_ngc`, in order, as the machine will execute them (rounding included).
+
+    ``tool_tip_offset`` (mm): R when the program gives the ball's tip, added back to Z.
+    Moves before the first complete X, Y, Z position are skipped (the first rapid gives Z
+    only).
+    """
+    pos = [math.nan, math.nan, math.nan]
+    out = []
+    for line in text.splitlines():
+        if not line.startswith(("G0 ", "G1 ")):
+            continue
+        for axis, value in _WORD.findall(line):
+            pos["XYZ".index(axis)] = float(value)
+        if not any(math.isnan(v) for v in pos):
+            out.append((pos[0], pos[1], pos[2] + tool_tip_offset))
+    return np.array(out, dtype=float).reshape(-1, 3)

@@ -1,4 +1,4 @@
-"""Write toolpaths by the output file's suffix: .json, .csv or .ngc."""
+"""Toolpaths rendered by the output file's suffix: .json, .csv or .ngc."""
 
 from __future__ import annotations
 
@@ -6,34 +6,34 @@ from pathlib import Path
 
 from ..errors import OutputError
 from ..program.toolpath import Toolpath
-from .gcode import write_ngc
-from .toolpath_csv import write_csv
-from .toolpath_json import write_json
+from .gcode import to_ngc
+from .output_set import check_destination, write_one
+from .toolpath_csv import toolpath_csv
+from .toolpath_json import toolpath_json
 
 SUFFIXES = (".json", ".csv", ".ngc")
 
 
-def check_output(out) -> str:
+def check_output(out, inputs=()) -> str:
     """The format of ``out`` from its suffix, or OutputError (checked before computing)."""
-    out = Path(out)
-    suffix = out.suffix.lower()
-    if suffix not in SUFFIXES:
-        raise OutputError(f"{out}: unknown output format {suffix or '(no suffix)'!r}; use "
-                          f"one of {', '.join(SUFFIXES)}")
-    folder = out.parent if str(out.parent) else Path(".")
-    if not folder.is_dir():
-        raise OutputError(f"{out}: cannot write, folder {folder} does not exist")
-    if out.is_dir():
-        raise OutputError(f"{out}: is a folder")
-    return suffix[1:]
+    check_destination(out, SUFFIXES, inputs)
+    return Path(out).suffix.lower()[1:]
+
+
+def render(paths: list[Toolpath], out, **gcode_options) -> str:
+    """The text of ``out`` by its suffix: one G-code program for all paths; JSON and CSV
+    hold exactly one path."""
+    kind = Path(out).suffix.lower()[1:]
+    if kind == "ngc":
+        return to_ngc(paths, **gcode_options)
+    if kind not in ("json", "csv"):
+        raise OutputError(f"{out}: unknown output format {kind!r}; use one of "
+                          f"{', '.join(SUFFIXES)}")
+    if len(paths) != 1:
+        raise OutputError(f"{out}: {kind.upper()} holds one path, got {len(paths)}")
+    return (toolpath_json if kind == "json" else toolpath_csv)(paths[0])
 
 
 def write_toolpaths(paths: list[Toolpath], out, **gcode_options) -> None:
-    """Write by suffix: one G-code program for all paths; JSON/CSV need exactly one path."""
-    kind = check_output(out)
-    if kind == "ngc":
-        write_ngc(paths, out, **gcode_options)
-        return
-    if len(paths) != 1:
-        raise OutputError(f"{out}: {kind.upper()} holds one path, got {len(paths)}")
-    (write_json if kind == "json" else write_csv)(paths[0], out)
+    """Write one file by suffix, atomically (see :func:`render`)."""
+    write_one(out, render(paths, out, **gcode_options), SUFFIXES)

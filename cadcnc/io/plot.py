@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import OutputError
 from ..geometry.mesh import tessellate
-from .atomic import write_bytes
+from .output_set import write_one
 
 FACE_COLOURS = ((0.35, 0.55, 0.85), (0.85, 0.55, 0.30))
 PATH_COLOUR = (0.80, 0.10, 0.10)
@@ -135,14 +135,21 @@ def glb_bytes(path, part) -> bytes:
     return scene(path, part).export(file_type="glb")
 
 
-def write_picture(path, part, out, title: str = "") -> None:
-    """Write ``out`` by suffix: .png (matplotlib) or .glb (trimesh scene), atomically."""
+PICTURE_SUFFIXES = (".png", ".glb")
 
+
+def picture_bytes(path, part, out, title: str = "") -> bytes:
+    """The picture of ``path`` on ``part`` in the format of ``out``'s suffix: .png
+    (matplotlib) or .glb (trimesh scene)."""
     suffix = Path(out).suffix.lower()
     if suffix == ".png":
-        write_bytes(out, png_bytes(path, part, title))
-    elif suffix == ".glb":
-        write_bytes(out, glb_bytes(path, part))
-    else:
-        raise OutputError(f"{out}: unknown picture format {suffix or '(no suffix)'!r}; "
-                          "use .png or .glb")
+        return png_bytes(path, part, title)
+    if suffix == ".glb":
+        return glb_bytes(path, part)
+    raise OutputError(f"{out}: unknown picture format {suffix or '(no suffix)'!r}; "
+                      "use .png or .glb")
+
+
+def write_picture(path, part, out, title: str = "") -> None:
+    """Write ``out`` by suffix (see :func:`picture_bytes`), atomically."""
+    write_one(out, picture_bytes(path, part, out, title), PICTURE_SUFFIXES)

@@ -23,7 +23,13 @@ def summary(path: Toolpath, part_name: str = "") -> str:
         f"  length     {path.length:.4f} mm",
         f"  time       {path.duration:.4f} s",
         f"  stop       {path.stop_reason}: {path.stop_detail}",
+        f"  result     {'complete' if path.complete else 'partial: ' + partial_reason(path)}",
         f"  predicted  {path.worst_predicted_mm:.3g} mm worst steady-state error (eq. 16)",
         f"  start      {xyz(path.points[0])}",
         f"  end        {xyz(path.points[-1])}",
     ])
+
+
+def partial_reason(path: Toolpath) -> str:
+    """Why a path that is not complete stopped short, for the user."""
+    return f"stopped on {path.stop_reason} after {path.length:.3f} mm ({path.stop_detail})"

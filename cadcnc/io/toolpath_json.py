@@ -94,6 +94,9 @@ def toolpath_from_dict(d: dict) -> Toolpath:
             bounds = tuple(SurfaceBounds(**{k: _decode(b[k]) for k in names})
                            for b in d["bounds"])
         faces = tuple(None if f is None else int(f) for f in d["faces"])
+        if len(faces) != 2 or len(d["offsets"]) != 2:
+            raise ValueError(f"faces and offsets need two values each, got {d['faces']} "
+                             f"and {d['offsets']}")
         inputs = dict(d.get("inputs") or {})
         inputs.setdefault("offsets", d["offsets"])
         path = Toolpath(**arrays, job=Job.from_inputs(inputs, faces),
@@ -103,15 +106,30 @@ def toolpath_from_dict(d: dict) -> Toolpath:
         raise InputError(f"toolpath JSON is incomplete or malformed ({type(e).__name__}: "
                          f"{e})") from None
     n = len(path.points)
-    if path.points.shape != (n, 3) or path.contacts.shape != (n, 2, 3):
-        raise InputError(f"toolpath JSON arrays disagree in shape: points "
-                         f"{path.points.shape}, contacts {path.contacts.shape}")
+    if n == 0:
+        raise InputError("toolpath JSON has no points")
+    shapes = {name: getattr(path, name).shape for name in ARRAYS}
+    want = {"points": (n, 3), "contacts": (n, 2, 3), "normals": (n, 2, 3), "uv": (n, 2, 2),
+            "steps": (n,), "commanded": (n,)}
+    if shapes != want:
+        raise InputError(f"toolpath JSON arrays disagree in shape: "
+                         f"{', '.join(f'{k} {v}' for k, v in shapes.items())}")
+    for name in ("points", "contacts", "uv"):
+        if not np.all(np.isfinite(getattr(path, name))):
+            raise InputError(f"toolpath JSON has a non-finite number in {name!r}")
+    if len(path.faces) != 2:
+        raise InputError(f"toolpath JSON needs two faces, got {list(path.faces)}")
     return path
+
+
+def toolpath_json(path: Toolpath) -> str:
+    """``path`` as compact JSON text (see the module doc)."""
+    return json.dumps(toolpath_to_dict(path), separators=(",", ":")) + "\n"
 
 
 def write_json(path: Toolpath, out) -> None:
     """Write ``path`` to ``out`` as JSON (atomic)."""
-    write_text(out, json.dumps(toolpath_to_dict(path), separators=(",", ":")) + "\n")
+    write_text(out, toolpath_json(path))
 
 
 def read_json(file) -> Toolpath:

@@ -15,6 +15,7 @@ import sys
 from importlib.metadata import version
 
 from cadcnc.errors import CadcncError  # light: the package loads OCCT lazily
+from cadcnc.interrupts import sigint_deferred
 
 UNITS = "Units: lengths mm, feed mm/min, period with a unit (4ms, 0.004s, 250us)."
 
@@ -53,7 +54,11 @@ def _gouge_options(p, gate: bool = True) -> None:
                         "this fails (exit 5), mm (default 0.001)")
     if gate:
         p.add_argument("--allow-gouge", action="store_true",
-                       help="write the path even when the whole-part check finds a gouge")
+                       help="write the path even when the whole-part check finds a gouge "
+                            "(the exit code stays 5)")
+        p.add_argument("--allow-partial", action="store_true",
+                       help="write a path that stopped before its intended end (the exit "
+                            "code stays 6)")
 
 
 def _gcode_options(p) -> None:
@@ -172,8 +177,10 @@ def main(argv: list[str] | None = None) -> int:
     debug = getattr(args, "debug", False)
     args.quiet = getattr(args, "quiet", False)
     try:
-        # importing the library (OCCT) takes ~1.5 s: `--help` and usage errors don't pay it
-        from . import commands
+        # importing the library (OCCT) takes ~1.5 s: `--help` and usage errors don't pay it;
+        # Ctrl-C inside OCCT's C-extension import would surface as an ImportError
+        with sigint_deferred():
+            from . import commands
 
         return int(commands.COMMANDS[args.command](args) or 0)
     except KeyboardInterrupt:

@@ -1,0 +1,108 @@
+"""A set of output files written all or nothing, checked before anything is computed.
+
+A machinist runs ``cadcnc path ... && send-to-machine``: a failed or interrupted run must
+leave no half file and never destroy an earlier good one. :class:`OutputSet` checks every
+destination up front (known suffix, existing writable folder, not a folder itself, not one
+of the run's input files, a name the file system accepts), then writes the whole set to
+temporary files beside their destinations and renames them only when all are ready, with
+Ctrl-C (SIGINT) deferred during the renames. A symlink destination is followed: its target
+is replaced, the link stays.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+
+from ..errors import OutputError
+from ..interrupts import sigint_deferred
+
+NAME_MAX = 255  # bytes in one file name on common file systems
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return os.path.realpath(a) == os.path.realpath(b)
+
+
+def check_destination(out, suffixes: tuple[str, ...], inputs=()) -> Path:
+    """The real path ``out`` will be written to (symlinks followed), or OutputError."""
+    out = Path(out)
+    suffix = out.suffix.lower()
+    if suffix not in suffixes:
+        kind = "picture" if set(suffixes) <= {".png", ".glb"} else "output"
+        raise OutputError(f"{out}: unknown {kind} format {suffix or '(no suffix)'!r}; use "
+                          f"{' or '.join(suffixes) if len(suffixes) == 2 else 'one of ' + ', '.join(suffixes)}")
+    if len(os.fsencode(out.name)) > NAME_MAX:
+        raise OutputError(f"{str(out)[:40]}...: file name too long ({len(out.name)} "
+                          f"characters; at most {NAME_MAX} bytes)")
+    target = Path(os.path.realpath(out))
+    folder = target.parent
+    if not folder.is_dir():
+        raise OutputError(f"{out}: cannot write, folder {out.parent} does not exist")
+    if target.is_dir():
+        raise OutputError(f"{out}: is a folder")
+    if not os.access(folder, os.W_OK):
+        raise OutputError(f"{out}: cannot write, folder {out.parent} is not writable")
+    for source in inputs:
+        if source is not None and Path(source).exists() and _same_file(target, Path(source)):
+            raise OutputError(f"{out}: is an input of this run ({source}); refusing to "
+                              "write over it")
+    return target
+
+
+class OutputSet:
+    """Destinations checked now, written later all at once (see the module doc)."""
+
+    def __init__(self, destinations, suffixes: tuple[str, ...], inputs=()):
+        self.destinations = [Path(d) for d in destinations]
+        self.targets = {}
+        for d in self.destinations:
+            target = check_destination(d, suffixes, inputs)
+            if target in self.targets.values():
+                raise OutputError(f"{d}: named twice among the outputs")
+            self.targets[d] = target
+
+    def write(self, contents: dict) -> None:
+        """Write ``{destination: bytes or str}`` (every destination of the set) atomically."""
+        contents = {Path(k): v for k, v in contents.items()}
+        missing = [str(d) for d in self.destinations if d not in contents]
+        if missing:
+            raise OutputError(f"no content for {', '.join(missing)}")
+        temps: list[tuple[str, Path, Path]] = []
+        try:
+            for d in self.destinations:
+                target = self.targets[d]
+                data = contents[d]
+                data = data.encode("utf-8") if isinstance(data, str) else data
+                fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp",
+                                           dir=target.parent)
+                temps.append((tmp, target, d))
+                with os.fdopen(fd, "wb") as fh:
+                    fh.write(data)
+                os.chmod(tmp, 0o666 & ~_umask())
+            with sigint_deferred():
+                for tmp, target, _ in temps:
+                    os.replace(tmp, target)
+        except OSError as e:
+            name = temps[-1][2] if temps else self.destinations[0]
+            raise OutputError(f"{name}: cannot write ({e.strerror or e})") from e
+        finally:
+            for tmp, _, _ in temps:
+                with contextlib.suppress(OSError):
+                    os.unlink(tmp)
+
+
+def write_one(out, data, suffixes: tuple[str, ...], inputs=()) -> None:
+    """One file, checked and written atomically."""
+    OutputSet([out], suffixes, inputs).write({Path(out): data})

@@ -1,0 +1,163 @@
+"""A failed or interrupted run leaves no half file and never destroys an earlier good one.
+
+Every destination is checked before anything is computed; the set is written to
+temporary files and renamed only when all are ready, Ctrl-C deferred during the renames.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from conftest import FIXTURES
+from test_cli import cadcnc_cli
+
+BOSS = FIXTURES / "bspline_boss.step"
+SLOT = FIXTURES / "narrow_slot.step"
+JOB = ["--radius", "3", "--feed", "1500", "--period", "4ms"]
+
+
+def one_line(run, code, *needles):
+    assert run.returncode == code, (run.returncode, run.stderr)
+    assert "Traceback" not in run.stderr and len(run.stderr.strip().splitlines()) == 1
+    for needle in needles:
+        assert needle in run.stderr, run.stderr
+
+
+def test_unwritable_second_output_leaves_the_first_untouched(tmp_path, monkeypatch):
+    (tmp_path / "ro").mkdir()
+    good = tmp_path / "a.json"
+    good.write_text("old")
+    real_access = os.access
+    monkeypatch.setattr(os, "access", lambda p, mode: False if str(p).endswith("ro")
+                        else real_access(p, mode))
+    run = cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", good,
+                     "-o", tmp_path / "ro" / "o.json")
+    one_line(run, 4, "not writable")
+    assert good.read_text() == "old"
+
+
+def test_demo_with_a_folder_in_the_way_replaces_nothing(tmp_path):
+    out = tmp_path / "demo"
+    out.mkdir()
+    (out / "path.png").mkdir()
+    (out / "path.json").write_text("old")
+    run = cadcnc_cli("demo", "--out", out)
+    one_line(run, 4, "path.png: is a folder")
+    assert (out / "path.json").read_text() == "old"
+    assert sorted(p.name for p in out.iterdir()) == ["path.json", "path.png"]
+
+
+def test_an_output_never_overwrites_the_input(tmp_path):
+    step = tmp_path / "part.step"
+    step.write_bytes(BOSS.read_bytes())
+    link = tmp_path / "link.json"
+    link.symlink_to(step)
+    for out in (step, link):
+        before = step.read_bytes()
+        run = cadcnc_cli("path", step, "--faces", "4", "5", *JOB, "-o", out.with_suffix(
+            ".json") if out == step else out)
+        if out == step:
+            continue
+        one_line(run, 4, "input of this run")
+        assert step.read_bytes() == before
+
+
+def test_output_equal_to_input_json_is_refused(tmp_path):
+    saved = tmp_path / "p.json"
+    cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", saved, "--quiet", check=0)
+    before = saved.read_bytes()
+    one_line(cadcnc_cli("plot", saved, "-o", saved), 4)
+    assert saved.read_bytes() == before
+
+
+def test_symlinked_output_is_followed_not_replaced(tmp_path):
+    target = tmp_path / "real.json"
+    target.write_text("old")
+    link = tmp_path / "link.json"
+    link.symlink_to(target)
+    cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", link, "--quiet", check=0)
+    assert link.is_symlink() and json.loads(target.read_text())["format"] == "cadcnc-toolpath"
+
+
+def test_a_very_long_output_name_is_a_clear_error(tmp_path):
+    run = cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", tmp_path / ("x" * 260
+                                                                               + ".json"))
+    one_line(run, 4, "file name too long")
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (lambda d: d.update(faces=[4]), "two values"),
+    (lambda d: d.update(offsets=[3.0]), "two values"),
+    (lambda d: d.update(points=[], contacts=[], normals=[], uv=[], steps=[], commanded=[]),
+     "no points"),
+    (lambda d: d["points"][3].__setitem__(0, "NaN"), "non-finite"),
+    (lambda d: d["inputs"].update(radius="NaN"), "radius"),
+])
+def test_malformed_path_json_is_refused_quickly(tmp_path, edit, needle):
+    saved = tmp_path / "p.json"
+    cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", saved, "--quiet", check=0)
+    data = json.loads(saved.read_text())
+    edit(data)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    for command in (["plot", bad, "--part", BOSS, "-o", tmp_path / "x.png"],
+                    ["verify", bad, "--part", BOSS]):
+        start = time.perf_counter()
+        one_line(cadcnc_cli(*command), 2, needle)
+        assert time.perf_counter() - start < 10
+
+
+def test_stream_is_gated_before_the_first_increment(tmp_path):
+    program = tmp_path / "slot.apt"
+    program.write_text(f"PART = '{SLOT}'\nCUTTER/R=3\nFEED/1500\nPERIOD/4ms\n"
+                       "SLOT = P/[F3, F4, EDGE, EDGE]\nFINI\n")
+    run = cadcnc_cli("run", program, "--stream")
+    assert run.returncode == 5 and run.stdout == "" and "face 5 by 2 mm" in run.stderr
+
+
+def test_partial_path_exits_6_and_is_written_only_when_allowed(tmp_path):
+    out = tmp_path / "ramp.json"
+    args = ["path", FIXTURES / "ramp_wall.step", "--faces", "3", "7", *JOB, "-o", out]
+    run = cadcnc_cli(*args)
+    assert run.returncode == 6 and "partial: stopped on boundary" in run.stderr
+    assert not out.exists()
+    run = cadcnc_cli(*args, "--allow-partial")
+    assert run.returncode == 6 and out.exists() and "result     partial" in run.stdout
+
+
+def test_complete_path_says_so():
+    run = cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", "/dev/null/x.json")
+    assert run.returncode == 4  # the destination is checked before computing
+    ok = cadcnc_cli("verify", FIXTURES / "crossing_cylinders.step", "--faces", "1", "2", *JOB,
+                    "--quiet")
+    assert ok.returncode == 0
+
+
+def _cli(*args):
+    return [sys.executable, "-m", "cadcnc.cli", *map(str, args)]
+
+
+@pytest.mark.parametrize("delay", [0.3, 1.2, 2.0, 2.6])
+def test_ctrl_c_at_any_moment_keeps_a_whole_set(tmp_path, delay):
+    """Old outputs intact (or the whole new set), no temporary files left, exit 130."""
+    outs = [tmp_path / f"b{s}" for s in (".json", ".csv", ".ngc")]
+    for o in outs:
+        o.write_text("old")
+    proc = subprocess.Popen(_cli("path", BOSS, "--faces", "4", "5", *JOB,
+                                 *[x for o in outs for x in ("-o", o)]),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(delay)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    contents = [o.read_text() for o in outs]
+    assert contents == ["old"] * 3 or all(c != "old" for c in contents), contents
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+    if proc.returncode != 0:
+        assert proc.returncode == 130 and "Traceback" not in err, err
