@@ -16,7 +16,7 @@ def cadcnc(*args, cwd=None):
 def test_help_without_importing_occt():
     run = cadcnc("--help")
     assert run.returncode == 0 and "verify" in run.stdout
-    probe = subprocess.run([sys.executable, "-c", "import sys; from cadcnc.cli.main import "
+    probe = subprocess.run([sys.executable, "-c", "import sys; from cadcnc.cli.app import "
                             "build_parser; build_parser(); print('OCP' in sys.modules)"],
                            capture_output=True, text=True, timeout=60)
     assert probe.stdout.strip() == "False", probe.stderr
