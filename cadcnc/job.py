@@ -18,6 +18,7 @@ from .errors import InputError
 from .tolerances import DEFAULT, Tolerances
 
 SHANK_LENGTH_RADII = 10.0  # default shank length, in ball radii
+MIN_STEP = 1e-6  # mm: the shortest commanded step f = F Ts per period a job may ask for
 Point = tuple[float, float, float]
 
 
@@ -33,6 +34,21 @@ def check_number(name: str, value, unit: str, *, allow_zero: bool = False) -> fl
         need = ">= 0" if allow_zero else "> 0"
         raise InputError(f"{name} must be a number {need} {unit}, got {_show(value)}")
     return float(value)
+
+
+def check_step(feed: float, period: float) -> float:
+    """f = F Ts / 60 in mm, or InputError naming feed and period when it is below MIN_STEP.
+
+    A step of a nanometre per period is a mistake (a period in the wrong unit), and a step
+    that rounds to nothing never reaches the end: 1e6 cycles of nothing, or a closed path
+    "completed" at its start.
+    """
+    f = feed * period / 60.0
+    if not f >= MIN_STEP:
+        raise InputError(f"feed {_show(feed)} mm/min and period {_show(period)} s give a "
+                         f"step of {f:.3g} mm per period, below the minimum {MIN_STEP:g} mm: "
+                         "raise the feed or the period (is the period in seconds?)")
+    return f
 
 
 def check_point(name: str, value) -> Point | None:
@@ -153,6 +169,7 @@ class Job:
     def __post_init__(self):
         object.__setattr__(self, "feed", check_number("feed", self.feed, "mm/min"))
         object.__setattr__(self, "period", check_number("period", self.period, "s"))
+        check_step(self.feed, self.period)
         if self.clearance is not None:
             c = self.clearance
             if isinstance(c, bool) or not isinstance(c, numbers.Real) or not math.isfinite(c):

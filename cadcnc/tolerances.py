@@ -40,8 +40,18 @@ class Tolerances:
 
     Verification and gates:
 
-    - ``gouge`` (mm): the gouge limit: a ball reaching deeper than this into any face fails
-      the whole-part gate and ``cadcnc verify`` (1 um).
+    - ``gouge`` (mm): the gouge limit: a ball reaching deeper than this into any face, at a
+      cutter centre or anywhere along a straight move, fails the whole-part gate and
+      ``cadcnc verify`` (1 um). Finite and > 0: no value switches the gate off.
+    - ``hausdorff`` (mm): the largest Hausdorff distance ``cadcnc verify`` accepts between
+      the path polyline and OCCT's intersection of the offset surfaces over the path's own
+      span (chord sag included). 0.01 mm: ten times ``accuracy``; the fixtures measure
+      1.2e-4 mm at the default step f = 0.1 mm and 3.1e-3 mm at f = 0.5 mm, while a path
+      on the wrong part or with a skipped stretch is off by 0.02 mm or more; at f = 1 mm
+      (0.0125 mm on bspline_boss) the chords are coarser than this promises.
+    - ``coverage`` (fraction, <= 1): the least curve coverage ``cadcnc verify`` accepts:
+      the fraction of OCCT's intersection curve, over the path's own span, within 0.6
+      step of a cutter centre (1.0 on every fixture; one skipped step in 100 fails).
     - ``hit`` (mm): a ball reaching deeper than this into a face is reported as a hit
       (below it is tangency round-off).
     - ``off_face`` (mm): a contact whose trimmed-face distance exceeds its surface distance
@@ -67,6 +77,8 @@ class Tolerances:
     accuracy: float = 1e-3
     closed: float = 1e-6
     gouge: float = 1e-3
+    hausdorff: float = 1e-2
+    coverage: float = 0.99
     hit: float = 1e-6
     off_face: float = 1e-6
     noise: float = 1e-8
@@ -81,6 +93,8 @@ class Tolerances:
                     and math.isfinite(value) and value > 0):
                 raise InputError(f"tolerance {f.name} must be a finite number > 0, got "
                                  f"{value!r}")
+        if self.coverage > 1:
+            raise InputError(f"tolerance coverage is a fraction <= 1, got {self.coverage!r}")
 
 
 DEFAULT = Tolerances()

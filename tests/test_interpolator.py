@@ -20,6 +20,9 @@ from cadcnc.tolerances import DEFAULT
 
 FEED, PERIOD = 1500.0, 0.004      # the paper's example: f = 0.1 mm
 R = 3.0
+# the paper's method alone: an accuracy so loose that the stepper never shortens a step
+# (the tests that measure the method's order in f need the steps they command)
+RAW = replace(DEFAULT, accuracy=10.0)
 
 
 def surface_deviation(face, points, offset):
@@ -58,7 +61,8 @@ def test_crossing_cylinders_closed_form_at_paper_step(edge):
 def test_crossing_cylinders_error_is_second_order_in_step():
     worst = []
     for f in (0.4, 0.2, 0.1, 0.05):
-        tp = path_for("crossing_cylinders", 1, 2, feed=f * 60 / PERIOD)
+        tp = path_for("crossing_cylinders", 1, 2, feed=f * 60 / PERIOD, tol=RAW)
+        assert tp.accuracy_cycles == 0
         worst.append(crossing_deviation(tp.points, R).max())
     ratios = np.array(worst[:-1]) / np.array(worst[1:])
     assert np.all((3.0 <= ratios) & (ratios <= 5.0)), (worst, ratios)
@@ -103,7 +107,7 @@ def test_umbilic_excess_is_fourth_order():
     part = load_fixture("sphere_cylinder")
     worst = []
     for f in (0.4, 0.2):
-        tp = path_for("sphere_cylinder", 1, 2, feed=f * 60 / PERIOD)
+        tp = path_for("sphere_cylinder", 1, 2, feed=f * 60 / PERIOD, tol=RAW)
         worst.append(np.abs(surface_deviation(part.face(1), tp.points, R)).max())
     assert 12.0 < worst[0] / worst[1] < 20.0
 
@@ -118,7 +122,8 @@ def test_initial_error_decays_to_steady_state(name, i, j):
     n2 = plan.s2.normal(*plan.start.uv2)
     off = (n1 - n2) / np.linalg.norm(n1 - n2) * 0.05      # 0.05 mm off the true tangency
     start = Tangency(tuple(np.array(plan.start.p) + off), plan.start.uv1, plan.start.uv2)
-    stepper = stepper_for(replace(plan, start=start), max_cycles=100, record=True).run()
+    stepper = stepper_for(replace(plan, start=start), max_cycles=100, record=True,
+                          check_cycles=False).run()
     from cadcnc.program.toolpath import toolpath_from_record
 
     tp = toolpath_from_record(stepper.record, plan.job, stepper.stop_reason)
@@ -171,7 +176,8 @@ def test_whole_path_is_the_stepper_loop():
 
 def test_feed_override_changes_the_step_while_running():
     part = load_fixture("crossing_cylinders")
-    st = cadcnc.make_stepper(part.face(1), part.face(2), radius=R, feed=FEED, period=PERIOD)
+    st = cadcnc.make_stepper(part.face(1), part.face(2), radius=R, feed=FEED, period=PERIOD,
+                             tol=RAW)
     lengths = []
     for k in range(60):
         feed = FEED * (0.5 if k < 20 else 1.0 + k / 40)  # override 50 %, then a ramp
@@ -181,6 +187,20 @@ def test_feed_override_changes_the_step_while_running():
     np.testing.assert_allclose(got, want, rtol=1e-3)
     with pytest.raises(cadcnc.InputError, match="feed"):
         st.step(-5)
+
+
+def test_accuracy_caps_a_feed_override_and_counts_it():
+    """An override past what the path's curvature allows is shortened, like a feed limit."""
+    part = load_fixture("crossing_cylinders")
+    st = cadcnc.make_stepper(part.face(1), part.face(2), radius=R, feed=FEED, period=PERIOD)
+    for _ in range(10):
+        assert np.linalg.norm(st.step()) == pytest.approx(0.1, rel=1e-3)
+    assert st.accuracy_cycles == 0
+    steps = [np.linalg.norm(st.step(FEED * 4)) for _ in range(10)]  # 0.4 mm asked
+    assert st.accuracy_cycles == 10 and 0.4 * st.accuracy_ratio == pytest.approx(min(steps),
+                                                                                 rel=1e-3)
+    assert max(steps) < 0.3
+    np.testing.assert_allclose(st.record.ratio[11:], np.array(steps) / 0.4, rtol=1e-3)
 
 
 # -- the math does not need OCCT ------------------------------------------------------------

@@ -96,8 +96,17 @@ def test_singular_pole_stops_a_guide_surface_pass():
 
 def test_max_cycles_is_a_stop_with_a_reason():
     part = load_fixture("sphere_cylinder")
-    tp = cadcnc.intersection_path(part.face(1), part.face(2), radius=3, max_cycles=10, **KW)
+    # from a start point alone the length is unknown before running: the limit stops it
+    tp0 = cadcnc.intersection_path(part.face(1), part.face(2), radius=3, **KW)
+    start = tp0.points[0]
+    tp = cadcnc.intersection_path(part.face(1), part.face(2), radius=3, max_cycles=10,
+                                  start=tuple(start), **KW)
     assert tp.stop_reason == MAX_CYCLES and len(tp) == 11
+    assert not tp.complete and tp.partial_reason.startswith("stopped after 1.000 mm: max_cycles")
+    # along the edge the estimate (its length over the step) refuses before running
+    with pytest.raises(cadcnc.InputError, match="about 62.83 mm long.*feed 1500.*period"):
+        cadcnc.intersection_path(part.face(1), part.face(2), radius=3, max_cycles=10, **KW)
+    assert tp0.complete
 
 
 def test_pairs_a_ball_cannot_follow_are_refused_before_computing():

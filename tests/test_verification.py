@@ -115,8 +115,9 @@ def test_crossing_cylinders_radius_zero_follows_the_brep_edge():
 
 
 # -- every fixture pair -------------------------------------------------------------------
-# measured over-cut (mm), pinned: a 3 mm ball where R'k reaches 0.9, on face 7 over cycles
-# 510..575 and 1084..1148
+# measured over-cut (mm) where it exceeded the accuracy: a 3 mm ball where R'k reaches 0.9,
+# on face 7 (3.1e-3 mm at f = 0.1 with the stepper of commit 889b426; the stepper that
+# shortens steps for the chord and the predicted error may bring it within the accuracy)
 KNOWN_GOUGES = {("ellipse_pocket", 7, 8): 3.1011870594799262e-3}
 # step length off the commanded f by more than 1 % (a finding reported to the interpolator)
 KNOWN_FEED = {("ellipse_pocket", 7, 8): 0.049, ("narrow_slot", 11, 12): 0.0146}
@@ -144,11 +145,15 @@ def test_every_fixture_pair_verifies(name, i, j):
     assert rep.feed.max_rel_error < KNOWN_FEED.get((name, i, j), 0.0099) + 0.001
     third = [h for h in rep.whole_part_hits if not h.followed]
     assert third == []
-    if (name, i, j) in KNOWN_GOUGES:
-        assert rep.max_gouge_mm == pytest.approx(KNOWN_GOUGES[(name, i, j)], rel=0.01)
+    failed = {c.name for c in rep.verdict}
+    if (name, i, j) in KNOWN_GOUGES and rep.max_overcut_mm > rep.tolerances.accuracy:
+        # an over-cut beyond the accuracy fails the verdict (deviation), whatever the gouge
         assert rep.max_overcut_mm == rep.max_gouge_mm and not rep.ok(1e-3)
+        assert "deviation" in failed and not rep.ok()
+        assert ("gouge" in failed) == (rep.max_gouge_mm > rep.tolerances.gouge)
     else:
         assert rep.ok(1e-3), rep.format_table()
+        assert failed == set() and rep.ok()
 
 
 # -- corrupted paths are caught -----------------------------------------------------------
@@ -283,6 +288,15 @@ OLD_KEYS = {
 }
 
 
+# keys added since, after the old ones (issue 9: the swept ball, the verdict, curve coverage
+# over the path's own span, material-aware whole-part depth)
+NEW_KEYS = {
+    "": ["sweep", "ok", "criteria"],
+    "reference": ["intended_coverage", "own_span_mm"],
+    "whole_part": ["max_depth_mm", "faces_near", "material", "classified"],
+}
+
+
 def test_json_keeps_the_documented_keys(pushed):
     d = json.loads(json.dumps(pushed.to_dict()))
     assert d["whole_part_hits"]  # the pushed point hits face 1: the hit keys are checked
@@ -290,7 +304,9 @@ def test_json_keeps_the_documented_keys(pushed):
            "percentiles_mm": list(d["surfaces"][0]["percentiles_mm"]),
            "theory": list(d["theory"][0]), "whole_part_hits": list(d["whole_part_hits"][0]),
            **{k: list(d[k]) for k in ("reference", "feed", "whole_part", "stop", "seconds")}}
-    assert got == OLD_KEYS
+    assert got == {k: v + NEW_KEYS.get(k, []) for k, v in OLD_KEYS.items()}
+    assert [c["name"] for c in d["criteria"]] == ["gouge", "deviation", "hausdorff",
+                                                  "coverage"]
     assert all(list(s) == OLD_KEYS["surfaces"] for s in d["surfaces"])
     assert all(list(t) == OLD_KEYS["theory"] for t in d["theory"])
 
@@ -330,7 +346,9 @@ def test_gate_uses_the_given_or_the_job_tolerances(cylinders):
     part, tp, rep = cylinders
     strict = Tolerances(gouge=1e-6)
     gate = gouge_gate(tp, part, strict)
-    assert not gate.ok and gate.limit_mm == 1e-6 and gate.depth_mm == rep.max_gouge_mm
+    # under the stricter limit the gate examines the moves between the points and finds
+    # the chords deeper than the centres (verify bounds them within the default limit)
+    assert not gate.ok and gate.limit_mm == 1e-6 and gate.depth_mm >= rep.max_gouge_mm
     assert gate.message.startswith("refused: the ball cuts into the part (face ")
     job_tp = dataclasses.replace(tp, job=dataclasses.replace(tp.job, tolerances=strict))
     assert gouge_gate(job_tp, part).message == gate.message

@@ -10,14 +10,19 @@ The cycle from state (p, contacts q1, q2) with step f (mm):
   1. track    p* = p + f t,  t = n1 x n2 / |n1 x n2| (sign kept from the previous cycle)
   2. correct  p_e = p* + dp, dp from one 3x3 linear system (ball tangent to both curvature
               spheres, dp in the plane of o1, o2, p*; a flat direction uses the offset plane)
-  3. inverse  (u_i, w_i) += 2x2 solve, for each surface.
+  3. inverse  (u_i, w_i) += 2x2 solve, for each surface: eq. 5, or where eq. 5 would
+              amplify the contact's error (paper_inverse_ratio > 1: a cross curvature far
+              from the one along t, e.g. a torus tube narrower than the ball) the same-cost
+              linearisation through the whole shape operator (inverse_exact).
+Before the cycle, ``accurate_step`` shortens the step in closed form where the chord, the
+normals' turn or the predicted point error would exceed the accuracy (stepper.py).
 No iteration inside a cycle: the work per cycle is constant.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 from ..tolerances import DEFAULT, Tolerances
 from .vec3 import Vec, add, axpy, cross, dot, norm, scale, solve3, sub
@@ -153,6 +158,49 @@ def inverse(c: Contact, k: float, p_e: Vec) -> tuple[float, float]:
     return (-a12 * drr) / det, (a11 * drr) / det
 
 
+def inverse_exact(c: Contact, p_e: Vec) -> tuple[float, float]:
+    """(du, dw) moving contact c under p_e through the whole shape operator: one 2x2 solve.
+
+    The centre a contact at (u, w) puts the ball at is c(u, w) = r + R' n, with
+    c_u . r_u = E - R' L, c_u . r_w = c_w . r_u = F - R' M, c_w . r_w = G - R' N
+    (Weingarten). Solving (I - R' II) (du, dw) = ((p_e - c) . r_u, (p_e - c) . r_w) is the
+    linearisation of c(u, w) = p_e in the tangent plane: each direction of the contact's
+    move is divided by its own 1 - R' k, where eq. 5 divides every direction by that of t.
+    """
+    d = sub(p_e, c.centre())
+    R = c.offset
+    a11, a12, a22 = c.E - R * c.L, c.F - R * c.M, c.G - R * c.N
+    b1, b2 = dot(d, c.ru), dot(d, c.rw)
+    det = a11 * a22 - a12 * a12
+    if det == 0.0:
+        raise StopCycle(CURVATURE, "the contact's move is undefined: a principal curvature "
+                                   "equals 1/R'")
+    return (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
+
+
+def principal_curvatures(c: Contact) -> tuple[float, float]:
+    """(k_max, k_min) at contact c, 1/mm, from the mean and Gaussian curvature."""
+    det = c.E * c.G - c.F * c.F
+    H = (c.E * c.N - 2.0 * c.F * c.M + c.G * c.L) / (2.0 * det)
+    K = (c.L * c.N - c.M * c.M) / det
+    disc = math.sqrt(max(H * H - K, 0.0))
+    return H + disc, H - disc
+
+
+def paper_inverse_ratio(c: Contact, k: float) -> float:
+    """How much eq. 5 multiplies the contact estimate's error per cycle (contracts if < 1).
+
+    Eq. 5 divides the centre's displacement by 1 - R' k in every direction; along a
+    principal direction j the contact truly moves 1 / (1 - R' k_j) times the centre, so an
+    error along j is multiplied by R' (k_j - k) / (1 - R' k). This is the largest of the two
+    (the paper's eq. 15 factor g R' / (1 + |k| R') is the same for convex k).
+    """
+    if c.offset == 0.0:
+        return 0.0
+    k_max, k_min = principal_curvatures(c)
+    return c.offset * max(abs(k_max - k), abs(k_min - k)) / abs(1.0 - c.offset * k)
+
+
 def check_curvature(c: Contact, k: float, label: str) -> None:
     """Refuse a concave curvature the ball cannot follow without gouging (R' k >= 1)."""
     if c.offset * k >= 1.0:
@@ -160,14 +208,146 @@ def check_curvature(c: Contact, k: float, label: str) -> None:
                                    f"than the ball (R' k = {c.offset * k:.4g} >= 1)")
 
 
-def cycle(p: Vec, c1: Contact, c2: Contact, t_prev: Vec, f: float,
-          tol: Tolerances = DEFAULT) -> tuple[Vec, Vec, tuple[float, float], tuple[float, float]]:
-    """One interpolation cycle; returns (p_e, t, (u1, w1)_e, (u2, w2)_e). Pure: no state."""
+class Track(NamedTuple):
+    """What a cycle needs from the state before any step length is chosen.
+
+    ``t`` the track direction, ``k1``/``k2`` the normal curvatures along it, ``exact1``/
+    ``exact2`` whether that contact is moved by :func:`inverse_exact` (where eq. 5 would
+    amplify its error: :func:`paper_inverse_ratio` > ``PAPER_INVERSE_LIMIT``).
+    """
+
+    t: Vec
+    k1: float
+    k2: float
+    exact1: bool
+    exact2: bool
+
+
+# eq. 5 amplifies a contact's error where paper_inverse_ratio exceeds 1; the margin keeps
+# rounding out of the choice (a round pocket of radius 2 R' sits at exactly 1: its vertical
+# error mode is neutral and never excited, and eq. 5 keeps following it)
+PAPER_INVERSE_LIMIT = 1.0 + 1e-9
+
+
+def track(c1: Contact, c2: Contact, t_prev: Vec, tol: Tolerances = DEFAULT) -> Track:
+    """Track direction and curvatures at the current contacts; refuses R' k >= 1."""
     t = track_direction(c1, c2, t_prev, tol)
     k1, k2 = c1.curvature(t), c2.curvature(t)
     check_curvature(c1, k1, "surface 1")
     check_curvature(c2, k2, "surface 2")
-    p_e = correct(axpy(f, t, p), c1, c2, k1, k2, tol)
-    du1, dw1 = inverse(c1, k1, p_e)
-    du2, dw2 = inverse(c2, k2, p_e)
-    return p_e, t, (c1.u + du1, c1.w + dw1), (c2.u + du2, c2.w + dw2)
+    return Track(t, k1, k2, paper_inverse_ratio(c1, k1) > PAPER_INVERSE_LIMIT,
+                 paper_inverse_ratio(c2, k2) > PAPER_INVERSE_LIMIT)
+
+
+def centre_curvature(c1: Contact, c2: Contact, k1: float, k2: float) -> float:
+    """Curvature (1/mm) of the centre's path in the cycle's model, from the contacts alone.
+
+    Along t, offset surface i curves by kappa_i = k_i / (1 - R'_i k_i) towards n_i (the
+    curvature sphere of radius d_i of eq. 4). The path lies on both, so its curvature vector
+    lies in the plane of n1, n2 with components kappa_i along n_i (Meusnier):
+    |kappa|^2 = (kappa_1^2 + kappa_2^2 - 2 c kappa_1 kappa_2) / (1 - c^2), c = n1 . n2.
+    """
+    a = k1 / (1.0 - c1.offset * k1)
+    b = k2 / (1.0 - c2.offset * k2)
+    c = dot(c1.n, c2.n)
+    return math.sqrt(max(a * a + b * b - 2.0 * c * a * b, 0.0) / max(1.0 - c * c, 1e-300))
+
+
+def model_step(c: Contact, k: float, t: Vec, carried: Vec, slope: float,
+               budget: float) -> float:
+    """The longest step (mm) whose predicted error on this surface stays within ``budget``.
+
+    The cycle replaces the surface by its curvature sphere along t (eq. 4). Over a step f
+    the contact moves by z = f a + e, a the move for a unit centre step along t and e the
+    move that absorbs the carried error ``carried`` = p - (q + R' n), both through the
+    shape operator as in :func:`inverse_exact` ((I - R' II) x = (v . r_u, v . r_w)).
+    Where the sphere and the surface part, the centre is off by the gap:
+
+    - second order, the shape: h2 = |z^T (II - k I) z| / 2, which vanishes along a
+      principal direction with no carried error (a surface of revolution followed along
+      a parallel); it is the paper's eq. 11/12 in the direction actually taken;
+    - third order, the curvature's change along the path: h3 = |k'| |z|^3 / 6, with
+      ``slope`` |k'| (1/mm^2) the change of k between the last two contacts over their
+      distance (0 on the first cycle).
+
+    Each gets half the budget. Closed form: a quadratic in f for h2, a cube root for h3.
+    Where the carried error alone fills a half, the step is half the one that would fill
+    it without the carried error (never 0: the step cannot undo an error already made).
+    """
+    R = c.offset
+    a11, a12, a22 = c.E - R * c.L, c.F - R * c.M, c.G - R * c.N
+    det = a11 * a22 - a12 * a12
+    if det == 0.0:   # a principal curvature is exactly 1/R': the model says nothing
+        return math.inf
+    ru, rw = c.ru, c.rw
+    b1, b2 = dot(t, ru), dot(t, rw)
+    a0, a1 = (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
+    b1, b2 = dot(carried, ru), dot(carried, rw)
+    e0, e1 = (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
+    qL, qM, qN = c.L - k * c.E, c.M - k * c.F, c.N - k * c.G   # II - k I
+    q2 = abs(qL * a0 * a0 + 2.0 * qM * a0 * a1 + qN * a1 * a1)
+    q1 = abs(qL * a0 * e0 + qM * (a0 * e1 + a1 * e0) + qN * a1 * e1)
+    q0 = abs(qL * e0 * e0 + 2.0 * qM * e0 * e1 + qN * e1 * e1)
+    # h2 <= (q2 f^2 + 2 q1 f + q0) / 2 <= budget / 2
+    room = budget - q0
+    if q2 == 0.0 and q1 == 0.0:
+        f2 = math.inf
+    elif room > 0.0:
+        f2 = room / (q1 + math.sqrt(q1 * q1 + q2 * room))
+    else:   # the carried error alone fills the budget; a shorter step cannot undo it
+        f2 = 0.5 * math.sqrt(budget / q2) if q2 > 0.0 else math.inf
+    if slope <= 0.0:
+        return f2
+    # h3 <= |k'| (f |a| + |e|)^3 / 6 <= budget / 2
+    la = math.sqrt(max(c.E * a0 * a0 + 2.0 * c.F * a0 * a1 + c.G * a1 * a1, 0.0))
+    le = math.sqrt(max(c.E * e0 * e0 + 2.0 * c.F * e0 * e1 + c.G * e1 * e1, 0.0))
+    reach = (3.0 * budget / slope) ** (1.0 / 3.0)
+    f3 = (reach - le) / la if reach > 2.0 * le else 0.5 * reach / la
+    return min(f2, f3)
+
+
+MAX_TURN = 0.1
+"""rad: the most the normals (and the centre's path) may turn in one step. The sphere of
+eq. 4 and the inverse of eq. 5 model the surface about the contact; a turn of 0.1 rad
+keeps the contact within a tenth of a radian of its own curvature circle, however fast it
+runs (1 / (1 - R' k) times the centre near R' k = 1, where the chord alone allows more)."""
+
+
+def accurate_step(p: Vec, c1: Contact, c2: Contact, tr: Track, f: float, accuracy: float,
+                  slopes: tuple[float, float] = (0.0, 0.0)) -> float:
+    """The commanded step f, shortened so the cycle stays within ``accuracy``: closed form.
+
+    Half the accuracy goes to the chord: a chord of length f on a path of curvature kappa
+    (:func:`centre_curvature`) leaves it by kappa f^2 / 8. An eighth goes to each
+    surface's predicted point error (:func:`model_step`); the measured error reaches up to
+    twice that prediction, so a point stays within a quarter, a chord within the accuracy.
+    Returns f itself (the same float) when no rule shortens it.
+    """
+    step = f
+    kappa = centre_curvature(c1, c2, tr.k1, tr.k2)
+    if kappa * f * f > 4.0 * accuracy:
+        step = math.sqrt(4.0 * accuracy / kappa)
+    if kappa * step > MAX_TURN:
+        step = MAX_TURN / kappa
+    for c, k, slope in ((c1, tr.k1, slopes[0]), (c2, tr.k2, slopes[1])):
+        limit = model_step(c, k, tr.t, sub(p, c.centre()), slope, accuracy / 4.0)
+        if limit < step:
+            step = limit
+    return step
+
+
+def advance(p: Vec, c1: Contact, c2: Contact, tr: Track, f: float,
+            tol: Tolerances = DEFAULT) -> tuple[Vec, tuple[float, float], tuple[float, float]]:
+    """Correct p + f t onto both surfaces and move the contacts: (p_e, uv1_e, uv2_e)."""
+    p_e = correct(axpy(f, tr.t, p), c1, c2, tr.k1, tr.k2, tol)
+    du1, dw1 = inverse_exact(c1, p_e) if tr.exact1 else inverse(c1, tr.k1, p_e)
+    du2, dw2 = inverse_exact(c2, p_e) if tr.exact2 else inverse(c2, tr.k2, p_e)
+    return p_e, (c1.u + du1, c1.w + dw1), (c2.u + du2, c2.w + dw2)
+
+
+def cycle(p: Vec, c1: Contact, c2: Contact, t_prev: Vec, f: float,
+          tol: Tolerances = DEFAULT) -> tuple[Vec, Vec, tuple[float, float], tuple[float, float]]:
+    """One interpolation cycle; returns (p_e, t, (u1, w1)_e, (u2, w2)_e). Pure: no state."""
+    tr = track(c1, c2, t_prev, tol)
+    p_e, uv1, uv2 = advance(p, c1, c2, tr, f, tol)
+    return p_e, tr.t, uv1, uv2

@@ -22,6 +22,7 @@ FIELDS = {
     "forms": (2, 6),     # E, F, G (first form) and L, M, N (second form, against n)
     "commanded": (),     # commanded step f of the cycle into this row, mm
     "steps": (),         # actual step |dp| into this row, mm
+    "ratio": (),         # step / commanded step where the accuracy rule shortened it, else 1
 }
 
 
@@ -51,8 +52,9 @@ class PathRecord:
             bigger[:len(a)] = a
             self._data[k] = bigger
 
-    def add(self, p, c1, c2, f: float, step: float) -> None:
-        """Append one row: centre ``p`` (3-tuple), contacts ``c1``/``c2``, f and |dp| (mm)."""
+    def add(self, p, c1, c2, f: float, step: float, ratio: float = 1.0) -> None:
+        """Append one row: centre ``p`` (3-tuple), contacts ``c1``/``c2``, f and |dp| (mm),
+        and the accuracy rule's step ratio."""
         n = self._n
         d = self._data
         if n == len(d["steps"]):
@@ -67,6 +69,7 @@ class PathRecord:
             d["forms"][n, side] = c.E, c.F, c.G, c.L, c.M, c.N
         d["commanded"][n] = f
         d["steps"][n] = step
+        d["ratio"][n] = ratio
         self._n = n + 1
 
     def field(self, name: str) -> np.ndarray:
@@ -82,3 +85,4 @@ class PathRecord:
     forms = property(lambda self: self.field("forms"))
     commanded = property(lambda self: self.field("commanded"))
     steps = property(lambda self: self.field("steps"))
+    ratio = property(lambda self: self.field("ratio"))

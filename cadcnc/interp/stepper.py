@@ -11,10 +11,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..job import check_number
+from ..job import MIN_STEP, check_number, check_step
 from .cycle import (
     BOUNDARY, CLOSED, DIVERGED, END, MAX_CYCLES, SINGULAR, Contact, StopCycle, SurfaceLike,
-    check_curvature, cycle,
+    Track, accurate_step, advance, check_curvature, track,
 )
 from ..tolerances import DEFAULT, Tolerances
 from ..trim import OUTSIDE
@@ -38,6 +38,13 @@ class Stepper:
     surface). ``direction`` is the initial travel direction (only its sign against
     n1 x n2 matters). With ``end`` the last step is shortened to land on it; with
     ``closed`` the end is the start, reached after going once around.
+
+    Each step is the commanded f = F Ts, shortened where the chord, the turn of the
+    normals or the predicted point error would exceed ``tol.accuracy``
+    (:func:`~cadcnc.interp.cycle.accurate_step`, closed form, once per step). Like a feed
+    override, this is counted: ``accuracy_cycles`` steps were shortened, the shortest to
+    ``accuracy_ratio`` of F Ts; ``record.ratio`` holds it per cycle. The commanded step
+    of the job must be at least MIN_STEP (1e-6 mm); a later override may ask for less.
     """
 
     def __init__(self, s1: SurfaceLike, s2: SurfaceLike, offsets: tuple[float, float],
@@ -48,6 +55,7 @@ class Stepper:
         self.tol = tol
         self.period = check_number("period", period, "s")
         self.feed = self._check_feed(feed)
+        check_step(self.feed, self.period)
         self.c1 = Contact(s1, float(offsets[0]), *start.uv1)
         self.c2 = Contact(s2, float(offsets[1]), *start.uv2)
         # spare contacts evaluated at the next cycle's parameters, swapped in on success
@@ -63,6 +71,11 @@ class Stepper:
         self.travelled = 0.0
         self.stop_reason: str | None = None
         self.stop_detail = ""
+        self.accuracy_cycles = 0      # cycles whose step was shortened for accuracy
+        self.accuracy_ratio = 1.0     # the smallest step / commanded step among them
+        self._tr: Track | None = None
+        self._ratio = 1.0
+        self._last: tuple | None = None  # k1, k2 and contact points of the last cycle
         self.record = PathRecord() if record else None
         if self.record is not None:
             self.record.add(self.p, self.c1, self.c2, 0.0, 0.0)
@@ -92,19 +105,46 @@ class Stepper:
         if self.cycles >= self.max_cycles:
             self._stop(MAX_CYCLES, f"cycle limit {self.max_cycles} reached")
             return None
-        f = self.step_length
+        f_cmd = self.step_length
+        self._ratio = 1.0
+        try:  # direction and curvatures of the current state: the same for every trial
+            self._tr = track(self.c1, self.c2, self.t, self.tol)
+        except StopCycle as stop:
+            self._tr, failure = None, (stop.reason, stop.detail)
+        f = f_cmd if self._tr is None else self._accurate(f_cmd)
         landing = self._landing(f)
         if landing is not None or self.stop_reason is not None:
             return landing
+        if self._tr is None:
+            self._stop(failure[0], failure[1] + " (no step possible from the current point)")
+            return None
         failure = self._try(f)
         if failure is None:
             return self._commit(*self._trial, f)
         return self._land_on_limit(f, failure)
 
+    def _accurate(self, f_cmd: float) -> float:
+        """The commanded step, shortened where the chord sag or the predicted error would
+        exceed ``tol.accuracy`` (never below MIN_STEP); counted like a feed override."""
+        tr = self._tr
+        slopes = (0.0, 0.0)
+        if self._last is not None:   # |k'| between the last two contacts of each surface
+            k1, k2, r1, r2 = self._last
+            slopes = tuple(abs(k - k_old) / d if d > 0.0 else 0.0 for k, k_old, d in (
+                (tr.k1, k1, norm(sub(self.c1.r, r1))), (tr.k2, k2, norm(sub(self.c2.r, r2)))))
+        f = accurate_step(self.p, self.c1, self.c2, tr, f_cmd, self.tol.accuracy, slopes)
+        if f < f_cmd:
+            f = max(f, min(MIN_STEP, f_cmd))
+            self._ratio = f / f_cmd
+        else:
+            self._ratio = 1.0
+        return f
+
     # -- pieces of a step -----------------------------------------------------------------
     def _advance(self, f: float) -> tuple[Vec, Vec]:
         """Run one cycle into the spare contacts; raises StopCycle on a geometric stop."""
-        p_e, t, uv1, uv2 = cycle(self.p, self.c1, self.c2, self.t, f, self.tol)
+        t = self._tr.t
+        p_e, uv1, uv2 = advance(self.p, self.c1, self.c2, self._tr, f, self.tol)
         for spare, uv, label in ((self._n1, uv1, 1), (self._n2, uv2, 2)):
             spare.move_to(*uv)
             if spare.singularity < self.tol.near_singular:
@@ -199,13 +239,18 @@ class Stepper:
     def _commit(self, p_e: Vec, t: Vec, f: float) -> Vec:
         dp = sub(p_e, self.p)
         step = norm(dp)
+        if self._tr is not None:
+            self._last = (self._tr.k1, self._tr.k2, self.c1.r, self.c2.r)
         self.p, self.t = p_e, t
         self.c1, self._n1 = self._n1, self.c1
         self.c2, self._n2 = self._n2, self.c2
         self.cycles += 1
         self.travelled += step
+        if self._ratio < 1.0:
+            self.accuracy_cycles += 1
+            self.accuracy_ratio = min(self.accuracy_ratio, self._ratio)
         if self.record is not None:
-            self.record.add(p_e, self.c1, self.c2, f, step)
+            self.record.add(p_e, self.c1, self.c2, f, step, self._ratio)
         return dp
 
     def run(self, progress=None, every: int = 10000) -> "Stepper":

@@ -34,6 +34,17 @@ class PathPlan:
     closed: bool
     direction: tuple[float, float, float]
     check_boundary: bool = True
+    edge_length: float | None = None   # mm: the shared edge followed (default start/end)
+
+    @property
+    def length_estimate(self) -> float | None:
+        """The path's length before running it, mm: the edge's length when it follows one,
+        else the straight distance from start to end (None from a start alone)."""
+        if self.edge_length is not None:
+            return self.edge_length
+        if self.end is not None and not self.closed:
+            return float(np.linalg.norm(np.subtract(self.end.p, self.start.p)))
+        return None
 
     @property
     def offsets(self) -> tuple[float, float]:
@@ -95,8 +106,10 @@ def plan_path(s1: FaceSurface, s2: FaceSurface, job: Job) -> PathPlan:
     offs = job.offsets
     start, end = op.start, op.end
     closed = False
+    edge_length = None
     if start is None:
         e = shared_edge_for(s1, s2, op.edge)
+        edge_length = float(e.length)
         anchors = [(e.start, e.start_tangent), (None if e.closed else (e.end, e.end_tangent))]
         direction, closed = e.start_tangent, e.closed
     else:
@@ -134,7 +147,7 @@ def plan_path(s1: FaceSurface, s2: FaceSurface, job: Job) -> PathPlan:
     # boundary by construction: the boundary rule cannot apply, the edge's ends bound it.
     on_edge = start is None and offs == (0.0, 0.0)
     return PathPlan(s1, s2, job, t_start, t_end, closed, tuple(map(float, direction)),
-                    check_boundary=not on_edge)
+                    check_boundary=not on_edge, edge_length=edge_length)
 
 
 def make_stepper(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,
@@ -148,8 +161,31 @@ def make_stepper(face_a, face_b, *, radius: float, allowance: float = 0.0, feed:
     return stepper_for(plan_path(s1, s2, job), max_cycles, record)
 
 
-def stepper_for(plan: PathPlan, max_cycles: int = 1_000_000, record: bool = True) -> Stepper:
-    """The stepper of a solved plan."""
+def check_cycle_count(plan: PathPlan, max_cycles: int) -> None:
+    """Refuse, before running, a job whose path needs more cycles than ``max_cycles``.
+
+    The estimate is the plan's length estimate over the commanded step f = F Ts (steps
+    the accuracy rule shortens come on top). InputError names the feed and the period.
+    """
+    length = plan.length_estimate
+    job = plan.job
+    if length is None or length <= 0.0:
+        return
+    cycles = length / job.step
+    if cycles > max_cycles:
+        raise InputError(
+            f"the path is about {length:.4g} mm long: at feed {job.feed:g} mm/min and "
+            f"period {job.period:g} s (a step of {job.step:.3g} mm) it needs about "
+            f"{cycles:.3g} cycles, over the limit of {max_cycles}: raise the feed or the "
+            "period, or the cycle limit")
+
+
+def stepper_for(plan: PathPlan, max_cycles: int = 1_000_000, record: bool = True, *,
+                check_cycles: bool = True) -> Stepper:
+    """The stepper of a solved plan; InputError when its cycle estimate exceeds the limit
+    (``check_cycles=False`` for a deliberately short run of a longer path)."""
+    if check_cycles:
+        check_cycle_count(plan, max_cycles)
     job = plan.job
     return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
                    period=job.period, direction=plan.direction, end=plan.end,
@@ -164,7 +200,7 @@ def run_plan(plan: PathPlan, max_cycles: int = 1_000_000, progress=None) -> Tool
         raise GeometryError(f"no path: the interpolator stopped at the start point "
                             f"({stepper.stop_reason}): {stepper.stop_detail}")
     return toolpath_from_record(stepper.record, plan.job, stepper.stop_reason,
-                                stepper.stop_detail)
+                                stepper.stop_detail, plan.edge_length)
 
 
 def intersection_path(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,

@@ -3,7 +3,9 @@
 Shapes (N = number of points, row 0 the start): points (N, 3) cutter centres in mm;
 contacts (N, 2, 3) contact points on surface 1 and 2; normals (N, 2, 3); uv (N, 2, 2) the
 contacts' native (u, w) parameters; steps (N,) the length of the step that led to each
-point (0 for the start), commanded (N,) the commanded step f = F Ts of that cycle (mm).
+point (0 for the start), commanded (N,) the step f the cycle was commanded (mm): F Ts, or
+less where the accuracy rule shortened it (``accuracy_cycles``, ``accuracy_ratio``) or the
+last step landed on the end or a limit.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..interp.cycle import CLOSED, END
+from ..interp.cycle import CLOSED, END, PAPER_INVERSE_LIMIT
 from ..interp.error_bounds import (
     SurfaceBounds, bounds_for_surface, mp_length, surface_curvatures,
 )
@@ -36,6 +38,9 @@ class Toolpath:
     stop_reason: str
     stop_detail: str = ""
     bounds: tuple[SurfaceBounds, SurfaceBounds] | None = None
+    accuracy_cycles: int = 0      # cycles whose step was shortened to keep tol.accuracy
+    accuracy_ratio: float = 1.0   # the smallest shortened step / commanded step F Ts
+    expected_length: float | None = None  # mm: the followed edge's length, when known
 
     def __len__(self) -> int:
         return len(self.points)
@@ -58,6 +63,25 @@ class Toolpath:
     def complete(self) -> bool:
         """True when the path stopped where it was meant to (its end, or once around)."""
         return self.stop_reason in INTENDED_STOPS
+
+    @property
+    def partial_reason(self) -> str:
+        """Why the path stopped short, for the user ('' when it is complete), e.g.
+        "stopped at 5.900 of 97.8 mm (the edge's length): diverged: surface 2: ..."."""
+        if self.complete:
+            return ""
+        where = (f"stopped at {self.length:.3f} of {self.expected_length:.1f} mm (the edge's "
+                 "length)" if self.expected_length else f"stopped after {self.length:.3f} mm")
+        return f"{where}: {self.stop_reason}: {self.stop_detail}"
+
+    @property
+    def accuracy_note(self) -> str:
+        """"feed reduced on N cycles to X % for accuracy", or '' when no step was shortened."""
+        if not self.accuracy_cycles:
+            return ""
+        return (f"feed reduced on {self.accuracy_cycles} of {len(self) - 1} cycles to "
+                f"{100.0 * self.accuracy_ratio:.3g} % for accuracy "
+                f"({self.job.tolerances.accuracy:g} mm)")
 
     @property
     def length(self) -> float:
@@ -91,13 +115,22 @@ class Toolpath:
 
 
 def toolpath_from_record(record: PathRecord, job: Job, stop_reason: str,
-                         stop_detail: str = "") -> Toolpath:
-    """Arrays (copied) and the paper's error bounds from the stepper's per-cycle record."""
+                         stop_detail: str = "", expected_length: float | None = None
+                         ) -> Toolpath:
+    """Arrays (copied) and the paper's error bounds from the stepper's per-cycle record.
+
+    The accuracy rule's count and smallest ratio come from the record's ``ratio`` column;
+    ``expected_length`` (mm) is the length of the edge the path follows, if it does.
+    """
+    ratio = record.ratio[1:]
+    short = ratio < 1.0
     path = Toolpath(
         points=record.points.copy(), contacts=record.contacts.copy(),
         normals=record.normals.copy(), uv=record.uv.copy(), steps=record.steps.copy(),
         commanded=record.commanded.copy(), job=job, stop_reason=stop_reason,
-        stop_detail=stop_detail)
+        stop_detail=stop_detail, accuracy_cycles=int(short.sum()),
+        accuracy_ratio=float(ratio[short].min()) if short.any() else 1.0,
+        expected_length=expected_length)
     path.bounds = compute_bounds(path, record.ru, record.rw, record.forms)
     return path
 
@@ -119,5 +152,15 @@ def compute_bounds(path: Toolpath, ru: np.ndarray, rw: np.ndarray,
         k, kmax, kmin, tau = curv[i]
         mp = mp_length(R, curv[0][0], curv[1][0], path.contacts[:, 0], path.contacts[:, 1],
                        path.normals[:, 0], path.normals[:, 1])
-        out.append(bounds_for_surface(R, f, eps, k, kmax, kmin, tau, mp))
+        b = bounds_for_surface(R, f, eps, k, kmax, kmin, tau, mp)
+        # where the exact inverse moved this contact (eq. 5 would amplify its error), the
+        # paper's steady state of eq. 5 does not apply: report eq. 12 from the measured
+        # carried error instead (the step's own bound, whatever the inverse)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rho = R * np.maximum(np.abs(kmax - k), np.abs(kmin - k)) / np.abs(1.0 - R * k)
+        exact = rho > PAPER_INVERSE_LIMIT
+        if exact.any():
+            b.eps_ss = np.where(exact, eps, b.eps_ss)
+            b.eq16 = np.where(exact, b.eq12, b.eq16)
+        out.append(b)
     return out[0], out[1]

@@ -4,26 +4,31 @@
 algorithms, never with the interpolator's arithmetic: the path's contact parameters
 (u, w) are used only to seed projections, and a sample is re-projected without seeds to
 prove the seeds did not steer the answer. :func:`gouge_gate` runs only the gouge checks
-(the pair's faces and the ball against every face of the part) and fails closed; the CLI
-calls it before writing a path. Sign convention: a surface's deviation is the signed
-distance of the cutter centre from it (+ out of the material) minus its offset
-R' = R + C, so a negative deviation is an over-cut (a gouge) and a positive one an
-under-cut (material left). Every threshold comes from :class:`~cadcnc.tolerances.Tolerances`.
-Lengths in mm, times in s. See docs/validation.md.
+(the pair's faces, the ball against every face of the part at every centre, and the ball
+swept along every straight move) and fails closed; the CLI calls it before writing a path.
+Sign convention: a surface's deviation is the signed distance of the cutter centre from
+it (+ out of the material) minus its offset R' = R + C, so a negative deviation is an
+over-cut (a gouge) and a positive one an under-cut (material left). The depth of the ball
+into the part is material-aware: OCCT's solid classifier, not a face's side, says which
+centres are in the material. Every threshold comes from
+:class:`~cadcnc.tolerances.Tolerances`. Lengths in mm, times in s. See docs/validation.md
+and docs/gate.md.
 
 Modules: :mod:`.records` (one typed record per check), :mod:`.report` (the report and
-its JSON), :mod:`.surface_checks` (per-face deviations), :mod:`.whole_part` (the ball
-against every face), :mod:`.path_checks` (feed, theory, stop), :mod:`.reference` (OCCT's
-intersection curve), :mod:`.gate`, :mod:`.run` (:func:`verify`), :mod:`.probe` (OCCT
-primitives), :mod:`.table` (text).
+its JSON), :mod:`.verdict` (its criteria), :mod:`.surface_checks` (per-face deviations),
+:mod:`.whole_part` (the ball against every face, at the centres and along the moves),
+:mod:`.sweep` (distances along a polyline), :mod:`.bounds` (the segment bound),
+:mod:`.material` (faces, boxes and the solid classifier), :mod:`.path_checks` (feed,
+theory, stop), :mod:`.reference` (OCCT's intersection curve), :mod:`.gate`, :mod:`.run`
+(:func:`verify`), :mod:`.probe` (OCCT primitives), :mod:`.table` (text).
 """
 
 from __future__ import annotations
 
 from .gate import GateResult, gouge_gate
 from .records import (
-    FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, TheoryRow, WholePartCheck,
-    WholePartHit,
+    Criterion, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, SweepCheck, SweepHit,
+    TheoryRow, WholePartCheck, WholePartHit,
 )
 from .report import VerificationReport
 from .run import verify
@@ -31,5 +36,5 @@ from .run import verify
 __all__ = [
     "verify", "gouge_gate", "GateResult", "VerificationReport", "SurfaceCheck",
     "ReferenceCheck", "FeedCheck", "TheoryRow", "StopCheck", "WholePartCheck",
-    "WholePartHit",
+    "WholePartHit", "SweepCheck", "SweepHit", "Criterion",
 ]

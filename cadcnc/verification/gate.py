@@ -1,11 +1,14 @@
 """The whole-part gouge gate: may this path be written? Fails closed.
 
 :func:`gouge_gate` runs only the checks that measure gouges: each face of the pair
-against its offset (trimmed face included) and the ball against every face of the part.
-It skips OCCT's intersection reference, the expensive part of
-:func:`~cadcnc.verification.verify`, so that a CLI can call it before writing every path.
-The answer is ``ok`` only when the check completed and measured a finite depth within the
-limit: an exception inside the check, or a depth it could not measure, refuses the path.
+against its offset (trimmed face included), the ball against every face of the part at
+every centre (material-aware: OCCT's solid classifier decides which centres are in the
+material), and the ball swept along every straight move actually commanded, bounded
+(not sampled) between the points. It skips OCCT's intersection reference, the expensive
+part of :func:`~cadcnc.verification.verify`, so that a CLI can call it before writing
+every path. The answer is ``ok`` only when the check completed and proved every depth
+within the limit: an exception inside the check, or a depth it could not measure,
+refuses the path. docs/gate.md states what is checked and the bound it uses.
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ import math
 from dataclasses import dataclass, field
 
 from ..tolerances import Tolerances
-from .records import WholePartHit, deepest, strict_max
+from .records import SweepCheck, WholePartHit, strict_max
 from .surface_checks import SAMPLE_UNSEEDED, check_pair, prepare
 from .whole_part import check_whole_part
 
@@ -24,11 +27,15 @@ class GateResult:
     """The gate's answer.
 
     ``ok``: the ball cuts no face of the part deeper than ``limit_mm`` (``Tolerances.gouge``)
-    and the check completed. ``depth_mm``: the deepest cut into any face, the pair's own
-    trimmed faces included (nan when unmeasured); ``hits`` every face cut deeper than
-    ``Tolerances.hit``. ``message``: empty when ok, else why the path is refused
-    ("refused: the ball cuts into the part (face 5 by 2 mm over 601 cycles) beyond
-    0.001 mm; nothing written").
+    at any centre, the swept ball along every move is proven within ``limit_mm`` less
+    ``blend_mm``, and the check completed. ``depth_mm``: the deepest cut measured into any
+    face (centres, and moves where they were examined; nan when unmeasured); ``hits``
+    every face cut deeper than ``Tolerances.hit`` at a centre; ``sweep`` the moves' check
+    (its ``depth_bound_mm`` the proven bound). ``in_material``: the depth reaches R' less
+    the limit: some centre or move lies in, on or within the limit of the material, where
+    no smaller radius can help. ``message``: empty when ok,
+    else why the path is refused ("refused: the ball cuts into the part (face 5 by 2 mm
+    over 601 cycles) beyond 0.001 mm; nothing written").
     """
 
     ok: bool
@@ -36,42 +43,71 @@ class GateResult:
     hits: list[WholePartHit] = field(default_factory=list)
     limit_mm: float = math.nan
     message: str = ""
+    sweep: SweepCheck | None = None
+    blend_mm: float = 0.0
+    in_material: bool = False
 
 
-def gouge_gate(toolpath, part=None, tol: Tolerances | None = None, *,
-               progress=None) -> GateResult:
+def gouge_gate(toolpath, part=None, tol: Tolerances | None = None, *, moves=None,
+               blend_mm: float = 0.0, progress=None) -> GateResult:
     """Whether ``toolpath`` clears every face of ``part`` within ``tol.gouge`` (fails closed).
 
     ``part`` defaults to the STEP file the toolpath's job names; ``tol`` to the job's
-    tolerances. ``progress(stage, done, total)`` is called as the checks advance.
+    tolerances. ``moves``: (M, 3) ball-centre positions actually commanded, in order
+    (after point dropping, rounding, the tool-tip offset taken back to centres, and the
+    links); default the toolpath's points. ``blend_mm``: how far the machine may leave the
+    programmed polyline (G64 P), counted against the limit: every move must keep the ball
+    within ``tol.gouge - blend_mm`` of the part. ``progress(stage, done, total)`` is called
+    as the checks advance ("surfaces", "whole part", "moves").
     """
     limit = math.nan
+    blend = blend_mm
     try:
         tol = toolpath.job.tolerances if tol is None else tol
         limit = float(tol.gouge)
+        blend = float(blend_mm)
+        if not (math.isfinite(blend) and blend >= 0):
+            raise ValueError(f"the blending tolerance must be a finite length >= 0 mm, got "
+                             f"{blend_mm!r}")
         part, probes = prepare(toolpath, part, tol)
         surfaces = check_pair(toolpath, probes, tol, SAMPLE_UNSEEDED, progress)
-        whole = check_whole_part(part, probes, toolpath, surfaces, toolpath.job.tool.offset,
-                                 tol, progress)
-        overcut = strict_max(s.max_overcut_mm for s in surfaces)
-        depth = deepest(overcut, whole.hits)
+        whole, sweep = check_whole_part(part, probes, toolpath, surfaces,
+                                        toolpath.job.tool.offset, tol, progress, moves=moves,
+                                        limit=limit, blend=blend)
+        depth = strict_max([whole.max_depth_mm, sweep.depth_mm])
     except Exception as e:  # noqa: BLE001 - any failure refuses the path
         return GateResult(False, math.nan, [], limit,
-                          _incomplete(f"{type(e).__name__}: {e}"))
-    if not math.isfinite(depth) or not math.isfinite(limit):
-        unknown = [h.face for h in whole.hits if not math.isfinite(h.depth_mm)]
+                          _incomplete(f"{type(e).__name__}: {e}"), blend_mm=blend)
+    ball = toolpath.job.tool.offset
+    inside = bool(depth >= ball - limit)  # a centre within the limit of the material
+    result = dict(hits=whole.hits, limit_mm=limit, sweep=sweep, blend_mm=blend,
+                  in_material=inside)
+    unknown = [h.face for h in whole.hits if math.isnan(h.depth_mm)]
+    unknown += [h.face for h in sweep.hits if math.isnan(h.depth_mm) and h.face not in unknown]
+    if unknown or not math.isfinite(limit) or math.isnan(depth):
         why = (f"the depth into face{'s' if len(unknown) > 1 else ''} "
                f"{', '.join(map(str, unknown))} could not be measured" if unknown
                else f"the depth measured is {depth}")
-        return GateResult(False, depth, whole.hits, limit, _incomplete(why))
-    if depth <= limit:
-        return GateResult(True, depth, whole.hits, limit)
-    deep = [h for h in whole.hits if h.depth_mm > limit]
-    what = "; ".join(f"face {h.face} by {h.depth_mm:.4g} mm over {h.n_cycles} cycles"
-                     for h in deep) or f"over-cut {overcut:.4g} mm"
-    return GateResult(False, depth, whole.hits, limit,
-                      f"refused: the ball cuts into the part ({what}) beyond {limit:g} mm; "
-                      "nothing written")
+        return GateResult(False, depth, message=_incomplete(why), **result)
+    if depth <= limit and sweep.proven:
+        return GateResult(True, depth, **result)
+    what = [f"face {h.face} by {h.depth_mm:.4g} mm over {h.n_cycles} cycles"
+            for h in whole.hits if h.depth_mm > limit]
+    named = {h.face for h in whole.hits if h.depth_mm > limit}
+    what += [f"face {h.face} by {h.depth_mm:.4g} mm along {h.n_moves} "
+             f"move{'s' if h.n_moves > 1 else ''} between points"
+             for h in sweep.hits if h.face not in named and h.depth_mm > sweep.allowance_mm]
+    counted = f" less the blending tolerance {blend:g} mm" if blend else ""
+    if what:
+        return GateResult(False, depth, message=(
+            f"refused: the ball cuts into the part ({'; '.join(what)}) beyond {limit:g} mm"
+            f"{counted}; nothing written"), **result)
+    why = (f"a ball of radius R' = {ball:g} mm runs on the faces: the chords between its "
+           "points cannot be bounded" if ball <= sweep.allowance_mm else
+           "a move could not be measured exactly")
+    return GateResult(False, depth, message=(
+        f"refused: the moves are not proven within {limit:g} mm{counted} ({why}; the "
+        f"bound reaches {sweep.depth_bound_mm:.4g} mm); nothing written"), **result)
 
 
 def _incomplete(why: str) -> str:

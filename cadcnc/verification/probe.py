@@ -15,16 +15,17 @@ import numpy as np
 from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
 from OCP.BRepBndLib import BRepBndLib
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
 from OCP.BRepClass import BRepClass_FaceClassifier
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_IsInFace
 from OCP.BRepTools import BRepTools
+from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.Extrema import Extrema_GenLocateExtPS
 from OCP.Geom import Geom_OffsetSurface
 from OCP.GeomAdaptor import GeomAdaptor_Surface
 from OCP.GeomAPI import GeomAPI_IntSS, GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
-from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
+from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
 
 from ..tolerances import DEFAULT, Tolerances
 from ..trim import BOUNDARY, INSIDE, OUTSIDE
@@ -32,6 +33,9 @@ from ..trim import BOUNDARY, INSIDE, OUTSIDE
 _STATES = {TopAbs_IN: INSIDE, TopAbs_ON: BOUNDARY}
 NEWTON_PARAMETER_PRECISION = 1e-12
 """Convergence of the seeded Newton search in (u, w): a solver precision, not a threshold."""
+SEGMENT_AS_POINT = 1e-7
+"""A segment shorter than this (mm, OCCT's Precision::Confusion) has no edge: its
+midpoint's distance less half its length stands for it (a lower bound, within 1e-7)."""
 
 
 class FaceProbe:
@@ -57,6 +61,8 @@ class FaceProbe:
         self._dss = BRepExtrema_DistShapeShape()
         self._dss.LoadS2(topods_face)
         self._p, self._du, self._dw = gp_Pnt(), gp_Vec(), gp_Vec()
+        self._bbox = None
+        self._fclass = None
 
     # -- surface -----------------------------------------------------------------------
     def normal(self, u: float, w: float) -> np.ndarray:
@@ -108,11 +114,20 @@ class FaceProbe:
 
     # -- trimmed face ------------------------------------------------------------------
     def state(self, u: float, w: float, loose: bool = False) -> str:
-        """INSIDE / BOUNDARY / OUTSIDE the trimmed face (BRepClass_FaceClassifier).
+        """INSIDE / BOUNDARY / OUTSIDE the trimmed face.
 
-        Boundary tolerance ``tol.classify``, or ``tol.classify_loose`` with ``loose``.
+        Boundary tolerance ``tol.classify``: OCCT's face classifier built once per face
+        (BRepTopAdaptor_FClass2d, ~10x faster per point), with BRepClass_FaceClassifier
+        deciding what it finds on the boundary. ``loose``: BRepClass_FaceClassifier with
+        ``tol.classify_loose``.
         """
         u, w = self.wrap(u, w)
+        if not loose:
+            if self._fclass is None:
+                self._fclass = BRepTopAdaptor_FClass2d(self.face, self.tol.classify)
+            state = self._fclass.Perform(gp_Pnt2d(u, w))
+            if state in (TopAbs_IN, TopAbs_OUT):
+                return _STATES.get(state, OUTSIDE)
         eps = self.tol.classify_loose if loose else self.tol.classify
         fc = BRepClass_FaceClassifier(self.face, gp_Pnt2d(u, w), eps)
         return _STATES.get(fc.State(), OUTSIDE)
@@ -144,12 +159,30 @@ class FaceProbe:
                 sign = -1.0
         return sign * d, d
 
+    def segment_distance(self, a, b) -> float:
+        """Exact distance from the straight segment a-b to the trimmed face (nan if OCCT
+        cannot say): BRepExtrema_DistShapeShape of an edge built on the segment."""
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        length = float(np.linalg.norm(b - a))
+        if length <= SEGMENT_AS_POINT:  # no edge: the midpoint, less half the length
+            return max(self.face_distance(0.5 * (a + b))[1] - 0.5 * length, 0.0)
+        maker = BRepBuilderAPI_MakeEdge(gp_Pnt(*map(float, a)), gp_Pnt(*map(float, b)))
+        if not maker.IsDone():
+            return math.nan
+        self._dss.LoadS1(maker.Edge())
+        self._dss.Perform()
+        if not self._dss.IsDone() or self._dss.NbSolution() == 0:
+            return math.nan
+        return self._dss.Value()
+
     def bbox(self) -> tuple[np.ndarray, np.ndarray]:
-        """(lo, hi) corners of the face's optimal bounding box, mm."""
-        box = Bnd_Box()
-        BRepBndLib.AddOptimal_s(self.face, box, False, False)
-        xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
-        return np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
+        """(lo, hi) corners of the face's optimal bounding box, mm (computed once)."""
+        if self._bbox is None:
+            box = Bnd_Box()
+            BRepBndLib.AddOptimal_s(self.face, box, False, False)
+            xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
+            self._bbox = np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
+        return self._bbox
 
 
 def offset_surface(probe: FaceProbe, offset: float):

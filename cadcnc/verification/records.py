@@ -54,11 +54,14 @@ class ReferenceCheck:
     ``points_to_branch`` (N,): exact distance of each cutter centre to the branch.
     ``path_to_branch_mm``: max of that and of the path's segment midpoints (chord sag
     included); ``branch_to_path_mm``: max distance of the branch, within the path's span,
-    to the path polyline; ``hausdorff_mm`` the larger of the two. ``coverage`` in [0, 1]:
-    the fraction of the branch between the path's start and its intended end lying
-    within ``cover_radius_mm`` of a cutter centre; ``gaps`` the uncovered stretches
-    (from, to) in mm of arc length from the start. ``residual_mm``: how far OCCT's own
-    curve is from the offset surfaces (the reference's accuracy).
+    to the path polyline; ``hausdorff_mm`` the larger of the two. ``coverage`` in [0, 1],
+    the *curve coverage*: the fraction of the branch over the path's own span (its start
+    to its last point, or the whole loop; ``own_span_mm`` long) lying within
+    ``cover_radius_mm`` of a cutter centre, so a path that ends early is judged on what it
+    covers. ``intended_coverage``: the same over ``span_mm``, from the start to the
+    intended end; ``gaps`` its uncovered stretches (from, to) in mm of arc length from the
+    start. ``residual_mm``: how far OCCT's own curve is from the offset surfaces (the
+    reference's accuracy).
     """
 
     n_curves: int = 0
@@ -76,6 +79,8 @@ class ReferenceCheck:
     gaps: list[tuple[float, float]] = field(default_factory=list)
     residual_mm: float = math.nan
     note: str = ""
+    intended_coverage: float = math.nan
+    own_span_mm: float = math.nan
 
     def to_dict(self) -> dict:
         """The summary without the per-cycle distances."""
@@ -195,17 +200,97 @@ class WholePartHit:
 
 @dataclass
 class WholePartCheck:
-    """The ball of radius ``ball_radius_mm`` at every centre against every face of the part."""
+    """The ball of radius ``ball_radius_mm`` at every centre against every face of the part.
+
+    ``faces_checked``: faces of the part (those whose boxes came within reach of the path
+    were measured: ``faces_near``). ``max_depth_mm``: the deepest cut into any face at any
+    centre (0 when the ball cuts nothing; nan when a depth could not be measured).
+    ``material``: how membership was decided ("solid": OCCT's solid classifier, "faces":
+    the nearest face's side, for a part without a solid); ``classified``: classifier calls.
+    """
 
     hits: list[WholePartHit] = field(default_factory=list)
     faces_checked: int = 0
     distances_evaluated: int = 0
     ball_radius_mm: float = math.nan
     hit_tolerance_mm: float = math.nan
+    max_depth_mm: float = 0.0
+    faces_near: int = 0
+    material: str = ""
+    classified: int = 0
 
     def to_dict(self) -> dict:
         """The summary, without the hits (``whole_part_hits`` at the top level)."""
         return {f.name: getattr(self, f.name) for f in fields(self) if f.name != "hits"}
+
+
+@dataclass
+class SweepHit:
+    """One face the swept ball cuts deeper than the allowance along some moves.
+
+    Move k is the straight line from position k to k + 1 of the polyline checked.
+    ``depth_mm``: the deepest cut found on those moves, at ``worst_move`` (exact where
+    ``exact``, else measured at a sampled point: then the true depth is at least this);
+    ``n_moves`` moves in the ranges ``moves``; nan when a distance was not measurable.
+    """
+
+    face: int
+    depth_mm: float
+    worst_move: int
+    n_moves: int
+    moves: list[list[int]]
+    exact: bool = False
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass
+class SweepCheck:
+    """The ball swept along every straight move of a polyline, against every face.
+
+    ``proven``: every move is proven to cut no deeper than ``allowance_mm`` (the gouge
+    limit less ``blend_mm``), i.e. to stay at least ``clearance_mm`` = R' - allowance
+    from the part, outside it. ``depth_bound_mm``: the proven upper bound of the depth
+    over all moves (docs/gate.md); ``depth_mm``: the deepest depth measured (a lower
+    bound of the true deepest; exact on moves that needed the exact step).
+    ``hits``: the faces cut beyond the allowance. ``distances_evaluated``: point-to-face
+    distances; ``exact_moves``: segment-to-face distances (the exact step).
+    """
+
+    n_moves: int = 0
+    proven: bool = True
+    allowance_mm: float = math.nan
+    blend_mm: float = 0.0
+    clearance_mm: float = math.nan
+    depth_bound_mm: float = -math.inf
+    depth_mm: float = -math.inf
+    worst_move: int = -1
+    hits: list[SweepHit] = field(default_factory=list)
+    faces_near: int = 0
+    distances_evaluated: int = 0
+    exact_moves: int = 0
+    classified: int = 0
+
+    def to_dict(self) -> dict:
+        d = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "hits"}
+        d["hits"] = [h.to_dict() for h in self.hits]
+        return d
+
+
+@dataclass(frozen=True)
+class Criterion:
+    """One line of the verdict: ``name`` measured ``value`` against ``limit`` (mm, or a
+    fraction for coverage); ``ok`` False when it fails or could not be measured."""
+
+    name: str
+    value: float
+    limit: float
+    ok: bool
+    detail: str = ""
+
+    def to_dict(self) -> dict:
+        return asdict(self)
 
 
 def strict_max(values) -> float:

@@ -58,6 +58,35 @@ def polyline_distance(points: np.ndarray, poly: np.ndarray, closed: bool = False
     return best
 
 
+def _coverage(chain, s, lo, hi, points, cover_radius):
+    """(fraction covered, gaps, span length, branch samples) of the branch on [lo, hi].
+
+    A branch sample is covered when it lies within ``cover_radius`` of a cutter centre;
+    the fraction is the length between covered samples over the span's length (0 for an
+    empty span); gaps are the uncovered stretches (from, to) in mm from ``lo``.
+    """
+    keep = (s >= lo) & (s <= hi)
+    seg = chain[keep]
+    if len(seg) < 2:
+        return 0.0, [], hi - lo, seg
+    cd = np.linalg.norm(seg - points[nearest(seg, points)], axis=1)
+    covered = cd <= cover_radius
+    ss = s[keep] - lo
+    ds = np.diff(ss)
+    both = covered[1:] & covered[:-1]
+    total = float(ds.sum())
+    gaps, run = [], None
+    for i, c in enumerate(covered):
+        if not c and run is None:
+            run = ss[max(i - 1, 0)]
+        elif c and run is not None:
+            gaps.append((float(run), float(ss[i])))
+            run = None
+    if run is not None:
+        gaps.append((float(run), float(ss[-1])))
+    return (float(ds[both].sum() / total) if total > 0 else 0.0), gaps, hi - lo, seg
+
+
 def _sample(curve, points, extra, spacing, tol: Tolerances):
     """Parameters and points of a curve densely sampled where the path can be."""
     t0, t1 = curve.FirstParameter(), curve.LastParameter()
@@ -159,32 +188,16 @@ def check_reference(surface_a, surface_b, points: np.ndarray, *, span: str,
     else:
         rep.branch_to_path_mm = 0.0
     rep.hausdorff_mm = max(rep.path_to_branch_mm, rep.branch_to_path_mm)
-    # coverage over the intended span (start to the intended end)
+    # curve coverage over the path's own span (start to its last point, or the loop)
+    own = _coverage(chain, s, min(s0, s_last), max(s0, s_last), points, cover_radius)
+    rep.coverage, rep.own_span_mm = own[0], own[2]
+    # and over the intended span (start to the intended end): the gaps, what remains
     lo, hi = min(s0, s1), max(s0, s1)
-    keep = (s >= lo) & (s <= hi)
-    seg = chain[keep]
-    rep.span_mm = hi - lo
+    rep.intended_coverage, rep.gaps, rep.span_mm, seg = _coverage(chain, s, lo, hi, points,
+                                                                  cover_radius)
     if len(seg) < 2:
         rep.note = "the path's span on the reference branch is empty"
         return rep
-    # coverage: branch samples within cover_radius of a cutter centre
-    cd = np.linalg.norm(seg - points[nearest(seg, points)], axis=1)
-    covered = cd <= cover_radius
-    ss = s[keep] - lo
-    ds = np.diff(ss)
-    both = covered[1:] & covered[:-1]
-    total = float(ds.sum())
-    rep.coverage = float(ds[both].sum() / total) if total > 0 else 0.0
-    gaps, run = [], None
-    for i, c in enumerate(covered):
-        if not c and run is None:
-            run = ss[max(i - 1, 0)]
-        elif c and run is not None:
-            gaps.append((float(run), float(ss[i])))
-            run = None
-    if run is not None:
-        gaps.append((float(run), float(ss[-1])))
-    rep.gaps = gaps
     # the reference's own accuracy: OCCT's curve against the offset surfaces
     probe_pts = seg[np.linspace(0, len(seg) - 1, 24).astype(int)]
     worst = 0.0

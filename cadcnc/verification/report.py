@@ -14,10 +14,11 @@ from dataclasses import dataclass, field
 from ..jsonable import plain
 from ..tolerances import DEFAULT, Tolerances
 from .records import (
-    FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, TheoryRow, WholePartCheck,
-    WholePartHit, deepest, strict_max,
+    Criterion, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, SweepCheck, TheoryRow,
+    WholePartCheck, WholePartHit, strict_max,
 )
 from .table import format_table
+from .verdict import criteria
 
 
 @dataclass
@@ -25,8 +26,10 @@ class VerificationReport:
     """Everything :func:`~cadcnc.verification.verify` measured.
 
     ``to_dict()`` for JSON, ``format_table()`` for people. ``radius`` R and
-    ``ball_radius`` R' = R + C (mm); ``tolerances`` the record the checks used (its
-    ``gouge`` is the default limit of :meth:`ok`).
+    ``ball_radius`` R' = R + C (mm); ``tolerances`` the record the checks used (the
+    limits of the verdict: ``gouge``, ``accuracy``, ``hausdorff``, ``coverage``).
+    ``sweep``: the ball swept along the path's moves (None when the whole-part check
+    was skipped).
     """
 
     faces: tuple
@@ -45,6 +48,7 @@ class VerificationReport:
     edge_deviation_mm: float | None = None
     seconds: dict[str, float] = field(default_factory=dict)
     tolerances: Tolerances = field(default=DEFAULT, repr=False)
+    sweep: SweepCheck | None = None
 
     @property
     def max_overcut_mm(self) -> float:
@@ -68,14 +72,30 @@ class VerificationReport:
 
     @property
     def max_gouge_mm(self) -> float:
-        """Deepest cut of the ball into any face of the part (the pair's included), mm."""
-        return deepest(self.max_overcut_mm, self.whole_part_hits)
+        """Deepest cut of the ball into any face of the part (the pair's included), at the
+        centres and along the moves where they were examined, mm (material-aware; the
+        pair's over-cut when the whole-part check was skipped)."""
+        if self.sweep is None:
+            return strict_max([self.max_overcut_mm,
+                               *(h.depth_mm for h in self.whole_part_hits)])
+        return strict_max([self.whole_part.max_depth_mm, self.sweep.depth_mm])
+
+    def criteria(self, tolerance_mm: float | None = None) -> list[Criterion]:
+        """Every criterion (gouge, deviation, hausdorff, coverage) with its pass or fail;
+        ``tolerance_mm`` overrides the gouge limit (see :mod:`.verdict`)."""
+        return criteria(self, tolerance_mm)
+
+    @property
+    def verdict(self) -> list[Criterion]:
+        """The criteria that fail at the report's own tolerances (empty when all pass)."""
+        return [c for c in self.criteria() if not c.ok]
 
     def ok(self, tolerance_mm: float | None = None) -> bool:
-        """True when no face is gouged deeper than ``tolerance_mm`` (default the gouge
-        limit of :attr:`tolerances`); False when the depth could not be measured."""
-        limit = self.tolerances.gouge if tolerance_mm is None else tolerance_mm
-        return self.max_gouge_mm <= limit
+        """True when every criterion passes: no face gouged deeper than ``tolerance_mm``
+        (default the gouge limit of :attr:`tolerances`) at the centres or along the
+        moves, deviation, Hausdorff and coverage within their tolerances. False when
+        anything could not be measured."""
+        return all(c.ok for c in self.criteria(tolerance_mm))
 
     def to_dict(self) -> dict:
         """JSON-ready summary (no per-cycle arrays; non-finite numbers become None)."""
@@ -89,9 +109,12 @@ class VerificationReport:
             stop=self.stop.to_dict(), surfaces=[s.to_dict() for s in self.surfaces],
             reference=self.reference.to_dict(), feed=self.feed.to_dict(),
             theory=[t.to_dict() for t in self.theory], whole_part=self.whole_part.to_dict(),
-            edge_deviation_mm=self.edge_deviation_mm, seconds=self.seconds))
+            edge_deviation_mm=self.edge_deviation_mm, seconds=self.seconds,
+            sweep=None if self.sweep is None else self.sweep.to_dict(), ok=self.ok(),
+            criteria=[c.to_dict() for c in self.criteria()]))
 
     def format_table(self, tolerance_mm: float | None = None) -> str:
-        """A text table; the verdict against ``tolerance_mm`` (default the gouge limit)."""
+        """A text table, each criterion's pass or fail last (``tolerance_mm`` overrides
+        the gouge limit)."""
         return format_table(self, self.tolerances.gouge if tolerance_mm is None
                             else tolerance_mm)

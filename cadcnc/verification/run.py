@@ -34,10 +34,12 @@ def verify(toolpath, part=None, *, tol: Tolerances | None = None,
     the STEP file named by ``toolpath.job.source``). ``tol``: the thresholds (default the
     job's tolerances): ``hit`` (whole-part hits), ``gouge`` (the default limit of
     ``report.ok()``), ``noise``, ``off_face``, ``classify``, ``classify_loose``,
-    ``closed``. ``sample_unseeded``: how many cycles per face are re-projected without
-    seeds. ``reference_spacing_mm``: sample spacing of OCCT's intersection curve.
-    ``whole_part``: False skips the ball against the other faces. ``progress(stage, done,
-    total)`` is called as stages advance ("surfaces", "reference", "whole part").
+    ``closed``, and the verdict's ``accuracy``, ``hausdorff``, ``coverage``.
+    ``sample_unseeded``: how many cycles per face are re-projected without seeds.
+    ``reference_spacing_mm``: sample spacing of OCCT's intersection curve.
+    ``whole_part``: False skips the ball against the other faces (and along the moves).
+    ``progress(stage, done, total)`` is called as stages advance ("surfaces", "reference",
+    "whole part").
     """
     tol = toolpath.job.tolerances if tol is None else tol
     part, probes = prepare(toolpath, part, tol)
@@ -62,9 +64,10 @@ def verify(toolpath, part=None, *, tol: Tolerances | None = None,
     if edge is not None and max(offsets) == 0.0:
         edge_dev = float(np.nanmax(shape_distances(edge.edge, toolpath.points)))
     t2 = time.perf_counter()
-    whole = (check_whole_part(part, probes, toolpath, surfaces, tool.offset, tol, progress)
-             if whole_part else WholePartCheck(ball_radius_mm=tool.offset,
-                                               hit_tolerance_mm=tol.hit))
+    whole, sweep = (check_whole_part(part, probes, toolpath, surfaces, tool.offset, tol,
+                                     progress)
+                    if whole_part else (WholePartCheck(ball_radius_mm=tool.offset,
+                                                       hit_tolerance_mm=tol.hit), None))
     timer["whole_part"] = time.perf_counter() - t2
     timer["total"] = time.perf_counter() - t0
     return VerificationReport(
@@ -73,4 +76,4 @@ def verify(toolpath, part=None, *, tol: Tolerances | None = None,
         stop_detail=toolpath.stop_detail, surfaces=surfaces, reference=ref,
         feed=check_feed(toolpath, tol), theory=check_theory(toolpath, surfaces, tol),
         whole_part=whole, stop=check_stop(toolpath, probes, ref, span, f_max, tol),
-        edge_deviation_mm=edge_dev, seconds=timer, tolerances=tol)
+        edge_deviation_mm=edge_dev, seconds=timer, tolerances=tol, sweep=sweep)

@@ -18,6 +18,7 @@ from .records import SurfaceCheck, cycle_ranges
 
 PERCENTILES = (50, 95, 99)
 SAMPLE_UNSEEDED = 64  # cycles per face re-projected without seeds (plus the worst ones)
+TICK = 5000  # progress is reported every 5000 cycles
 
 
 def resolve_part(toolpath, part):
@@ -49,22 +50,31 @@ def check_pair(toolpath, probes: dict[int, FaceProbe], tol: Tolerances, n_unseed
     for side, n in enumerate(toolpath.faces):
         if progress:
             progress("surfaces", side, 2)
+        tick = None
+        if progress:
+            def tick(k, n_points, side=side):
+                progress("surfaces", side * n_points + k, 2 * n_points)
         out.append(check_surface(probes[n], n, float(toolpath.offsets[side]),
-                                 toolpath.points, toolpath.uv[:, side], n_unseeded, tol))
+                                 toolpath.points, toolpath.uv[:, side], n_unseeded, tol,
+                                 tick))
     return out
 
 
 def check_surface(probe: FaceProbe, face_no, offset: float, points: np.ndarray,
-                  uw: np.ndarray, n_unseeded: int, tol: Tolerances) -> SurfaceCheck:
+                  uw: np.ndarray, n_unseeded: int, tol: Tolerances,
+                  tick=None) -> SurfaceCheck:
     """Deviations of ``points`` (N, 3) from one face offset by ``offset``.
 
     ``uw`` (N, 2): the path's contact parameters on that face, used as seeds only.
     ``n_unseeded``: how many evenly spaced cycles are re-projected without seeds.
+    ``tick(done, total)`` is called every :data:`TICK` points.
     """
     n = len(points)
     dev, fdev, dist = np.empty(n), np.empty(n), np.empty(n)
     states = []
     for k, p in enumerate(points):
+        if tick and k % TICK == 0:
+            tick(k, n)
         res = probe.project_seeded(p, *uw[k])
         if res is None:
             res = probe.project_global(p)

@@ -53,7 +53,8 @@ def format_table(rep, tolerance_mm: float) -> str:
         f"{_mm(ref.residual_mm)} mm",
         f"  centres to branch max {_mm(ref.points_max_mm)} mm @{ref.points_worst_cycle}; "
         f"Hausdorff (polyline, two-sided) {_mm(ref.hausdorff_mm)} mm",
-        f"  coverage {ref.coverage:.4f} of {ref.span_mm:.3f} mm"
+        f"  curve coverage {ref.coverage:.4f} of the path's own {ref.own_span_mm:.3f} mm; "
+        f"{ref.intended_coverage:.4f} of the intended {ref.span_mm:.3f} mm"
         + (f"; gaps {[(round(a, 3), round(b, 3)) for a, b in ref.gaps]}" if ref.gaps else ""),
     ]
     if ref.note:
@@ -74,7 +75,28 @@ def format_table(rep, tolerance_mm: float) -> str:
         lines.append(f"  face {h.face}{' (followed)' if h.followed else ''}: depth "
                      f"{_mm(h.depth_mm)} mm @{h.worst_cycle}, {h.n_cycles} cycles "
                      f"{h.cycles[:4]}{'...' if len(h.cycles) > 4 else ''}")
-    verdict = "OK" if rep.ok(tolerance_mm) else "GOUGE"
+    sw = rep.sweep
+    if sw is not None:
+        lines.append(f"moves ({sw.n_moves}): swept ball proven within {_mm(sw.depth_bound_mm)} "
+                     f"mm, deepest measured {_mm(sw.depth_mm)} mm @{sw.worst_move}; "
+                     f"{sw.distances_evaluated} distances, {sw.exact_moves} exact moves"
+                     + (f"; material by {rep.whole_part.material} classifier"
+                        if rep.whole_part.material else ""))
+        for h in sw.hits:
+            lines.append(f"  face {h.face}: depth {_mm(h.depth_mm)} mm @move {h.worst_move}, "
+                         f"{h.n_moves} moves {h.moves[:4]}{'...' if len(h.moves) > 4 else ''}")
+    lines.append("")
+    lines.append(f"{'verdict':<12}{'measured':>12}{'limit':>12}")
+    units = {"coverage": ""}
+    crit = rep.criteria(tolerance_mm)
+    for c in crit:
+        value = f"{c.value:.4f}" if c.name == "coverage" else _mm(c.value)
+        limit = f"{c.limit:g}" if c.name == "coverage" else f"{c.limit:g}"
+        lines.append(f"{c.name:<12}{value:>12}{limit:>12}{units.get(c.name, ' mm')}  "
+                     f"{'pass' if c.ok else 'FAIL'}" + (f"  ({c.detail})" if c.detail and not
+                                                        c.ok else ""))
+    failed = [c.name for c in crit if not c.ok]
+    lines.append("OK" if not failed else f"FAILED: {', '.join(failed)}")
     lines.append(f"max gouge {_mm(rep.max_gouge_mm)} mm vs tolerance {tolerance_mm:g} mm: "
-                 f"{verdict}")
+                 f"{'OK' if crit[0].ok else 'GOUGE'}")
     return "\n".join(lines)

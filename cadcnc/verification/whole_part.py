@@ -1,11 +1,14 @@
-"""The ball at every cutter centre against every face of the part (OCCT distances).
+"""The ball against every face of the part: at every cutter centre, and along every move.
 
-A face whose optimal bounding box, grown by the ball radius, misses a centre cannot touch
-the ball there. Otherwise the exact point-to-face distance d is computed (signed only where
-the nearest point lies inside the face); as d is 1-Lipschitz along the path, the next
-d - R' - hit mm of travel cannot hit that face and are skipped without loss. The pair's own
-faces reuse their per-face check. A distance OCCT cannot compute counts as a hit of
-unknown (nan) depth, never as a miss. Lengths in mm.
+Material-aware depth: the ball of radius R' centred at a point outside the solid at
+unsigned distance d_k from face k cuts R' - d_k into it; a centre inside the solid cuts
+R' + d into the nearest face (d its distance to the whole part). Membership comes from
+OCCT's solid classifier (:mod:`.material`); a face's own side says nothing about it (the
+centre may be behind a thin wall's far face and still outside). Distances are OCCT's exact
+point-to-face (and, where needed, segment-to-face) distances, after a box broad phase and
+1-Lipschitz skipping (:mod:`.sweep`). The pair's own faces reuse their per-face check at
+the centres. A distance OCCT cannot compute, or a point it cannot classify, counts as a
+hit of unknown (nan) depth, never as a miss. Lengths in mm.
 """
 
 from __future__ import annotations
@@ -14,55 +17,162 @@ import numpy as np
 
 from ..tolerances import Tolerances
 from .probe import FaceProbe
-from .records import SurfaceCheck, WholePartCheck, WholePartHit, cycle_ranges
+from .records import SurfaceCheck, SweepCheck, SweepHit, WholePartCheck, WholePartHit, cycle_ranges
+from .material import Material, PartFaces
+from .sweep import Polyline
+
+FAR_MATCH_STEPS = 4.0  # a move farther than 4 steps from the centre found near it is
+MATCH_WINDOW = 64      # matched against every centre (a link); else within 64 centres
 
 
 def check_whole_part(part, probes: dict[int, FaceProbe], toolpath,
                      surfaces: list[SurfaceCheck], ball: float, tol: Tolerances,
-                     progress=None) -> WholePartCheck:
-    """Every face of ``part`` against the ball of radius ``ball`` (R') at every centre.
+                     progress=None, *, moves=None, limit: float | None = None,
+                     blend: float = 0.0) -> tuple[WholePartCheck, SweepCheck]:
+    """Every face of ``part`` against the ball of radius ``ball`` (R'): at every centre
+    (a face is hit where the ball reaches deeper than ``tol.hit``), and swept along every
+    straight move of ``moves`` ((M, 3) ball centres; default the toolpath's points), which
+    must stay within ``limit`` (default ``tol.gouge``) less ``blend``.
 
     ``probes``: the pair's probes (others are made here); ``surfaces``: the pair's checks.
-    A face is hit where the ball reaches deeper than ``tol.hit`` into it.
     """
+    limit = tol.gouge if limit is None else limit
+    faces = PartFaces(part, probes, tol)
+    material = Material(faces, tol)
     pts = toolpath.points
-    travel = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
-    hits, evaluated = [], 0
-    pair = {s.face: s for s in surfaces}
-    for n in range(1, len(part) + 1):
-        if progress:
-            progress("whole part", n, len(part))
-        if n in pair:
-            s = pair[n]
-            depth = ball - (s.face_deviation + s.offset)
-            evaluated += len(pts)
-        else:
-            probe = probes.get(n) or FaceProbe(part.face(n).topods, tol)
-            depth, count = _face_depths(probe, pts, travel, ball, tol.hit)
-            evaluated += count
-        hit = _hit(n, n in pair, depth, tol.hit)
+    known = {s.face: (np.abs(s.face_deviation + s.offset), s.face_deviation + s.offset)
+             for s in surfaces}
+    allowance = limit - blend
+    centres = Polyline(faces, material, pts, ball, hit=tol.hit,
+                       allowance=allowance if moves is None else None, known=known,
+                       progress=progress).run()
+    line = centres
+    if moves is not None:
+        moves = np.asarray(moves, float).reshape(-1, 3)
+        line = Polyline(faces, material, moves, ball, allowance=allowance,
+                        anchors=_anchors(centres, moves), progress=progress,
+                        stage="moves").run()
+    whole = _whole(centres, surfaces, ball, tol, len(part), material)
+    sweep = _sweep(line, ball, allowance, blend, material)
+    return whole, sweep
+
+
+def _anchors(centres: Polyline, moves: np.ndarray):
+    """(match, centres, {face: distances at the centres}) for :class:`Polyline`."""
+    pts = centres.points
+    dists = {}
+    for k, (idx, d, _) in centres.samples.items():
+        dense = np.full(len(pts), np.nan)
+        dense[idx] = d
+        dists[k] = dense
+    step = float(centres.length.max()) if len(centres.length) else 1.0
+    match = np.zeros(len(moves), int)
+    at = 0
+    for j, m in enumerate(moves):
+        lo, hi = max(at - MATCH_WINDOW, 0), min(at + MATCH_WINDOW + 1, len(pts))
+        gap = np.linalg.norm(pts[lo:hi] - m, axis=1)
+        at = lo + int(np.argmin(gap))
+        if gap.min() > FAR_MATCH_STEPS * step:
+            far = int(np.argmin(np.linalg.norm(pts - m, axis=1)))
+            if np.linalg.norm(pts[far] - m) < gap.min():
+                at = far
+        match[j] = at
+    return match, pts, dists
+
+
+def _whole(line: Polyline, surfaces, ball: float, tol: Tolerances, n_faces: int,
+           material: Material) -> WholePartCheck:
+    """The per-face hits at the centres, from the distances and the membership."""
+    n = len(line.points)
+    followed = {s.face for s in surfaces}
+    state, inside, inside_face = line.state, line.inside, line.inside_face
+    depth: dict[int, np.ndarray] = {}
+    for k, (idx, d, _) in line.samples.items():
+        dense = np.full(n, -np.inf)
+        dense[idx] = ball - d  # out of (or on) the material; a face crossed from inside
+        depth[k] = dense
+    fallback = sorted(followed)[0] if followed else 1
+    for j in np.nonzero(state == 2)[0]:  # inside: R' + d into the nearest face
+        k = int(inside_face[j]) or int(line.d_face[j]) or fallback
+        depth.setdefault(k, np.full(n, -np.inf))[j] = ball + inside[j]
+    for j in np.nonzero(state == -1)[0]:  # membership unknown: fail closed
+        k = int(line.d_face[j]) or fallback
+        depth.setdefault(k, np.full(n, -np.inf))[j] = np.nan
+    hits = []
+    for k in sorted(depth):
+        hit = _hit(k, k in followed, depth[k], tol.hit)
         if hit is not None:
             hits.append(hit)
-    return WholePartCheck(hits=hits, faces_checked=len(part), distances_evaluated=evaluated,
-                          ball_radius_mm=ball, hit_tolerance_mm=tol.hit)
+    every = [a[np.isfinite(a) | np.isnan(a)] for a in depth.values()]
+    every = np.concatenate(every) if every else np.zeros(0)
+    deepest = np.nan if np.isnan(every).any() else float(max(0.0, every.max(initial=0.0)))
+    return WholePartCheck(hits=hits, faces_checked=n_faces,
+                          distances_evaluated=line.evaluated + sum(
+                              len(s.face_deviation) for s in surfaces),
+                          ball_radius_mm=ball, hit_tolerance_mm=tol.hit, max_depth_mm=deepest,
+                          faces_near=line.faces_near, material=material.kind,
+                          classified=line.classified)
 
 
-def _face_depths(probe: FaceProbe, pts: np.ndarray, travel: np.ndarray, ball: float,
-                 hit_tol: float) -> tuple[np.ndarray, int]:
-    """(N,) depth of the ball into one face (-inf where it cannot reach), distances used."""
-    lo, hi = probe.bbox()
-    near = np.all((pts >= lo - ball - hit_tol) & (pts <= hi + ball + hit_tol), axis=1)
-    depth = np.full(len(pts), -np.inf)
-    skip_until, evaluated = -np.inf, 0
-    for k in np.nonzero(near)[0]:
-        if travel[k] < skip_until:
-            continue
-        sd, _ = probe.face_distance(pts[k])
-        evaluated += 1
-        depth[k] = ball - sd
-        if np.isfinite(sd):  # an unmeasured distance proves nothing about the next ones
-            skip_until = travel[k] + (sd - ball - hit_tol)
-    return depth, evaluated
+def _sweep(line: Polyline, ball: float, allowance: float, blend: float,
+           material: Material) -> SweepCheck:
+    """The swept ball along the moves of ``line``: bounds, depths, failing faces."""
+    m = len(line.points) - 1
+    out = SweepCheck(n_moves=max(m, 0), allowance_mm=allowance, blend_mm=blend,
+                     clearance_mm=ball - allowance, faces_near=line.faces_near,
+                     distances_evaluated=line.evaluated, exact_moves=line.exact_moves,
+                     classified=line.classified)
+    if m < 1:
+        return out
+    state, length = line.state, line.length
+    sa, sb = state[:-1], state[1:]
+    u = np.where(state == 2, line.inside, 0.0)  # distance to the air, an upper bound
+    u = np.where(state == -1, np.nan, u)
+    bound = ball - line.seg_lb
+    meas = ball - line.seg_meas
+    inside = (sa == 2) | (sb == 2)
+    lipschitz = ball + 0.5 * (u[:-1] + u[1:] + length)  # depth from the air's distance
+    touch = ~(line.seg_lb > 0)
+    bound = np.where(inside | (touch & (ball - allowance <= 0)), lipschitz, bound)
+    meas = np.where(inside, np.fmax(meas, ball + np.fmax(u[:-1], u[1:])), meas)
+    unknown = (sa == -1) | (sb == -1)
+    bound[unknown] = meas[unknown] = np.nan
+    failed = ~(bound <= allowance)
+    out.proven = not failed.any()
+    out.depth_bound_mm = float(np.nan if np.isnan(bound).any() else bound.max())
+    out.depth_mm = float(np.nan if np.isnan(meas).any() else meas.max())
+    out.worst_move = int(np.nanargmax(np.where(np.isnan(meas), np.inf, meas)))
+    if not out.proven:
+        out.hits = _sweep_hits(line, failed, inside | unknown, ball, allowance, meas)
+    return out
+
+
+def _sweep_hits(line: Polyline, failed, blamed_on_nearest, ball, allowance, meas):
+    """One record per face the failing moves cut beyond the allowance."""
+    per_face: dict[int, list] = {}
+    for k, (seg_lb, seg_meas, exact) in line.seg.items():
+        bad = np.nonzero(failed & ~(ball - seg_lb <= allowance) & ~blamed_on_nearest)[0]
+        for s in bad:
+            per_face.setdefault(k, []).append((int(s), ball - seg_meas[s], bool(exact[s])))
+    for s in np.nonzero(failed & blamed_on_nearest)[0]:
+        j = s if line.state[s] != 0 else s + 1
+        k = int(line.inside_face[j]) or int(line.d_face[j]) or int(line.seg_face[s]) or 1
+        per_face.setdefault(k, []).append((int(s), float(meas[s]), False))
+    named = {r[0] for rows in per_face.values() for r in rows}
+    for s in np.nonzero(failed)[0]:  # the touching moves of a ball within the allowance
+        if int(s) not in named:
+            k = int(line.seg_face[s]) or int(line.d_face[s]) or 1
+            per_face.setdefault(k, []).append((int(s), float(meas[s]), False))
+    hits = []
+    for k in sorted(per_face):
+        rows = per_face[k]
+        depths = np.array([r[1] for r in rows], float)
+        w = int(np.argmax(np.where(np.isnan(depths), np.inf, depths)))
+        hits.append(SweepHit(face=k, depth_mm=float(np.nan if np.isnan(depths).any()
+                                                      else depths[w]),
+                             worst_move=rows[w][0], n_moves=len(rows),
+                             moves=cycle_ranges(sorted(r[0] for r in rows)), exact=rows[w][2]))
+    return hits
 
 
 def _hit(face: int, followed: bool, depth: np.ndarray, hit_tol: float) -> WholePartHit | None:

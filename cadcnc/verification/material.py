@@ -1,0 +1,165 @@
+"""Where the material is: the part's faces with their boxes, and which points lie inside.
+
+Membership in the material is a property of the solid, not of one face: a point behind a
+face (on its material side) may still be outside the part, past a thin wall or beyond the
+face's far edge. :class:`Material` asks OCCT's solid classifier
+(``BRepClass3d_SolidClassifier``) of every solid of the part; a part without a solid (a
+shell, loose faces) falls back to the material side of the nearest face, where the
+nearest point lies inside that face. :class:`PartFaces` holds one probe and two boxes per
+face: a cheap loose box for all faces (``BRepBndLib::Add``, ~20 us a face) and the
+optimal box (``AddOptimal``, ~4 ms a face) only for faces the loose box cannot rule out.
+Lengths in mm.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from OCP.Bnd import Bnd_Box
+from OCP.BRepBndLib import BRepBndLib
+from OCP.BRepClass3d import BRepClass3d_SolidClassifier
+from OCP.gp import gp_Pnt
+from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_SOLID
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
+
+from ..tolerances import Tolerances
+from .bounds import box_box_distance, point_box_distance
+from .probe import FaceProbe
+
+IN, OUT, ON = "in", "out", "on"
+SOLID, FACES = "solid", "faces"
+BOX_MARGIN = 1e-6
+"""Growth of every optimal box (mm): AddOptimal finds the extent numerically."""
+
+
+def _box(shape, optimal: bool) -> tuple[np.ndarray, np.ndarray]:
+    box = Bnd_Box()
+    if optimal:
+        BRepBndLib.AddOptimal_s(shape, box, False, False)
+    else:
+        BRepBndLib.Add_s(shape, box, False)
+    if box.IsVoid():
+        return np.full(3, np.inf), np.full(3, -np.inf)
+    xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
+    return np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
+
+
+class PartFaces:
+    """Every face of a part: OCCT probes (made when first needed) and bounding boxes.
+
+    ``probes``: probes already made (the pair's), by face number.
+    """
+
+    def __init__(self, part, probes: dict[int, FaceProbe], tol: Tolerances):
+        self.part, self.tol = part, tol
+        self.probes = dict(probes)
+        n = len(part)
+        self.loose = np.empty((n + 1, 2, 3))
+        self.loose[0, 0], self.loose[0, 1] = np.inf, -np.inf
+        for k in range(1, n + 1):
+            self.loose[k] = _box(part.face(k).topods, optimal=False)
+        self._tight: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+    def __len__(self) -> int:
+        return len(self.loose) - 1
+
+    def probe(self, n: int) -> FaceProbe:
+        if n not in self.probes:
+            self.probes[n] = FaceProbe(self.part.face(n).topods, self.tol)
+        return self.probes[n]
+
+    def box(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """The face's optimal box grown by :data:`BOX_MARGIN` (computed once)."""
+        if n not in self._tight:
+            lo, hi = self.probe(n).bbox()
+            self._tight[n] = lo - BOX_MARGIN, hi + BOX_MARGIN
+        return self._tight[n]
+
+    def near(self, lo: np.ndarray, hi: np.ndarray, margin: float) -> list[int]:
+        """Faces whose loose box comes within ``margin`` of the box [lo, hi]."""
+        return [k for k in range(1, len(self) + 1)
+                if box_box_distance(lo, hi, *self.loose[k]) <= margin]
+
+    def nearest(self, point) -> tuple[int, float, float]:
+        """(face, signed, unsigned distance) of the face nearest to ``point``.
+
+        Branch and bound: faces in order of their loose box's distance, stopping when the
+        next box is farther than the best distance found. Signed as
+        :meth:`FaceProbe.face_distance` (+ out of the material). (0, nan, nan) when no
+        distance could be measured.
+        """
+        p = np.asarray(point, float)[None]
+        lower = point_box_distance(np.repeat(p, len(self), 0), self.loose[1:, 0],
+                                   self.loose[1:, 1])
+        best = (0, math.nan, math.inf)
+        for k in np.argsort(lower, kind="stable") + 1:
+            if lower[k - 1] > best[2]:
+                break
+            sd, ud = self.probe(int(k)).face_distance(p[0])
+            if math.isnan(ud):
+                return 0, math.nan, math.nan
+            if ud < best[2]:
+                best = (int(k), sd, ud)
+        return best if best[0] else (0, math.nan, math.nan)
+
+
+class Material:
+    """Which points of space lie in the part's material (``IN``, ``OUT`` or ``ON``).
+
+    ``kind`` is ``SOLID`` when the part has solids (OCCT's solid classifier, one per solid,
+    with the boundary tolerance ``tol.classify``), else ``FACES`` (the material side of
+    the nearest face). ``solids``: the TopoDS solids to use (default every solid of the
+    part's shape; ``[]`` forces the faces' rule). ``classified`` counts the classifier
+    calls.
+    """
+
+    def __init__(self, faces: PartFaces, tol: Tolerances, solids=None):
+        self.faces, self.tol = faces, tol
+        if solids is None:  # every solid of the part's shape
+            solids = []
+            explorer = TopExp_Explorer(faces.part.shape, TopAbs_SOLID)
+            while explorer.More():
+                solids.append(TopoDS.Solid_s(explorer.Current()))
+                explorer.Next()
+        self.solids = list(solids)
+        self.kind = SOLID if self.solids else FACES
+        self._boxes = [_box(s, optimal=False) for s in self.solids]
+        self._classifiers: list = [None] * len(self.solids)
+        self.classified = 0
+
+    def state(self, point) -> str | None:
+        """IN, OUT or ON; None when it cannot be told (the caller fails closed)."""
+        if self.kind == FACES:
+            return self.side_of_nearest_face(point)
+        p = np.asarray(point, float)
+        on = unknown = False
+        for k, solid in enumerate(self.solids):
+            lo, hi = self._boxes[k]
+            if np.any(p < lo - BOX_MARGIN) or np.any(p > hi + BOX_MARGIN):
+                continue  # outside this solid's box: outside this solid
+            if self._classifiers[k] is None:
+                self._classifiers[k] = BRepClass3d_SolidClassifier(solid)
+            classifier = self._classifiers[k]
+            classifier.Perform(gp_Pnt(*map(float, p)), self.tol.classify)
+            self.classified += 1
+            state = classifier.State()
+            if state == TopAbs_IN:
+                return IN
+            on |= state == TopAbs_ON
+            unknown |= state not in (TopAbs_IN, TopAbs_ON, TopAbs_OUT)
+        if on:
+            return ON
+        if unknown:  # the classifier could not tell: the faces' sides decide
+            return self.side_of_nearest_face(point)
+        return OUT
+
+    def side_of_nearest_face(self, point) -> str | None:
+        """The fallback rule: IN behind the nearest face (its nearest point inside it)."""
+        face, signed, unsigned = self.faces.nearest(point)
+        if not face or math.isnan(signed):
+            return None
+        if unsigned <= self.tol.noise:
+            return ON
+        return IN if signed < 0 else OUT
