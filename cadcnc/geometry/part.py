@@ -144,10 +144,7 @@ class Part:
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo (3,), hi (3,)) of the part's optimal axis-aligned bounding box, mm."""
         if self._bbox is None:
-            box = Bnd_Box()
-            BRepBndLib.AddOptimal_s(self.shape, box, True, False)
-            xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
-            self._bbox = np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
+            self._bbox = optimal_box(self.shape, use_triangulation=True)
         return self._bbox
 
     @property
@@ -256,6 +253,14 @@ class Part:
             tangent = -tangent
         d = np.cross(n, tangent)
         return d / np.linalg.norm(d), n
+
+
+def optimal_box(shape, use_triangulation: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(lo (3,), hi (3,)) of OCCT's optimal axis-aligned bounding box of a shape, mm."""
+    box = Bnd_Box()
+    BRepBndLib.AddOptimal_s(shape, box, use_triangulation, False)
+    xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
+    return np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
 
 
 def _point_and_tangent(curve: BRepAdaptor_Curve, t: float) -> tuple[np.ndarray, np.ndarray]:

@@ -12,9 +12,7 @@ import math
 import time
 
 import numpy as np
-from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
-from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
 from OCP.BRepClass import BRepClass_FaceClassifier
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_IsInFace
@@ -27,6 +25,7 @@ from OCP.GeomAPI import GeomAPI_IntSS, GeomAPI_ProjectPointOnCurve, GeomAPI_Proj
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
 
+from ..geometry.part import optimal_box
 from ..tolerances import DEFAULT, Tolerances
 from ..trim import BOUNDARY, INSIDE, OUTSIDE
 
@@ -178,10 +177,7 @@ class FaceProbe:
     def bbox(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) corners of the face's optimal bounding box, mm (computed once)."""
         if self._bbox is None:
-            box = Bnd_Box()
-            BRepBndLib.AddOptimal_s(self.face, box, False, False)
-            xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
-            self._bbox = np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
+            self._bbox = optimal_box(self.face, use_triangulation=False)
         return self._bbox
 
 
