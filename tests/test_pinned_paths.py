@@ -2,7 +2,8 @@
 
 fixtures/pinned_paths.npz was written by fixtures/build_pinned_paths.py (R 3 mm, 1.5 in
 narrow_slot; f = 0.1 mm). Points and contact parameters must agree to 1e-12 (mm, or
-native parameter units); the eq. 16 bounds to 1e-12 relative. A change made on purpose
+native parameter units); the eq. 16 bounds to 1e-12 relative to the
+path's largest bound. A change made on purpose
 regenerates the file in the same commit.
 """
 
@@ -34,5 +35,8 @@ def test_fixture_path_is_unchanged(key, name, i, j):
     assert tp.points.shape == points.shape
     np.testing.assert_allclose(tp.points, points, rtol=0, atol=1e-12)
     np.testing.assert_allclose(tp.uv, uv, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(np.stack([b.eq16 for b in tp.bounds]), PINNED[f"{key}_eq16"],
-                               rtol=1e-12, atol=0)
+    eq16 = PINNED[f"{key}_eq16"]
+    # relative to each bound's own scale: a per-element 1e-12 on values 1e-6 below their
+    # neighbours compares last-digit noise of the cancellation (1e-18 mm seen across builds)
+    np.testing.assert_allclose(np.stack([b.eq16 for b in tp.bounds]), eq16, rtol=1e-12,
+                               atol=1e-12 * float(np.abs(eq16).max()))
