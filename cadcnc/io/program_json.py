@@ -1,0 +1,128 @@
+"""A program as JSON (format version 2) and back; version 1 toolpath files read as programs.
+
+Layout (``format: "cadcnc-program"``, ``version: 2``)::
+
+    {"format": "cadcnc-program", "version": 2,
+     "job": {...}                     the program's job (Job.to_inputs keys),
+     "segments": [                    in machining order
+        {"kind": "cut", "faces": [i, j], "edge": k, "stretch": s, "points": [[x, y, z], ...],
+         "stop_reason": ..., ... every key of a version 1 toolpath (inputs, contacts,
+         normals, uv, steps, commanded, bounds, accuracy_*)},
+        {"kind": "link", "points": [[x, y, z], ...], "rapid": [true, false, ...]}, ...],
+     "skipped": [{"faces": [i, j], "edge": k, "reason": ..., "detail": ...}, ...],
+     "summary": {"complete": ..., "cut_length_mm": ..., "link_length_mm": ...,
+                 "time_at_feed_s": ..., "cuts": ..., "links": ..., "skipped": ...}}
+
+Points are ball centres in mm; ``rapid[k]`` says whether link move k (point k to k + 1) is
+a rapid (else a feed move at the plunge feed). Written atomically.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..job import Job
+from ..jsonable import plain
+from ..program.program import CutSegment, LinkSegment, Program, Skipped
+from . import toolpath_json as v1
+from .atomic import write_text
+
+FORMAT = "cadcnc-program"
+VERSION = 2
+
+
+def _cut_to_dict(seg: CutSegment) -> dict:
+    d = v1.toolpath_to_dict(seg.path)
+    del d["format"], d["version"]
+    return {"kind": "cut", "faces": d.pop("faces"), "edge": seg.edge,
+            "stretch": seg.stretch, "points": d.pop("points"), **d}
+
+
+def program_to_dict(program: Program) -> dict:
+    """Everything in a :class:`Program` as JSON-ready objects (see the module doc)."""
+    segments = []
+    for seg in program.segments:
+        if seg.kind == "cut":
+            segments.append(_cut_to_dict(seg))
+        else:
+            segments.append({"kind": "link", "points": seg.points.tolist(),
+                             "rapid": seg.rapid.tolist()})
+    return {
+        "format": FORMAT, "version": VERSION,
+        "job": plain(program.job.to_inputs(), nonfinite_as_strings=True),
+        "segments": segments,
+        "skipped": [{"faces": list(s.faces), "edge": s.edge, "reason": s.reason,
+                     "detail": s.detail} for s in program.skipped],
+        "summary": plain({"complete": program.complete, **program.totals()},
+                         nonfinite_as_strings=True),
+    }
+
+
+def _segment(d: dict, k: int):
+    kind = d.get("kind") if isinstance(d, dict) else None
+    if kind == "link":
+        pts = np.array(d["points"], dtype=float)
+        if not np.all(np.isfinite(pts)):
+            raise InputError(f"segment {k} (link) has a non-finite point")
+        return LinkSegment(pts, d.get("rapid", [True] * (len(pts) - 1)))
+    if kind == "cut":
+        body = {key: v for key, v in d.items() if key not in ("kind", "edge", "stretch")}
+        try:
+            path = v1.toolpath_from_dict({**body, "format": v1.FORMAT, "version": v1.VERSION})
+        except InputError as e:
+            raise InputError(f"segment {k} (cut): {e}") from None
+        return CutSegment(path, d.get("edge"), d.get("stretch"))
+    raise InputError(f"segment {k}: kind must be \"cut\" or \"link\", got {kind!r}")
+
+
+def program_from_dict(d: dict) -> Program:
+    """The :class:`Program` of a version 2 dict, or of a version 1 toolpath dict."""
+    if isinstance(d, dict) and d.get("format") == v1.FORMAT:
+        return Program.of_paths([v1.toolpath_from_dict(d)])
+    if not isinstance(d, dict) or d.get("format") != FORMAT:
+        raise InputError("not a cadcnc program or toolpath (no \"format\": "
+                         "\"cadcnc-program\" or \"cadcnc-toolpath\")")
+    if d.get("version") != VERSION:
+        raise InputError(f"program format version {d.get('version')!r} is not supported "
+                         f"(this cadcnc reads version {VERSION}, and toolpath version "
+                         f"{v1.VERSION})")
+    try:
+        segments = [_segment(s, k) for k, s in enumerate(d["segments"], 1)]
+        skipped = [Skipped(tuple(s["faces"]), s["reason"], s.get("detail", ""), s.get("edge"))
+                   for s in d.get("skipped", [])]
+        cuts = [s for s in segments if s.kind == "cut"]
+        job = Job.from_inputs(d["job"], cuts[0].path.faces if cuts else (None, None))
+    except (KeyError, TypeError, ValueError) as e:
+        raise InputError(f"program JSON is incomplete or malformed ({type(e).__name__}: "
+                         f"{e})") from None
+    if not cuts and not skipped:
+        raise InputError("program JSON has no cut segment and nothing skipped")
+    return Program(job, segments, skipped)
+
+
+def program_json(program: Program) -> str:
+    return json.dumps(program_to_dict(program), separators=(",", ":")) + "\n"
+
+
+def write_program_json(program: Program, out) -> None:
+    """Write ``program`` to ``out`` as JSON version 2 (atomic)."""
+    write_text(out, program_json(program))
+
+
+def read_program(file) -> Program:
+    """Read a program (version 2) or toolpath (version 1) JSON file; errors name the file."""
+    file = Path(file)
+    try:
+        data = json.loads(file.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(f"{file}: no such file") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise InputError(f"{file}: not a program JSON file ({e})") from None
+    try:
+        return program_from_dict(data)
+    except InputError as e:
+        raise InputError(f"{file}: {e}") from None

@@ -1,0 +1,106 @@
+"""The program of linked moves: links, totals, JSON version 2 round trip, version 1 read."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from cadcnc.errors import InputError
+from cadcnc.io.program_json import program_to_dict, read_program, write_program_json
+from cadcnc.io.toolpath_json import write_json
+from cadcnc.program.linking import APPROACH, link, linked
+from cadcnc.program.program import CutSegment, Program, Skipped
+from conftest import fixture_path
+from test_writers import assert_same_path
+
+
+@pytest.fixture(scope="module")
+def two_cuts():
+    """Two floor-to-wall corners of the pocket: two separate cuts."""
+    return [fixture_path("pocket", i, 17) for i in (8, 12)]
+
+
+def test_link_retracts_rapids_and_plunges():
+    a, b = np.array([0.0, 0.0, 1.0]), np.array([10.0, 5.0, -2.0])
+    ln = link(a, b, z_safe=20.0)
+    np.testing.assert_array_equal(ln.points, [a, [0, 0, 20], [10, 5, 20],
+                                              [10, 5, -2 + APPROACH], b])
+    assert ln.rapid.tolist() == [True, True, True, False]
+    assert ln.feed_length == pytest.approx(APPROACH)
+    assert ln.length == pytest.approx(19 + np.hypot(10, 5) + 22)
+
+
+def test_linked_program_order_and_totals(two_cuts):
+    cuts = [CutSegment(p, edge=k + 1) for k, p in enumerate(two_cuts)]
+    z = 60.0
+    prog = Program(two_cuts[0].job, linked(cuts, z), [Skipped((1, 2), "too short", "x")])
+    kinds = [s.kind for s in prog.segments]
+    assert kinds == ["link", "cut", "link", "cut", "link"]
+    moves = prog.all_moves()
+    # consecutive segments join: every link starts where the previous cut ended
+    for before, after in zip(prog.segments, prog.segments[1:]):
+        np.testing.assert_array_equal(before.points[-1], after.points[0])
+    assert moves[:, 2].max() == pytest.approx(z)
+    assert prog.cut_length == pytest.approx(sum(p.length for p in two_cuts))
+    feed_s = sum(p.duration for p in two_cuts) + 2 * APPROACH / prog.job.feed * 60
+    assert prog.time_at_feed == pytest.approx(feed_s)
+    assert prog.complete == all(p.complete for p in two_cuts)
+
+
+def test_joined_cuts_need_no_link(two_cuts):
+    p = two_cuts[0]
+    assert [s.kind for s in linked([CutSegment(p), CutSegment(p)], 99.0)].count("link") == 3
+    # the saddle's two edges meet end to start: one continuous cut, no link between
+    halves = [CutSegment(fixture_path("crossing_cylinders", 1, 2, edge=k)) for k in (0, 1)]
+    assert [s.kind for s in linked(halves, 99.0)] == ["link", "cut", "cut", "link"]
+
+
+def test_program_json_round_trip(two_cuts, tmp_path):
+    cuts = [CutSegment(p, edge=k + 1, stretch=1) for k, p in enumerate(two_cuts)]
+    prog = Program(two_cuts[0].job, linked(cuts, 60.0),
+                   [Skipped((3, 4), "tangent", "faces meet along a tangent edge", 2)])
+    out = tmp_path / "prog.json"
+    write_program_json(prog, out)
+    d = json.loads(out.read_text())
+    assert (d["format"], d["version"]) == ("cadcnc-program", 2)
+    assert [s["kind"] for s in d["segments"]] == ["link", "cut", "link", "cut", "link"]
+    assert d["segments"][1]["faces"] == [8, 17] and d["segments"][1]["edge"] == 1
+    back = read_program(out)
+    assert back.skipped == prog.skipped
+    for a, b in zip(back.segments, prog.segments):
+        assert a.kind == b.kind
+        if a.kind == "cut":
+            assert_same_path(a.path, b.path)
+            assert (a.edge, a.stretch) == (b.edge, b.stretch)
+        else:
+            np.testing.assert_array_equal(a.points, b.points)
+            np.testing.assert_array_equal(a.rapid, b.rapid)
+    assert d["summary"]["cuts"] == 2 and d["summary"]["links"] == 3
+
+
+def test_version_1_reads_as_a_program_of_one_cut(two_cuts, tmp_path):
+    out = tmp_path / "v1.json"
+    write_json(two_cuts[0], out)
+    prog = read_program(out)
+    assert len(prog.segments) == 1 and prog.cuts[0].edge == 1
+    assert_same_path(prog.paths[0], two_cuts[0])
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda d: d.update(version=3), "version 3 is not supported"),
+    (lambda d: d.update(format="x"), "not a cadcnc program"),
+    (lambda d: d["segments"][0].update(kind="jump"), "segment 1: kind must be"),
+    (lambda d: d["segments"][0]["points"][0].__setitem__(0, "NaN"), "non-finite"),
+    (lambda d: d["segments"][1].pop("uv"), r"segment 2 \(cut\)"),
+    (lambda d: d.update(segments=[], skipped=[]), "no cut segment"),
+])
+def test_program_json_errors(two_cuts, tmp_path, change, message):
+    prog = Program(two_cuts[0].job, linked([CutSegment(two_cuts[0])], 60.0))
+    d = json.loads(json.dumps(program_to_dict(prog)))
+    change(d)
+    f = tmp_path / "bad.json"
+    f.write_text(json.dumps(d))
+    with pytest.raises(InputError, match=message):
+        read_program(f)
