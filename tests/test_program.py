@@ -104,3 +104,47 @@ def test_program_json_errors(two_cuts, tmp_path, change, message):
     f.write_text(json.dumps(d))
     with pytest.raises(InputError, match=message):
         read_program(f)
+
+
+def test_program_gcode_moves_are_the_programs(two_cuts):
+    """Every move written, parsed back, is the program's own sequence of points."""
+    from cadcnc.io.gcode import programmed_moves
+    from cadcnc.io.program_gcode import program_ngc
+
+    prog = Program(two_cuts[0].job, linked([CutSegment(p) for p in two_cuts], 60.0))
+    text = program_ngc(prog, plunge_feed=300.0)
+    moves = programmed_moves(text)
+    want = [prog.segments[0].points[0]]
+    for seg in prog.segments:
+        want += list(seg.points[1:])
+    np.testing.assert_allclose(moves, np.array(want), rtol=0, atol=0.5e-4 * np.sqrt(3))
+    assert text.count("F300") == 2 and "G0 X" in text and text.rstrip().endswith("%")
+    tip = programmed_moves(program_ngc(prog, tool_tip=True), tool_tip_offset=3.0)
+    np.testing.assert_allclose(tip, moves, atol=1e-4)
+
+
+def test_rs274_reads_the_program_moves(two_cuts, tmp_path):
+    """rs274 executes every feed and rapid move of a linked program, at the program's points."""
+    import re
+    import subprocess
+
+    from cadcnc.io.program_gcode import program_ngc
+    from test_gcode import RS274, RS274_DECIMALS
+
+    if RS274 is None:
+        pytest.skip("LinuxCNC rs274 not installed")
+    prog = Program(two_cuts[0].job, linked([CutSegment(p) for p in two_cuts], 60.0))
+    src, out = tmp_path / "p.ngc", tmp_path / "canon.txt"
+    src.write_text(program_ngc(prog, plunge_feed=300.0))
+    run = subprocess.run([RS274, "-g", str(src), str(out)], capture_output=True, text=True,
+                         timeout=60)
+    assert run.returncode == 0, run.stderr
+    canon = out.read_text()
+    moves = np.array([[float(v) for v in m.group(2).split(",")[:3]] for m in re.finditer(
+        r"STRAIGHT_(FEED|TRAVERSE)\(([^)]*)\)", canon)])
+    want = [prog.segments[0].points[0]]
+    for seg in prog.segments:
+        want += list(seg.points[1:])
+    # the first rapid gives Z only (X, Y from the machine's start): compare from the second
+    np.testing.assert_allclose(moves[1:], np.array(want), rtol=0,
+                               atol=0.5 * 10.0 ** -RS274_DECIMALS + 1e-9)

@@ -1,0 +1,86 @@
+"""RS274/NGC of a :class:`~cadcnc.program.program.Program`: its cuts and links, in order.
+
+The same conventions as :mod:`cadcnc.io.gcode` (mm, absolute, ``G64 P<tolerance>``,
+points dropped by Douglas-Peucker within ``tolerance`` on cuts, fewest decimals keeping
+rounding within a tenth of it). Each segment's moves are written as they are: a cut's
+points as ``G1`` at the job's feed, a link's moves as ``G0`` (rapid) or ``G1`` at the
+plunge feed. The program starts with a rapid to the first segment's height and ends with
+``M2``. With ``tool_tip`` the programmed point is the ball's tip (centre Z - R).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+from ..job import check_number
+from ..program.program import Program
+from .gcode import DEFAULT_TOLERANCE, _comment, _num, digits_for, simplify
+
+
+def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: bool = False,
+                spindle: float | None = None, plunge_feed: float | None = None,
+                title: str = "") -> str:
+    """One RS274/NGC program for ``program`` (see the module doc); InputError on a point
+    or word that cannot be written."""
+    if not program.segments:
+        raise InputError("the program has no segment: nothing to write")
+    tol = DEFAULT_TOLERANCE if tolerance is None else float(tolerance)
+    digits = digits_for(tol)
+    feed = program.job.feed
+    plunge = feed if plunge_feed is None else check_number("plunge feed", plunge_feed,
+                                                            "mm/min")
+    if spindle is not None:
+        check_number("spindle speed", spindle, "rpm")
+    for name, f in (("feed", feed), ("plunge feed", plunge)):
+        if float(_num(f, 3)) <= 0:
+            raise InputError(f"{name} {f:g} mm/min prints as F0: too slow for G-code")
+    dz = program.job.tool.radius if tool_tip else 0.0
+    n = lambda v: _num(v, digits)  # noqa: E731
+    xyz = lambda p: f"X{n(p[0])} Y{n(p[1])} Z{n(p[2] - dz)}"  # noqa: E731
+    for k, seg in enumerate(program.segments, 1):
+        if not np.all(np.isfinite(seg.points)):
+            raise InputError(f"segment {k} ({seg.kind}) has a non-finite point: nothing "
+                             "written")
+    point_name = "tool tip (ball centre Z - R)" if tool_tip else "ball centre"
+    first = program.segments[0].points[0]
+    lines = [
+        "%",
+        _comment(f"cadcnc {title}".strip()),
+        _comment(f"programmed point: {point_name}; units mm; +Z is the spindle axis"),
+        _comment(f"tolerance {tol:g} mm ({'points dropped' if tolerance else 'every point kept'}"
+                 f"); {digits} decimals; feed {_num(feed, 3)}, plunge {_num(plunge, 3)} "
+                 "mm/min"),
+        "G17 G21 G40 G90 G94",
+        f"G64 P{_num(tol, digits)}",
+        f"G0 Z{n(first[2] - dz)}",
+    ]
+    if spindle:
+        lines.append(f"S{_num(spindle, 0)} M3")
+    lines.append(f"G0 X{n(first[0])} Y{n(first[1])}")
+    current = None  # the feed word in force
+    for k, seg in enumerate(program.segments, 1):
+        if seg.kind == "cut":
+            path = seg.path
+            keep = simplify(seg.points, tolerance) if tolerance else np.arange(len(seg.points))
+            lines.append(_comment(
+                f"cut {k}: faces {path.faces[0]} {path.faces[1]}, {len(keep)} of "
+                f"{len(seg.points)} points, stop: {path.stop_reason}"))
+            if current != feed:
+                lines.append(f"F{_num(feed, 3)}")
+                current = feed
+            lines += [f"G1 {xyz(p)}" for p in seg.points[keep[1:]]]
+            continue
+        lines.append(_comment(f"link {k}"))
+        for p, rapid in zip(seg.points[1:], seg.rapid):
+            if rapid:
+                lines.append(f"G0 {xyz(p)}")
+                continue
+            if current != plunge:
+                lines.append(f"F{_num(plunge, 3)}")
+                current = plunge
+            lines.append(f"G1 {xyz(p)}")
+    if spindle:
+        lines.append("M5")
+    lines += ["M2", "%"]
+    return "\n".join(lines) + "\n"
