@@ -148,3 +148,21 @@ def test_rs274_reads_the_program_moves(two_cuts, tmp_path):
     # the first rapid gives Z only (X, Y from the machine's start): compare from the second
     np.testing.assert_allclose(moves[1:], np.array(want), rtol=0,
                                atol=0.5 * 10.0 ** -RS274_DECIMALS + 1e-9)
+
+
+@pytest.mark.parametrize("suffix", [".png", ".glb"])
+def test_program_pictures(two_cuts, tmp_path, suffix):
+    """The picture shows the part, one line per cut and the links."""
+    from cadcnc.io.program_plot import program_scene, write_program_picture
+    from conftest import load_fixture
+
+    part = load_fixture("pocket")
+    prog = Program(two_cuts[0].job, linked([CutSegment(p) for p in two_cuts], 60.0))
+    out = tmp_path / f"p{suffix}"
+    write_program_picture(prog, part, out, title="pocket")
+    magic = b"\x89PNG\r\n\x1a\n" if suffix == ".png" else b"glTF"
+    assert out.read_bytes().startswith(magic)
+    if suffix == ".glb":
+        names = set(program_scene(prog, part).geometry)
+        assert {"cut2", "cut4", "link1", "link3", "link5"} <= names
+        assert sum(n.startswith("face") for n in names) == len(part.faces)
