@@ -43,8 +43,8 @@ def faces(args) -> int:
     print(f"{args.step}: {len(part)} faces; material side: {data['material']['rule']}")
     if data["material"].get("sewing"):
         sewn = data["material"]["sewing"]
-        print(f"sewn at {sewn['tolerance_mm']:g} mm: widest gap closed "
-              f"{sewn['widest_gap_mm']:.3g} mm, {sewn['free_edges']} free edges")
+        print(f"sewn at {sewn['tolerance_mm']:g} mm: largest edge tolerance "
+              f"{sewn['max_edge_tolerance_mm']:.3g} mm, {sewn['free_edges']} free edges")
     print(f"{'face':>4}  {'kind':<10} {'area mm^2':>11}  neighbours: face class "
           "material-angle deg")
     for f in data["faces"]:

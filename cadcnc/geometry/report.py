@@ -36,13 +36,13 @@ def faces_report(part: Part) -> dict:
 def material_report(part: Part) -> dict:
     """{"rule", "flipped", ["shells", "sewing"]}: which rule put the material where
     (docs/surface_models.md); for a surface model each shell's faces and rule, and the
-    sewing tolerance, widest gap closed (mm) and free edges."""
+    sewing tolerance, largest edge tolerance after sewing (mm) and free edges."""
     out = {"rule": part.material_rule, "flipped": part.flip_material}
     model = part.surface_model
     if model is not None:
         out["shells"] = [s.to_dict() for s in model.shells]
         out["sewing"] = {"tolerance_mm": model.sewn.tolerance,
-                         "widest_gap_mm": model.sewn.gap,
+                         "max_edge_tolerance_mm": model.sewn.edge_tolerance,
                          "free_edges": model.sewn.free_edges}
     return out
 

@@ -30,13 +30,14 @@ class Sewn:
     """The result of sewing: ``shells`` (TopoDS_Shell, each consistently oriented),
     ``numbers`` (one list per shell: the file's 1-based face number of each face, in the
     shell's own order), the ``tolerance`` used and the largest edge tolerance after sewing
-    (``gap``, the widest gap sewing closed), mm, and ``free_edges`` (edges of one face
+    (``edge_tolerance``, mm: it bounds every gap between sewn faces, the file's own
+    included), and ``free_edges`` (edges of one face
     only: an open shell's border, or a gap wider than the tolerance)."""
 
     shells: list
     numbers: list[list[int]]
     tolerance: float
-    gap: float
+    edge_tolerance: float
     free_edges: int
     n_faces: int
     face_map: TopTools_IndexedMapOfShape  # the sewn faces; index = the file's face number
