@@ -107,7 +107,7 @@ def test_step_with_one_face_is_an_open_surface_model(tmp_path):
 def test_step_with_no_face(tmp_path):
     wire_only = tmp_path / "wire.step"
     cq.exporters.export(cq.Workplane().rect(10, 10), str(wire_only))
-    with pytest.raises(StepFileError, match="holds no (faces|shape)"):
+    with pytest.raises(StepFileError, match="holds no faces"):
         cadcnc.load_step(wire_only)
 
 
