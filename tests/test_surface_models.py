@@ -23,7 +23,7 @@ from OCP.TopoDS import TopoDS_Compound
 
 import cadcnc
 from cadcnc.cli.app import main
-from cadcnc.geometry.material_side import CLOSED_SHELL, FLIPPED, OPEN_SHELL
+from cadcnc.geometry.material_side import CLOSED_SHELL, FLIPPED, OPEN_LEVEL, OPEN_SHELL
 from cadcnc.geometry.report import faces_report
 from cadcnc.geometry.sewing import file_faces, inconsistent_edges, sew
 from cadcnc.geometry.step_file import read_step
@@ -234,3 +234,14 @@ def test_cli_path_on_loose_faces_is_verified_on_the_same_material_side(tmp_path)
     code, _, err = cli("path", loose, "--faces", 4, 5, *job, "-o", tmp_path / "f.json",
                        "--flip-material")
     assert code != 0 and "convex" in err and not (tmp_path / "f.json").exists()
+
+
+def test_a_vertical_sheet_faces_neither_way_and_keeps_the_files_normals():
+    import cadquery as cq
+
+    for direction in ((1, 0, 0), (-1, 0, 0)):
+        part = cadcnc.Part(cq.Face.makePlane(10, 10, dir=direction).wrapped)
+        assert part.material_rule == OPEN_LEVEL
+        shell, = part.surface_model.shells
+        assert abs(shell.flux_mm2) < 1e-9 * shell.area_mm2 + 1e-9
+        assert np.allclose(part.face(1).normal(*middle(part.face(1))), direction)
