@@ -8,6 +8,7 @@ them, with no cadcnc code.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import io
 import json
 import math
@@ -15,9 +16,11 @@ import math
 import numpy as np
 import pytest
 from OCP.BRep import BRep_Builder
-from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy, BRepBuilderAPI_Transform
+from OCP.BRepBuilderAPI import (BRepBuilderAPI_Copy, BRepBuilderAPI_MakeVertex,
+                                BRepBuilderAPI_Transform)
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepGProp import BRepGProp
-from OCP.gp import gp_Trsf, gp_Vec
+from OCP.gp import gp_Pnt, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Compound
 
@@ -245,3 +248,41 @@ def test_a_vertical_sheet_faces_neither_way_and_keeps_the_files_normals():
         shell, = part.surface_model.shells
         assert abs(shell.flux_mm2) < 1e-9 * shell.area_mm2 + 1e-9
         assert np.allclose(part.face(1).normal(*middle(part.face(1))), direction)
+
+
+def _shifted(tp, keep, shift):
+    sub = {f.name: getattr(tp, f.name)[keep] for f in dataclasses.fields(tp)
+           if f.name in ("points", "contacts", "normals", "uv", "steps", "commanded")}
+    sub["points"] = sub["points"] + np.asarray(shift, float)
+    return dataclasses.replace(tp, **sub, bounds=None)
+
+
+def _distance_to(shape, points) -> np.ndarray:
+    dss = BRepExtrema_DistShapeShape()
+    dss.LoadS2(shape)
+    out = []
+    for p in points:
+        dss.LoadS1(BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex())
+        dss.Perform()
+        out.append(dss.Value())
+    return np.array(out)
+
+
+@pytest.mark.parametrize("shift, inside", [
+    ((0, 0, -1), False),   # the ball 1 mm into the floor, its centre above it
+    ((20, 0, -9), True),   # centres 6 mm under the floor, far from the wall
+    ((-5, 0, -5), True),   # behind the wall and under the floor: nearest point the edge
+], ids=["cut", "under the floor", "in the wedge"])
+def test_the_gate_refuses_an_open_sheet_path_in_its_material(shift, inside):
+    part = part_of("surf_sheet")
+    tp = cadcnc.intersection_path(part.face(1), part.face(2), radius=3, feed=1500,
+                                  period=0.004)
+    keep = np.nonzero(np.abs(tp.points[:, 1] - 15) <= 5)[0]
+    bad = _shifted(tp, keep, shift)
+    gate = gouge_gate(bad, part)
+    assert not gate.ok and gate.in_material == inside
+    d = _distance_to(part.shape, bad.points)  # OCCT's distance to the whole sheet
+    expected = 3 + d.max() if inside else 3 - d.min()
+    at_centres = max(h.depth_mm for h in gate.hits)  # the moves' sag may add a little
+    assert at_centres == pytest.approx(expected, abs=1e-6)
+    assert expected - 1e-6 <= gate.depth_mm <= expected + 1e-3
