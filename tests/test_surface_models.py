@@ -26,7 +26,7 @@ from OCP.TopoDS import TopoDS_Compound
 
 import cadcnc
 from cadcnc.cli.app import main
-from cadcnc.geometry.material_side import CLOSED_SHELL, FLIPPED, OPEN_LEVEL, OPEN_SHELL
+from cadcnc.geometry.material_side import CLOSED_SHELL, FLIPPED, OPEN_LEVEL, OPEN_SHELL, VOID
 from cadcnc.geometry.report import faces_report
 from cadcnc.geometry.sewing import file_faces, inconsistent_edges, sew
 from cadcnc.geometry.step_file import read_step
@@ -286,3 +286,31 @@ def test_the_gate_refuses_an_open_sheet_path_in_its_material(shift, inside):
     at_centres = max(h.depth_mm for h in gate.hits)  # the moves' sag may add a little
     assert at_centres == pytest.approx(expected, abs=1e-6)
     assert expected - 1e-6 <= gate.depth_mm <= expected + 1e-3
+
+
+def test_a_closed_shell_inside_another_is_a_void():
+    """A block with a closed inner cavity, as loose faces: the cavity's shell is a void of
+    the block (as in the solid), not a second body; an island inside the void is material."""
+    import cadquery as cq
+
+    solid = (cq.Workplane().box(40, 40, 40).cut(cq.Workplane().box(20, 20, 20))
+             .union(cq.Workplane().box(6, 6, 6))).val().wrapped
+    by_faces = cadcnc.Part(_loose_copy(solid))
+    rules = sorted(s.rule for s in by_faces.surface_model.shells)
+    assert rules == [CLOSED_SHELL, CLOSED_SHELL, VOID]
+    as_solid = cadcnc.Part(solid)
+    assert {p: as_solid.pair_class(*p) for p in as_solid.adjacency} == \
+        {p: by_faces.pair_class(*p) for p in by_faces.adjacency}
+    assert "concave" in {by_faces.pair_class(*p) for p in by_faces.adjacency}  # the cavity
+    material = Material(PartFaces(by_faces, {}, DEFAULT), DEFAULT)
+    states = [material.state(p) for p in ((15, 0, 0), (7, 0, 0), (0, 0, 0), (30, 0, 0))]
+    assert states == [IN, OUT, IN, OUT]  # wall, cavity, island, outside
+
+
+def _loose_copy(shape) -> TopoDS_Compound:
+    fmap = file_faces(shape)
+    builder, compound = BRep_Builder(), TopoDS_Compound()
+    builder.MakeCompound(compound)
+    for k in range(1, fmap.Extent() + 1):
+        builder.Add(compound, BRepBuilderAPI_Copy(fmap.FindKey(k)).Shape())
+    return compound

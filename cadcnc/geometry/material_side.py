@@ -2,7 +2,9 @@
 
 - A **solid** (as read): its inside, as today.
 - A **closed shell**: the volume it encloses; it is made a solid (``BRepBuilderAPI_MakeSolid``
-  then ``BRepLib::OrientClosedSolid``, which turns the shell so the volume is finite).
+  then ``BRepLib::OrientClosedSolid``, which turns the shell so the volume is finite). A
+  closed shell inside another (an odd number of others) is a void of the solid around it,
+  as in a solid with an inner cavity.
 - An **open shell**: the side its faces' normals point away from, the normals chosen so
   that most of the area faces the tool axis +Z: the shell is reversed when its
   area-weighted normal z component, the flux F = sum over faces of the integral of n.z dA
@@ -20,11 +22,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid
+from OCP.BRepClass3d import BRepClass3d_SolidClassifier
 from OCP.BRepLib import BRepLib
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
-from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
+from OCP.TopAbs import TopAbs_FACE, TopAbs_IN, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_VERTEX
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Compound
@@ -35,9 +40,12 @@ SOLID = "solid"
 CLOSED_SHELL = "closed shell"
 OPEN_SHELL = "open shell: normals chosen to face +Z"
 OPEN_LEVEL = "open shell: no side faces +Z, normals as in the file"
+VOID = "closed shell: a void inside another (material around it)"
 FLIPPED = "flipped by --flip-material"
 LEVEL_FRACTION = 1e-3
 """|F| / area below this: the open shell faces neither +Z nor -Z (the file's normals kept)."""
+NESTED = 1e-7
+"""Boundary tolerance (mm) of the classifier that tells whether a shell lies in another."""
 MESH_DEFLECTION = 0.01
 """Relative linear deflection of the triangulation the flux F is summed on (a sign test)."""
 
@@ -109,13 +117,15 @@ def material_sides(sewn: Sewn) -> SurfaceModel:
     builder = BRep_Builder()
     compound = TopoDS_Compound()
     builder.MakeCompound(compound)
+    closed = [BRep_Tool.IsClosed_s(shell) for shell in sewn.shells]
+    solids, voids = _solids([s for s, c in zip(sewn.shells, closed) if c])
+    for solid in solids:
+        builder.Add(compound, solid)
+    voids = iter(voids)
     sides = []
-    for shell, numbers in zip(sewn.shells, sewn.numbers):
-        if BRep_Tool.IsClosed_s(shell):
-            solid = BRepBuilderAPI_MakeSolid(shell).Solid()
-            BRepLib.OrientClosedSolid_s(solid)
-            builder.Add(compound, solid)
-            sides.append(ShellSide(sorted(numbers), True, CLOSED_SHELL))
+    for shell, numbers, is_closed in zip(sewn.shells, sewn.numbers, closed):
+        if is_closed:
+            sides.append(ShellSide(sorted(numbers), True, VOID if next(voids) else CLOSED_SHELL))
             continue
         flux, area = flux_z(shell)
         rule = OPEN_SHELL
@@ -127,6 +137,56 @@ def material_sides(sewn: Sewn) -> SurfaceModel:
         sides.append(ShellSide(sorted(numbers), False, rule, flux, area))
     faces = oriented_faces(compound, sewn)
     return SurfaceModel(compound, faces, sides, sewn)
+
+
+def _solids(shells: list) -> tuple[list, list[bool]]:
+    """(solids, void flag per shell) of closed shells: each shell bounds a finite volume;
+    one nested in an odd number of others is a void of the one directly around it (the
+    nesting depth's parity, so an island inside a void is material again)."""
+    finite = []
+    for shell in shells:
+        solid = BRepBuilderAPI_MakeSolid(shell).Solid()
+        BRepLib.OrientClosedSolid_s(solid)
+        finite.append(solid)
+    within = [[i != j and _inside(finite[j], finite[i]) for i in range(len(finite))]
+              for j in range(len(finite))]  # within[j][i]: shell j lies inside solid i
+    depth = [sum(row) for row in within]
+    void = [d % 2 == 1 for d in depth]
+    solids = []
+    for i, outer in enumerate(finite):
+        if void[i]:
+            continue
+        maker = BRepBuilderAPI_MakeSolid(_shell_of(outer))
+        for j, inner in enumerate(finite):
+            if void[j] and within[j][i] and depth[j] == depth[i] + 1:
+                maker.Add(TopoDS.Shell_s(_shell_of(inner).Reversed()))
+        solids.append(maker.Solid())
+    return solids, void
+
+
+def _shell_of(solid):
+    """The (only) shell of a solid made of one shell, as oriented in it."""
+    return TopoDS.Shell_s(TopExp_Explorer(solid, TopAbs_SHELL).Current())
+
+
+def _inside(inner, outer) -> bool:
+    """Whether the closed shell of solid ``inner`` lies inside solid ``outer`` (tested at
+    one of its vertices: closed shells of a valid model do not cross)."""
+    lo_i, hi_i = _box(inner)
+    lo_o, hi_o = _box(outer)
+    if np.any(hi_i < lo_o) or np.any(hi_o < lo_i):  # apart
+        return False
+    vertex = TopoDS.Vertex_s(TopExp_Explorer(inner, TopAbs_VERTEX).Current())
+    classifier = BRepClass3d_SolidClassifier(outer, BRep_Tool.Pnt_s(vertex), NESTED)
+    return classifier.State() == TopAbs_IN
+
+
+def _box(shape) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi) of OCCT's loose bounding box of a shape, mm."""
+    box = Bnd_Box()
+    BRepBndLib.Add_s(shape, box, False)
+    xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
+    return np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
 
 
 def oriented_faces(shape, sewn: Sewn) -> list:
