@@ -30,9 +30,10 @@ from OCP.BRepClass3d import BRepClass3d_SolidClassifier
 from OCP.BRepLib import BRepLib
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
 from OCP.TopAbs import TopAbs_FACE, TopAbs_IN, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_VERTEX
-from OCP.TopExp import TopExp_Explorer
+from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Compound
+from OCP.TopTools import TopTools_IndexedMapOfShape
 
 from .sewing import Sewn
 
@@ -46,6 +47,8 @@ LEVEL_FRACTION = 1e-3
 """|F| / area below this: the open shell faces neither +Z nor -Z (the file's normals kept)."""
 NESTED = 1e-7
 """Boundary tolerance (mm) of the classifier that tells whether a shell lies in another."""
+NESTED_VERTICES = 64
+"""At most this many vertices of a shell are classified to call it nested in another."""
 MESH_DEFLECTION = 0.01
 """Relative linear deflection of the triangulation the flux F is summed on (a sign test)."""
 
@@ -170,19 +173,25 @@ def _shell_of(solid):
 
 
 def _inside(inner, outer) -> bool:
-    """Whether the closed shell of solid ``inner`` lies inside solid ``outer`` (tested at
-    one of its vertices: closed shells of a valid model do not cross)."""
+    """Whether the closed shell of solid ``inner`` lies inside solid ``outer``: its box
+    inside the other's and every one of its vertices (up to :data:`NESTED_VERTICES`)
+    classified IN, so that two bodies that merely overlap are not taken for a void."""
     lo_i, hi_i = _box(inner)
     lo_o, hi_o = _box(outer)
-    if np.any(hi_i < lo_o) or np.any(hi_o < lo_i):  # apart
+    if np.any(lo_i < lo_o) or np.any(hi_i > hi_o):
         return False
-    vertex = TopoDS.Vertex_s(TopExp_Explorer(inner, TopAbs_VERTEX).Current())
-    classifier = BRepClass3d_SolidClassifier(outer, BRep_Tool.Pnt_s(vertex), NESTED)
-    return classifier.State() == TopAbs_IN
+    vertices = TopTools_IndexedMapOfShape()
+    TopExp.MapShapes_s(inner, TopAbs_VERTEX, vertices)
+    classifier = BRepClass3d_SolidClassifier(outer)
+    for k in range(1, min(vertices.Extent(), NESTED_VERTICES) + 1):
+        classifier.Perform(BRep_Tool.Pnt_s(TopoDS.Vertex_s(vertices.FindKey(k))), NESTED)
+        if classifier.State() != TopAbs_IN:
+            return False
+    return True
 
 
 def _box(shape) -> tuple[np.ndarray, np.ndarray]:
-    """(lo, hi) of OCCT's loose bounding box of a shape, mm."""
+    """(lo, hi) of OCCT's bounding box of a shape (enlarged by its tolerances), mm."""
     box = Bnd_Box()
     BRepBndLib.Add_s(shape, box, False)
     xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
