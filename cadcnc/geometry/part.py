@@ -99,8 +99,8 @@ class Part:
 
     A shape without a solid (shells, loose faces) is sewn at ``tol.sewing`` and each shell
     given a material side (:mod:`.material_side`); ``surface_model`` keeps the shells, the
-    rules and the sewing figures (None for a solid). Face numbers are always the shape's
-    own ``TopExp::MapShapes`` order. ``flip_material`` inverts the material side of every
+    rules and the sewing figures (None for a solid), and ``shape`` becomes the sewn model.
+    Face numbers are always the ``TopExp::MapShapes`` order of the shape as given. ``flip_material`` inverts the material side of every
     face; ``material_rule`` says which rule applied.
     """
 
