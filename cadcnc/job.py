@@ -155,7 +155,9 @@ class Job:
     """One machining job: tool, feed (mm/min), period (s), operation, part, tolerances.
 
     ``source``: the part's STEP file (None for a CadQuery object). ``clearance``: the Z
-    height (mm) of rapid moves, None for the part's top plus a margin.
+    height (mm) of rapid moves, None for the part's top plus a margin. ``flip_material``:
+    the part is read with its material side inverted (``--flip-material``,
+    docs/surface_models.md), so that a saved path is verified on the same side.
     """
 
     tool: Tool
@@ -165,6 +167,7 @@ class Job:
     source: str | None = None
     clearance: float | None = None
     tolerances: Tolerances = DEFAULT
+    flip_material: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "feed", check_number("feed", self.feed, "mm/min"))
@@ -195,7 +198,8 @@ class Job:
                     period=self.period, start=None if op.start is None else list(op.start),
                     end=None if op.end is None else list(op.end),
                     offsets=list(self.offsets), edge=op.edge, source=self.source,
-                    shank_length=self.tool.shank_length, clearance=self.clearance)
+                    shank_length=self.tool.shank_length, clearance=self.clearance,
+                    flip_material=self.flip_material)
 
     @classmethod
     def from_inputs(cls, inputs: dict, faces=(None, None)) -> "Job":
@@ -210,6 +214,7 @@ class Job:
                           start=inputs.get("start"), end=inputs.get("end"),
                           edge=inputs.get("edge", 0))
             return cls(tool, inputs["feed"], inputs["period"], op, inputs.get("source"),
-                       inputs.get("clearance"))
+                       inputs.get("clearance"),
+                       flip_material=bool(inputs.get("flip_material", False)))
         except KeyError as e:
             raise InputError(f"the recorded job has no {e.args[0]!r}") from None

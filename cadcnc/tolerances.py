@@ -37,6 +37,9 @@ class Tolerances:
       both offset surfaces, and the chord between points within it too.
     - ``closed`` (mm): a curve (edge, intersection branch, polyline) whose ends are closer
       than this is a loop.
+    - ``sewing`` (mm): the faces of a surface model (no solid) are sewn at this tolerance:
+      edges closer than it are merged (docs/surface_models.md); the largest edge tolerance
+      after sewing is reported.
 
     Verification and gates:
 
@@ -85,6 +88,7 @@ class Tolerances:
     classify: float = 1e-7
     classify_loose: float = 1e-4
     intersection: float = 1e-7
+    sewing: float = 1e-2
 
     def __post_init__(self):
         for f in fields(self):

@@ -46,6 +46,13 @@ def _job_options(p, required: bool) -> None:
     p.add_argument("--end", metavar="X,Y,Z", help="end point, mm (needs --start)")
     p.add_argument("--edge", type=int, default=1, metavar="K",
                    help="which shared concave edge when the faces share several (1, 2, ...)")
+    _flip_option(p)
+
+
+def _flip_option(p) -> None:
+    p.add_argument("--flip-material", action="store_true",
+                   help="the material is on the other side of every face (a surface "
+                        "model's side, or a solid's outside: docs/surface_models.md)")
 
 
 def _gouge_options(p, gate: bool = True) -> None:
@@ -96,6 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
             "for an intersection path.")
     p.add_argument("step", metavar="PART.step")
     p.add_argument("--json", action="store_true", help="machine-readable output")
+    _flip_option(p)
 
     p = add("path", "compute a path and write it (.json, .csv, .ngc)",
             "Compute the ball-end path along the intersection of faces I and J and write it; "

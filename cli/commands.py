@@ -33,14 +33,18 @@ PARTIAL = 6  # exit code: the path stopped before its intended end
 
 # -- faces -----------------------------------------------------------------------------------
 def faces(args) -> int:
-    part = cadcnc.load_step(args.step)
+    part = cadcnc.load_step(args.step, flip_material=args.flip_material)
     data = faces_report(part)
     for line in part.warnings:
         say_error(f"cadcnc: faces: OCCT's STEP reader: {line}")
     if args.json:
         print(json.dumps(data, indent=1))
         return 0
-    print(f"{args.step}: {len(part)} faces")
+    print(f"{args.step}: {len(part)} faces; material side: {data['material']['rule']}")
+    if data["material"].get("sewing"):
+        sewn = data["material"]["sewing"]
+        print(f"sewn at {sewn['tolerance_mm']:g} mm: largest edge tolerance "
+              f"{sewn['max_edge_tolerance_mm']:.3g} mm, {sewn['free_edges']} free edges")
     print(f"{'face':>4}  {'kind':<10} {'area mm^2':>11}  neighbours: face class "
           "material-angle deg")
     for f in data["faces"]:
@@ -67,7 +71,7 @@ def _angles(rng) -> str:
 def path(args) -> int:
     outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])
     job = job_from_args(args, args.step)
-    part = cadcnc.load_step(args.step)
+    part = cadcnc.load_step(args.step, flip_material=job.flip_material)
     for n in job.operation.faces:  # face numbers checked before anything is computed
         part.face(n)
     gopts = gcode_options(args, job.clearance, [part]) if wants_gcode(args.output) else {}
@@ -200,7 +204,7 @@ def load_saved(path_json: str, part_file: str | None):
         if not Path(part_file).is_absolute() and not Path(part_file).exists():
             near = Path(path_json).parent / part_file
             part_file = str(near) if near.exists() else part_file
-    return tp, cadcnc.load_step(part_file)
+    return tp, cadcnc.load_step(part_file, flip_material=tp.job.flip_material)
 
 
 def plot(args) -> int:
@@ -224,7 +228,7 @@ def verify(args) -> int:
         if args.part is not None:
             raise InputError("--part is for a saved PATH.json; a STEP input is the part")
         job = job_from_args(args, args.input)
-        part = cadcnc.load_step(args.input)
+        part = cadcnc.load_step(args.input, flip_material=job.flip_material)
         tp = path_for_job(part, job, progress=progress(args, "verify"))
     report = run_verify(tp, part, tol=tol, progress=_verify_progress(args))
     if args.json:

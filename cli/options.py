@@ -34,7 +34,8 @@ def job_from_args(args, source: str) -> Job:
                   end=None if args.end is None else parse_point(args.end, "end"),
                   edge=args.edge - 1)
     return Job(tool, parse_feed(args.feed), parse_duration(args.period), op, source=source,
-               clearance=clearance(args), tolerances=tolerances(args))
+               clearance=clearance(args), tolerances=tolerances(args),
+               flip_material=getattr(args, "flip_material", False))
 
 
 def clearance(args) -> float | None:

@@ -94,11 +94,21 @@ def test_corrupt_step_file(tmp_path):
         cadcnc.load_step(bad)
 
 
-def test_step_with_no_solid(tmp_path):
+def test_step_with_one_face_is_an_open_surface_model(tmp_path):
     face_only = tmp_path / "face.step"
     cq.exporters.export(cq.Workplane().rect(10, 10).extrude(1).faces(">Z"), str(face_only))
-    with pytest.raises(StepFileError, match="no solid"):
-        cadcnc.load_step(face_only)
+    part = cadcnc.load_step(face_only)
+    assert len(part) == 1 and part.material_rule == "open shell: normals chosen to face +Z"
+    face = part.face(1)
+    u, w = (0.5 * sum(face.u_range), 0.5 * sum(face.w_range))
+    assert face.normal(u, w) @ [0, 0, 1] == pytest.approx(1.0, abs=1e-12)
+
+
+def test_step_with_no_face(tmp_path):
+    wire_only = tmp_path / "wire.step"
+    cq.exporters.export(cq.Workplane().rect(10, 10), str(wire_only))
+    with pytest.raises(StepFileError, match="holds no faces"):
+        cadcnc.load_step(wire_only)
 
 
 @pytest.mark.parametrize("bad", [0, -1, 6, "2", 2.0, None])

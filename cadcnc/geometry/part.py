@@ -27,6 +27,8 @@ from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_Ind
 
 from ..errors import FaceNumberError, StepFileError
 from .face_surface import FaceSurface
+from .material_side import FLIPPED, SOLID, SurfaceModel, material_sides
+from .sewing import file_faces, sew
 from .step_file import read_step
 from ..tolerances import DEFAULT, Tolerances
 
@@ -58,14 +60,16 @@ class SharedEdge:
         return float(self.angles_deg.min()), float(self.angles_deg.max())
 
 
-def load_step(path: str | os.PathLike, tol: Tolerances = DEFAULT) -> "Part":
+def load_step(path: str | os.PathLike, tol: Tolerances = DEFAULT,
+              flip_material: bool = False) -> "Part":
     """Read a STEP file into a :class:`Part`; errors name the file and the problem.
 
     What OCCT's reader printed is kept in ``part.warnings`` (never on standard output).
+    A surface model (no solid) is sewn and given a material side (:class:`Part`).
     """
     path = os.fspath(path)
     shape, warnings = read_step(path)
-    part = Part(shape, source=path, tol=tol)
+    part = Part(shape, source=path, tol=tol, flip_material=flip_material)
     part.warnings = warnings
     return part
 
@@ -91,21 +95,43 @@ def _shape_of(obj) -> TopoDS_Shape:
 
 
 class Part:
-    """Faces (1-based), adjacency and edge classes of a solid."""
+    """Faces (1-based), adjacency and edge classes of a solid or a surface model.
 
-    def __init__(self, shape, source: str = "<shape>", tol: Tolerances = DEFAULT):
+    A shape without a solid (shells, loose faces) is sewn at ``tol.sewing`` and each shell
+    given a material side (:mod:`.material_side`); ``surface_model`` keeps the shells, the
+    rules and the sewing figures (None for a solid), and ``shape`` becomes the sewn model.
+    Face numbers are always the ``TopExp::MapShapes`` order of the shape as given. ``flip_material`` inverts the material side of every
+    face; ``material_rule`` says which rule applied.
+    """
+
+    def __init__(self, shape, source: str = "<shape>", tol: Tolerances = DEFAULT,
+                 flip_material: bool = False):
         self.shape = _shape_of(shape)
         self.source = source
         self.tol = tol
+        self.flip_material = bool(flip_material)
+        self.surface_model: SurfaceModel | None = None
         if self.shape is None or self.shape.IsNull():
             raise StepFileError(f"{source}: holds no shape")
-        if not TopExp_Explorer(self.shape, TopAbs_SOLID).More():
-            raise StepFileError(f"{source}: holds no solid (cadcnc machines solids)")
-        fmap = TopTools_IndexedMapOfShape()
-        TopExp.MapShapes_s(self.shape, TopAbs_FACE, fmap)
+        fmap = file_faces(self.shape)
         if fmap.Extent() == 0:
-            raise StepFileError(f"{source}: solid has no faces")
-        self._fmap = fmap
+            raise StepFileError(f"{source}: holds no faces (cadcnc machines solids and "
+                                "surface models)")
+        if TopExp_Explorer(self.shape, TopAbs_SOLID).More():
+            faces = [fmap.FindKey(k) for k in range(1, fmap.Extent() + 1)]
+            self.material_rule = SOLID
+        else:
+            self.surface_model = material_sides(sew(self.shape, tol.sewing, source))
+            self.shape = self.surface_model.shape
+            faces = self.surface_model.faces
+            self.material_rule = "; ".join(dict.fromkeys(
+                s.rule for s in self.surface_model.shells))
+        if self.flip_material:
+            faces = [f.Reversed() for f in faces]
+            self.material_rule += f"; {FLIPPED}"
+        self._fmap = TopTools_IndexedMapOfShape()
+        for f in faces:
+            self._fmap.Add(f)
         self._faces: dict[int, FaceSurface] = {}
         self._edges: dict[tuple[int, int], list[SharedEdge]] | None = None
         self._bbox: tuple[np.ndarray, np.ndarray] | None = None

@@ -28,7 +28,22 @@ def faces_report(part: Part) -> dict:
             {"class": e.edge_class, "angle_deg": _angle_range([e]),
              "length_mm": round(e.length, 6), "closed": bool(e.closed)} for e in edges]})
     out["concave_pairs"] = [list(p) for p in part.concave_pairs()]
+    out["material"] = material_report(part)
     out["warnings"] = list(part.warnings)
+    return out
+
+
+def material_report(part: Part) -> dict:
+    """{"rule", "flipped", ["shells", "sewing"]}: which rule put the material where
+    (docs/surface_models.md); for a surface model each shell's faces and rule, and the
+    sewing tolerance, largest edge tolerance after sewing (mm) and free edges."""
+    out = {"rule": part.material_rule, "flipped": part.flip_material}
+    model = part.surface_model
+    if model is not None:
+        out["shells"] = [s.to_dict() for s in model.shells]
+        out["sewing"] = {"tolerance_mm": model.sewn.tolerance,
+                         "max_edge_tolerance_mm": model.sewn.edge_tolerance,
+                         "free_edges": model.sewn.free_edges}
     return out
 
 

@@ -3,9 +3,10 @@
 Membership in the material is a property of the solid, not of one face: a point behind a
 face (on its material side) may still be outside the part, past a thin wall or beyond the
 face's far edge. :class:`Material` asks OCCT's solid classifier
-(``BRepClass3d_SolidClassifier``) of every solid of the part; a part without a solid (a
-shell, loose faces) falls back to the material side of the nearest face, where the
-nearest point lies inside that face. :class:`PartFaces` holds one probe and two boxes per
+(``BRepClass3d_SolidClassifier``) of every solid of the part (a closed shell of a surface
+model is one: :mod:`cadcnc.geometry.material_side`); a part with an open shell falls
+back to the material side of the nearest face (:meth:`Material.side_of_nearest_face`).
+With ``--flip-material`` the material is the other side: the classifier's IN and OUT swap. :class:`PartFaces` holds one probe and two boxes per
 face: a cheap loose box for all faces (``BRepBndLib::Add``, ~20 us a face) and the
 optimal box (``AddOptimal``, ~4 ms a face) only for faces the loose box cannot rule out.
 Lengths in mm.
@@ -19,6 +20,7 @@ import numpy as np
 from OCP.Bnd import Bnd_Box
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepClass3d import BRepClass3d_SolidClassifier
+from OCP.BRepExtrema import BRepExtrema_IsInFace
 from OCP.gp import gp_Pnt
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_SOLID
 from OCP.TopExp import TopExp_Explorer
@@ -32,6 +34,8 @@ IN, OUT, ON = "in", "out", "on"
 SOLID, FACES = "solid", "faces"
 BOX_MARGIN = 1e-6
 """Growth of every optimal box (mm): AddOptimal finds the extent numerically."""
+TIE = 1e-6
+"""Faces within this (mm) of the nearest distance share its foot point (an edge, a vertex)."""
 
 
 def _box(shape, optimal: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -117,6 +121,10 @@ class Material:
 
     def __init__(self, faces: PartFaces, tol: Tolerances, solids=None):
         self.faces, self.tol = faces, tol
+        model = getattr(faces.part, "surface_model", None)
+        if solids is None and model is not None and not model.closed:
+            solids = []  # an open shell bounds no volume: the faces' sides decide
+        self.flipped = bool(getattr(faces.part, "flip_material", False))
         if solids is None:  # every solid of the part's shape
             solids = []
             explorer = TopExp_Explorer(faces.part.shape, TopAbs_SOLID)
@@ -146,20 +154,57 @@ class Material:
             self.classified += 1
             state = classifier.State()
             if state == TopAbs_IN:
-                return IN
+                return OUT if self.flipped else IN
             on |= state == TopAbs_ON
             unknown |= state not in (TopAbs_IN, TopAbs_ON, TopAbs_OUT)
         if on:
             return ON
         if unknown:  # the classifier could not tell: the faces' sides decide
             return self.side_of_nearest_face(point)
-        return OUT
+        return IN if self.flipped else OUT
 
     def side_of_nearest_face(self, point) -> str | None:
-        """The fallback rule: IN behind the nearest face (its nearest point inside it)."""
+        """The faces' rule: IN when the point lies on the material side of the nearest
+        face (the face's normals already carry the chosen side, flipped or not).
+
+        Where the nearest point q lies inside the face, its normal there decides. Where it
+        lies on the face's boundary (an edge or a vertex), the faces within :data:`TIE` of
+        the same distance share q, and the sum of their normals at q decides (a
+        pseudo-normal: exact for an edge between two faces, concave or convex; at a free
+        edge of an open shell the one face's normal, as if the sheet went on; at a vertex
+        of three or more faces an unweighted sum, which can err: docs/surface_models.md).
+        """
         face, signed, unsigned = self.faces.nearest(point)
         if not face or math.isnan(signed):
             return None
         if unsigned <= self.tol.noise:
             return ON
-        return IN if signed < 0 else OUT
+        if signed < 0:
+            return IN
+        if not self._on_boundary(face):  # inside the face, on its outer side
+            return OUT
+        side = self._pseudo_normal_side(np.asarray(point, float), face, unsigned)
+        if side is None:
+            return None
+        return IN if side < 0 else OUT
+
+    def _on_boundary(self, face: int) -> bool:
+        """Whether the last distance to ``face`` found its foot on the face's boundary."""
+        dss = self.faces.probe(face)._dss  # the probe's last DistShapeShape (face_distance)
+        return any(dss.SupportTypeShape2(k) != BRepExtrema_IsInFace
+                   for k in range(1, dss.NbSolution() + 1))
+
+    def _pseudo_normal_side(self, p: np.ndarray, face: int, d: float) -> float | None:
+        """(p - q) . (sum of the normals at q of the faces at distance d from p), or None."""
+        q = np.array(self.faces.probe(face)._dss.PointOnShape2(1).Coord())
+        total = np.zeros(3)
+        for k in self.faces.near(p - d - TIE, p + d + TIE, 0.0):
+            probe = self.faces.probe(k)
+            _, ud = probe.face_distance(p)
+            if not abs(ud - d) <= TIE:
+                continue
+            found = probe.project_global(q)
+            if found is None:
+                return None
+            total += probe.normal(*found[:2])
+        return float((p - q) @ total)

@@ -29,7 +29,7 @@ def resolve_part(toolpath, part):
     if not source or str(source).startswith("<"):
         raise InputError("verify needs the part: the toolpath does not name a STEP file "
                          "(pass part=...)")
-    return load_step(source)
+    return load_step(source, flip_material=toolpath.job.flip_material)
 
 
 def prepare(toolpath, part, tol: Tolerances):
