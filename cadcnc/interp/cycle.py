@@ -36,7 +36,10 @@ CURVATURE = "curvature"      # concave curvature tighter than the ball: R' k >= 
 SINGULAR = "singular"        # a singular parameter point (pole, apex, collapsed edge)
 DIVERGED = "diverged"        # the carried error exceeded its safety limit
 MAX_CYCLES = "max_cycles"    # the cycle limit was reached
-STOP_REASONS = (END, CLOSED, BOUNDARY, TANGENT, CURVATURE, SINGULAR, DIVERGED, MAX_CYCLES)
+COLLISION = "collision"      # the ball or shank would come closer than allowed to a third
+                             # face (the stepper's guard, docs/interpolator.md)
+STOP_REASONS = (END, CLOSED, BOUNDARY, TANGENT, CURVATURE, SINGULAR, DIVERGED, MAX_CYCLES,
+                COLLISION)
 
 
 class SurfaceLike(Protocol):
@@ -102,12 +105,15 @@ class Contact:
 
 
 class StopCycle(Exception):
-    """Raised inside a cycle when the geometry forbids it; carries a stop reason."""
+    """Raised inside a cycle when the geometry forbids it; carries a stop reason and, for a
+    rule with a continuous measure, its ``margin`` (< 0 or, for curvature, <= 0 broken;
+    NaN where the rule is a yes/no answer). Landing solves for the margin's zero."""
 
-    def __init__(self, reason: str, detail: str):
+    def __init__(self, reason: str, detail: str, margin: float = math.nan):
         super().__init__(detail)
         self.reason = reason
         self.detail = detail
+        self.margin = margin
 
 
 def track_direction(c1: Contact, c2: Contact, t_prev: Vec, tol: Tolerances) -> Vec:
@@ -205,7 +211,8 @@ def check_curvature(c: Contact, k: float, label: str) -> None:
     """Refuse a concave curvature the ball cannot follow without gouging (R' k >= 1)."""
     if c.offset * k >= 1.0:
         raise StopCycle(CURVATURE, f"{label}: concave curvature k = {k:.6g} 1/mm is tighter "
-                                   f"than the ball (R' k = {c.offset * k:.4g} >= 1)")
+                                   f"than the ball (R' k = {c.offset * k:.4g} >= 1)",
+                        1.0 - c.offset * k)
 
 
 class Track(NamedTuple):
