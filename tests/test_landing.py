@@ -48,7 +48,7 @@ def test_a_yes_no_rule_is_bisected_within_the_trial_budget(root):
     assert lo <= root and root - lo <= 2.0 ** -(MAX_TRIALS - 1)
 
 
-def stepper(name, i, j, guard=None, radius=3.0):
+def stepper(name, i, j, guard=None, radius=3.0, compiled=None):
     part = load_fixture(name)
     s1, s2, job = pair_job(part.face(i), part.face(j), radius=radius, feed=1500.0,
                            period=0.004)
@@ -56,11 +56,12 @@ def stepper(name, i, j, guard=None, radius=3.0):
     return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
                    period=job.period, direction=plan.direction, end=plan.end,
                    closed=plan.closed, tol=job.tolerances, check_boundary=plan.check_boundary,
-                   guard=guard)
+                   guard=guard, compiled=compiled)
 
 
 def run_counting(st):
-    """Run to the stop; the number of trial cycles of each step."""
+    """Run to the stop; the number of trial cycles of each step (the compiled stepper runs
+    a step's first trial in the kernel: one more than counted here)."""
     tries, per_step = [0], []
     original = st._try
 
@@ -79,13 +80,17 @@ def run_counting(st):
 @pytest.mark.parametrize("key, name, i, j", CASES, ids=[c[0] for c in CASES])
 def test_every_fixture_stop_takes_at_most_24_trial_cycles(key, name, i, j):
     try:
-        st = stepper(name, i, j, radius=radius_for(name))
+        st = stepper(name, i, j, radius=radius_for(name), compiled=False)
     except Exception as exc:   # pairs refused before computing have no stop to land
         pytest.skip(f"refused: {type(exc).__name__}")
     per_step = run_counting(st)
     assert max(per_step) <= MAX_TRIALS
     if st.stop_reason == BOUNDARY:
         assert st.landing_trials == per_step[-2] == MAX_TRIALS   # yes/no rule: bisected
+        fast = stepper(name, i, j, radius=radius_for(name))
+        assert type(fast) is not Stepper
+        fast_steps = run_counting(fast)
+        assert fast.landing_trials == fast_steps[-2] + 1 == MAX_TRIALS
 
 
 class Plane:
@@ -113,23 +118,26 @@ def test_collision_is_a_stop_reason():
     assert COLLISION == "collision" and COLLISION in STOP_REASONS
 
 
-def test_a_plane_across_the_pocket_edge_stops_the_ball_tangent_to_it():
+@pytest.mark.parametrize("compiled", [False, None])
+def test_a_plane_across_the_pocket_edge_stops_the_ball_tangent_to_it(compiled):
     # pocket 10/17: the centre runs straight from x = -22 to x = 22 at y = -17, z = 18
     guard = Plane((1.0, 0.0, 0.0), 5.0123456789, 3.0)   # a wall at x = 5.0123456789
-    st = stepper("pocket", 10, 17, guard)
+    st = stepper("pocket", 10, 17, guard, compiled=compiled)
     per_step = run_counting(st)
     assert st.stop_reason == COLLISION and st.stop_detail == "ball touches the plane"
     last = st.record.points[-1]
     assert last[0] == pytest.approx(5.0123456789 - 3.0, abs=1e-9)   # closed form
     assert np.all(st.record.points[:, 0] <= 5.0123456789 - 3.0)
     assert max(per_step) <= MAX_TRIALS and st.landing_trials <= 4   # secant: few trials
+    assert (type(st) is Stepper) == (compiled is False)
 
 
-def test_a_sphere_beside_a_closed_path_stops_it_tangent_to_the_sphere():
+@pytest.mark.parametrize("compiled", [False, None])
+def test_a_sphere_beside_a_closed_path_stops_it_tangent_to_the_sphere(compiled):
     # sphere_cylinder: the centre runs on a circle of radius 13 about z at z = 30.33
     centre = (13.0 * math.cos(1.0), 13.0 * math.sin(1.0), 30.3315018 + 4.0)
     guard = Ball(centre, 1.5, 3.0)            # its surface is 1 mm off the circle's plane
-    st = stepper("sphere_cylinder", 1, 2, guard)
+    st = stepper("sphere_cylinder", 1, 2, guard, compiled=compiled)
     per_step = run_counting(st)
     assert st.stop_reason == COLLISION
     dist = np.linalg.norm(st.record.points - centre, axis=1)
@@ -145,7 +153,8 @@ def test_a_sphere_beside_a_closed_path_stops_it_tangent_to_the_sphere():
     assert max(per_step) <= MAX_TRIALS
 
 
-def test_a_start_already_in_collision_takes_no_step():
-    st = stepper("pocket", 10, 17, Plane((1.0, 0.0, 0.0), -30.0, 3.0))
+@pytest.mark.parametrize("compiled", [False, None])
+def test_a_start_already_in_collision_takes_no_step(compiled):
+    st = stepper("pocket", 10, 17, Plane((1.0, 0.0, 0.0), -30.0, 3.0), compiled=compiled)
     assert st.step() is None
     assert st.stop_reason == COLLISION and "no step possible" in st.stop_detail

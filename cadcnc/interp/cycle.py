@@ -116,12 +116,38 @@ class StopCycle(Exception):
         self.margin = margin
 
 
+def tangent_detail(s: float, tol: Tolerances) -> str:
+    return f"faces tangent: |n1 x n2| = {s:.3g} < {tol.tangent_sin:g}"
+
+
+def curvature_detail(label: str, k: float, rk: float) -> str:
+    return (f"{label}: concave curvature k = {k:.6g} 1/mm is tighter than the ball "
+            f"(R' k = {rk:.4g} >= 1)")
+
+
+def singular_detail(label: str, u: float, w: float) -> str:
+    return f"{label}: contact reaches a singular parameter point (u={u:.6g}, w={w:.6g})"
+
+
+def diverged_detail(label: str, eps: float, tol: Tolerances) -> str:
+    return f"{label}: carried error {eps:.4g} mm exceeds {tol.diverged:g} mm"
+
+
+def boundary_detail(left: str) -> str:
+    return f"contact on {left} reached the boundary of its face"
+
+
+CORRECTION_SINGULAR = ("correction system singular: the two spheres' normals are parallel "
+                       "(tangent faces)")
+MOVE_UNDEFINED = "the contact's move is undefined: a principal curvature equals 1/R'"
+
+
 def track_direction(c1: Contact, c2: Contact, t_prev: Vec, tol: Tolerances) -> Vec:
     """t = n1 x n2 / |n1 x n2|, signed to agree with the previous direction (eq. 3)."""
     m = cross(c1.n, c2.n)
     s = norm(m)
     if s < tol.tangent_sin:
-        raise StopCycle(TANGENT, f"faces tangent: |n1 x n2| = {s:.3g} < {tol.tangent_sin:g}")
+        raise StopCycle(TANGENT, tangent_detail(s, tol))
     if dot(m, t_prev) < 0.0:
         s = -s
     return scale(m, 1.0 / s)
@@ -146,8 +172,7 @@ def correct(p_star: Vec, c1: Contact, c2: Contact, k1: float, k2: float,
     e2, b2 = _sphere_row(c2, k2, p_star, tol)
     dp = solve3(e1, e2, cross(e1, e2), (b1, b2, 0.0))
     if dp is None:
-        raise StopCycle(TANGENT, "correction system singular: the two spheres' normals are "
-                                 "parallel (tangent faces)")
+        raise StopCycle(TANGENT, CORRECTION_SINGULAR)
     return add(p_star, dp)
 
 
@@ -179,8 +204,7 @@ def inverse_exact(c: Contact, p_e: Vec) -> tuple[float, float]:
     b1, b2 = dot(d, c.ru), dot(d, c.rw)
     det = a11 * a22 - a12 * a12
     if det == 0.0:
-        raise StopCycle(CURVATURE, "the contact's move is undefined: a principal curvature "
-                                   "equals 1/R'")
+        raise StopCycle(CURVATURE, MOVE_UNDEFINED)
     return (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
 
 
@@ -210,9 +234,7 @@ def paper_inverse_ratio(c: Contact, k: float) -> float:
 def check_curvature(c: Contact, k: float, label: str) -> None:
     """Refuse a concave curvature the ball cannot follow without gouging (R' k >= 1)."""
     if c.offset * k >= 1.0:
-        raise StopCycle(CURVATURE, f"{label}: concave curvature k = {k:.6g} 1/mm is tighter "
-                                   f"than the ball (R' k = {c.offset * k:.4g} >= 1)",
-                        1.0 - c.offset * k)
+        raise StopCycle(CURVATURE, curvature_detail(label, k, c.offset * k), 1.0 - c.offset * k)
 
 
 class Track(NamedTuple):

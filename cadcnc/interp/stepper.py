@@ -16,7 +16,8 @@ from typing import Protocol
 from ..job import MIN_STEP, check_number, check_step
 from .cycle import (
     BOUNDARY, CLOSED, COLLISION, CURVATURE, DIVERGED, END, MAX_CYCLES, SINGULAR, Contact, StopCycle,
-    SurfaceLike, Track, accurate_step, advance, check_curvature, track,
+    SurfaceLike, Track, accurate_step, advance, boundary_detail, check_curvature,
+    diverged_detail, singular_detail, track,
 )
 from .landing import LANDING_TOL, MAX_TRIALS, land
 from ..tolerances import DEFAULT, Tolerances
@@ -63,14 +64,27 @@ class Stepper:
 
     ``guard`` (a :class:`Guard`, optional) is asked for every trial that passes the other
     rules; a negative margin stops the path with ``collision``, landed tangent to the
-    third face like any other limit.
+    third face like any other limit. ``compiled``: None (default) runs the compiled
+    kernel (cadcnc.interp.compiled) when both surfaces have compiled data, False forces
+    this plain-Python reference.
     """
+
+    compiled_class: type | None = None
+    """Set by cadcnc.interp.compiled: the stepper used when both surfaces have compiled
+    data (``surface.kernel``) and ``compiled`` is not False."""
+
+    def __new__(cls, s1, s2, *args, compiled: bool | None = None, **kwargs):
+        if (cls is Stepper and compiled is not False and Stepper.compiled_class is not None
+                and getattr(s1, "kernel", None) and getattr(s2, "kernel", None)):
+            cls = Stepper.compiled_class
+        return object.__new__(cls)
 
     def __init__(self, s1: SurfaceLike, s2: SurfaceLike, offsets: tuple[float, float],
                  start: Tangency, *, feed: float, period: float, direction: Vec,
                  end: Tangency | None = None, closed: bool = False,
                  tol: Tolerances = DEFAULT, max_cycles: int = 1_000_000,
-                 record: bool = True, check_boundary: bool = True, guard: Guard | None = None):
+                 record: bool = True, check_boundary: bool = True, guard: Guard | None = None,
+                 compiled: bool | None = None):
         self.tol = tol
         self.period = check_number("period", period, "s")
         self.feed = self._check_feed(feed)
@@ -176,15 +190,14 @@ class Stepper:
             spare.move_to(*uv)
             m = spare.singularity - tol.near_singular
             if m < 0.0:
-                raise StopCycle(SINGULAR, f"surface {label}: contact reaches a singular "
-                                          f"parameter point (u={spare.u:.6g}, w={spare.w:.6g})",
+                raise StopCycle(SINGULAR, singular_detail(f"surface {label}", spare.u, spare.w),
                                 m)
             if watch == SINGULAR:
                 self._margin = min(self._margin, m)
             eps = norm(sub(p_e, spare.centre()))
             if eps > tol.diverged:
-                raise StopCycle(DIVERGED, f"surface {label}: carried error {eps:.4g} mm "
-                                          f"exceeds {tol.diverged:g} mm", tol.diverged - eps)
+                raise StopCycle(DIVERGED, diverged_detail(f"surface {label}", eps, tol),
+                                tol.diverged - eps)
             if watch == DIVERGED:
                 self._margin = min(self._margin, tol.diverged - eps)
             # the new contact too: a point whose ball cannot touch there is never emitted
@@ -209,7 +222,7 @@ class Stepper:
         if self.check_boundary:
             left = self._left_face(p_e, t)
             if left:
-                return BOUNDARY, f"contact on {left} reached the boundary of its face"
+                return BOUNDARY, boundary_detail(left)
         if self.guard is not None:
             clearance, detail = self.guard.margin(p_e)
             if self._watch == COLLISION or clearance < 0.0:
@@ -229,13 +242,14 @@ class Stepper:
         where the trials allow it; the reason reported is the one found next to the limit.
         Only trials that pass every check are committed.
         """
-        state = {"failure": failure, "kept": None}
+        state = {"failure": failure, "kept": False}
 
         def trial(s: float) -> tuple[bool, float, bool]:
             self._watch = state["failure"][0]
             found = self._try(s * f)
             if found is None:
-                state["kept"] = (*self._trial, self._n1.copy(), self._n2.copy())
+                self._keep_trial()
+                state["kept"] = True
                 return True, self._margin, False
             changed = found[0] != state["failure"][0]
             state["failure"] = found
@@ -247,13 +261,20 @@ class Stepper:
         self._watch = None
         self.landing_trials = used + 1
         reason, detail = state["failure"]
-        if lo * f < 1e-12 or state["kept"] is None:
+        if lo * f < 1e-12 or not state["kept"]:
             self._stop(reason, detail + " (no step possible from the current point)")
             return None
-        p_e, t, self._n1, self._n2 = state["kept"]
-        dp = self._commit(p_e, t, lo * f)
+        dp = self._commit_kept(lo * f)
         self._stop(reason, detail)
         return dp
+
+    def _keep_trial(self) -> None:
+        """Keep the trial that just passed (the landing commits the last one kept)."""
+        self._kept = (*self._trial, self._n1.copy(), self._n2.copy())
+
+    def _commit_kept(self, f: float) -> Vec:
+        p_e, t, self._n1, self._n2 = self._kept
+        return self._commit(p_e, t, f)
 
     def _state_margin(self, rule: str) -> float:
         """The margin of ``rule`` at the current point (the landing's s = 0), NaN if none."""
