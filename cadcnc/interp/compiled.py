@@ -28,6 +28,7 @@ from .cycle import (
     MOVE_UNDEFINED, SINGULAR, TANGENT, boundary_detail, curvature_detail, diverged_detail,
     singular_detail, tangent_detail,
 )
+from .kernel import entry as E
 from .kernel import step as K
 from .kernel.cycle_math import C_OFF, C_SING, C_U, C_W, CS
 from .record import ROW, PathRecord
@@ -89,6 +90,7 @@ class CompiledStepper(Stepper):
         self._grids = (kernel_data(s1)[1], kernel_data(s2)[1])
         self.F, self.I = pack((s1, s2), (kernel_data(s1), kernel_data(s2)))
         self.S = S = np.zeros(K.STATE_SIZE)
+        self.record = PathRecord() if record else None
         S[K.P:K.P + 3] = start.p
         d = math.sqrt(sum(float(x) ** 2 for x in direction))
         S[K.T:K.T + 3] = [float(x) / d for x in direction] if d > 0 else 0.0
@@ -107,15 +109,15 @@ class CompiledStepper(Stepper):
             for block in (o, o + K.N1 - K.C1, o + K.KEPT1 - K.C1):
                 S[block + C_OFF] = float(offsets[side])
             uv = (start.uv1, start.uv2)[side]
-            if K.move_to(self.F, self.I, S, side, o, float(uv[0]), float(uv[1])) != 0:
+            S[E.ARG_U], S[E.ARG_W] = uv
+            if self._call(E.OP_MOVE_TO, -1, 0.0, side)[0] != 0:
                 raise GeometryError(f"surface {side + 1}: the compiled evaluator cannot "
                                     f"evaluate the start contact {tuple(uv)}")
         self.closed, self.max_cycles, self.check_boundary = closed, max_cycles, check_boundary
         self.guard, self.stop_reason, self.stop_detail = guard, None, ""
         self._watch, self._margin, self.landing_trials = None, math.nan, 0
-        self.record = PathRecord() if record else None
         if self.record is not None:
-            K.write_row(S, self.record.rows, 0, 0.0, 0.0)
+            self._call(E.OP_FIRST_ROW, 0)
             self.record.set_length(1)
 
     # -- state read from the kernel's array ------------------------------------------------
@@ -137,6 +139,10 @@ class CompiledStepper(Stepper):
         c.E, c.F, c.G, c.L, c.M, c.N = S[o + 14:o + 20].tolist()
         c.singularity = float(S[o + C_SING])
         return c
+
+    def _call(self, op: int, n: int, x: float = 0.0, k: int = 0) -> tuple:
+        """One kernel operation (kernel/step.py ``entry``)."""
+        return E.entry(op, self.F, self.I, self.S, self._rows(), n, x, k)
 
     def _row(self) -> int:
         """The record row the next commit writes (-1: record off), growing it if full."""
@@ -165,7 +171,8 @@ class CompiledStepper(Stepper):
             self._stop(MAX_CYCLES, f"cycle limit {self.max_cycles} reached")
             return None
         n = self._row()
-        status = K.step(self.F, self.I, self.S, self._rows(), n, self.step_length)
+        status = E.entry(E.OP_STEP, self.F, self.I, self.S, self._rows(), n,
+                         self.step_length, 0)[0]
         if status == K.DONE:
             return self._committed(n)
         return self._finish(status, n)
@@ -177,8 +184,7 @@ class CompiledStepper(Stepper):
             if progress is not None:
                 limit = min(limit, (self.cycles // every + 1) * every)
             n = self._row()
-            status, n = K.run(self.F, self.I, self.S, self._rows(), n, self.step_length,
-                              limit)
+            status, n, _ = self._call(E.OP_RUN, n, self.step_length, limit)
             if self.record is not None:
                 self.record.set_length(n)
             if status == K.MAX_CYCLES:
@@ -205,7 +211,7 @@ class CompiledStepper(Stepper):
         self._margin = S[K.MARGIN]
         failure = self._resolve(status)
         if failure is None:
-            K.commit_trial(S, self._rows(), n)
+            self._call(E.OP_COMMIT_TRIAL, n)
             return self._committed(n)
         return self._land_on_limit(float(S[K.F_TRIAL]), failure)
 
@@ -263,22 +269,22 @@ class CompiledStepper(Stepper):
     # -- the landing's primitives (Stepper._land_on_limit drives them) ----------------------
     def _try(self, f: float) -> tuple[str, str] | None:
         self.S[K.WATCH] = _CODES.get(self._watch, K.WATCH_NONE)
-        status = K.trial(self.F, self.I, self.S, f)
-        self._margin = self.S[K.MARGIN]
+        status, _, self._margin = self._call(E.OP_TRIAL, -1, f)
         return self._resolve(status)
 
     def _keep_trial(self) -> None:
-        K.keep(self.S)
+        self._call(E.OP_KEEP, -1)
 
     def _commit_kept(self, f: float) -> Vec:
         n = self._row()
-        K.commit_kept(self.S, self._rows(), n, f)
+        self._call(E.OP_COMMIT_KEPT, n, f)
         return self._committed(n)
 
     def _state_margin(self, rule: str) -> float:
         if rule == COLLISION:
             return self.guard.margin(self.p)[0]
-        return K.state_margin(self.S, _CODES[rule]) if rule in _CODES else math.nan
+        return self._call(E.OP_STATE_MARGIN, -1, 0.0, _CODES[rule])[2] if rule in _CODES \
+            else math.nan
 
 
 assert K.N1 - K.C1 == K.KEPT1 - K.N1 == 2 * CS   # the contact blocks' layout

@@ -354,23 +354,6 @@ def step(F: np.ndarray, I: np.ndarray, S: np.ndarray, R: np.ndarray, n_rec: int,
 
 
 @_jit
-def run(F: np.ndarray, I: np.ndarray, S: np.ndarray, R: np.ndarray, n_rec: int,
-        f_cmd: float, max_cycles: int) -> tuple:
-    """Steps until one needs the caller: (status, rows recorded). MAX_CYCLES at the
-    limit, RECORD_FULL when R has no room for the next row."""
-    while True:
-        if S[CYCLES] >= max_cycles:
-            return MAX_CYCLES, n_rec
-        if n_rec >= R.shape[0]:
-            return RECORD_FULL, n_rec
-        status = step(F, I, S, R, n_rec, f_cmd)
-        if status != DONE:
-            return status, n_rec
-        if n_rec >= 0:
-            n_rec += 1
-
-
-@_jit
 def commit_trial(S: np.ndarray, R: np.ndarray, n_rec: int) -> None:
     """Commit the trial that just passed (after the caller's exact checks and guard)."""
     commit(S, R, n_rec, vec(S, P_E), vec(S, TR_T), S[F_TRIAL])
@@ -388,3 +371,4 @@ def state_margin(S: np.ndarray, rule: int) -> float:
         t = vec(S, TR_T)
         return 1.0 - max(S[C1 + C_OFF] * curvature(S, C1, t), S[C2 + C_OFF] * curvature(S, C2, t))
     return math.nan
+
