@@ -163,12 +163,7 @@ class CompiledStepper(Stepper):
 
     def step(self, feed: float | None = None) -> Vec | None:
         """As :meth:`Stepper.step`: the next period's dp_K (mm), None once stopped."""
-        if self.stop_reason is not None:
-            return None
-        if feed is not None:
-            self.feed = self._check_feed(feed)
-        if self.cycles >= self.max_cycles:
-            self._stop(MAX_CYCLES, f"cycle limit {self.max_cycles} reached")
+        if not self._may_step(feed):
             return None
         n = self._row()
         status = E.entry(E.OP_STEP, self.F, self.I, self.S, self._rows(), n,

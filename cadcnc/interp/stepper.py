@@ -133,14 +133,20 @@ class Stepper:
     def _stop(self, reason: str, detail: str) -> None:
         self.stop_reason, self.stop_detail = reason, detail
 
-    def step(self, feed: float | None = None) -> Vec | None:
-        """Compute the next period's axis increment dp_K (mm); None once stopped."""
+    def _may_step(self, feed: float | None) -> bool:
+        """Take a feed override and apply the cycle limit: False when no step follows."""
         if self.stop_reason is not None:
-            return None
+            return False
         if feed is not None:
             self.feed = self._check_feed(feed)
         if self.cycles >= self.max_cycles:
             self._stop(MAX_CYCLES, f"cycle limit {self.max_cycles} reached")
+            return False
+        return True
+
+    def step(self, feed: float | None = None) -> Vec | None:
+        """Compute the next period's axis increment dp_K (mm); None once stopped."""
+        if not self._may_step(feed):
             return None
         f_cmd = self.step_length
         self._ratio = 1.0
