@@ -174,6 +174,7 @@ class CompiledStepper(Stepper):
 
     def run(self, progress=None, every: int = 10000) -> "Stepper":
         """As :meth:`Stepper.run`, with the loop in the kernel between events."""
+        reported = -1
         while self.stop_reason is None:
             limit = self.max_cycles
             if progress is not None:
@@ -187,8 +188,10 @@ class CompiledStepper(Stepper):
                     self._stop(MAX_CYCLES, f"cycle limit {self.max_cycles} reached")
             elif status != K.RECORD_FULL and self._finish(status, self._row()) is None:
                 continue
-            if progress is not None and self.cycles % every == 0 and self.cycles:
-                progress(self.cycles, self.travelled)
+            cycles = self.cycles
+            if progress is not None and cycles % every == 0 and cycles != reported:
+                reported = cycles
+                progress(cycles, self.travelled)
         return self
 
     def _finish(self, status: int, n: int) -> Vec | None:
