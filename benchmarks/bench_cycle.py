@@ -3,7 +3,9 @@
 Prints, for two fixtures, the time of one interpolation cycle (median, p99, max, in
 microseconds) and of one baseline step run in the same process: predict along n1 x n2,
 then Newton on the four contact parameters to 1e-10 mm (cadcnc.interp.tangency.solve_tangency).
-Ratios, not absolute times, are the figures to compare across machines.
+Ratios, not absolute times, are the figures to compare across machines. The interpolator
+timed here is the default Stepper (the compiled kernel where both faces have compiled data);
+benchmarks/bench_kernel.py prints the real-time figures of docs/performance.md.
 
     .venv/bin/python benchmarks/bench_cycle.py [--cycles N]
 """
@@ -22,6 +24,7 @@ from cadcnc.ops.pair_path import pair_job, plan_path
 from cadcnc.interp.stepper import Stepper
 from cadcnc.interp.tangency import solve_tangency
 from cadcnc.tolerances import DEFAULT
+from bench_kernel import step_times  # noqa: E402 (a sibling script)
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = [("crossing_cylinders.step", 1, 2), ("bspline_boss.step", 4, 5)]
@@ -32,17 +35,7 @@ def time_interpolator(plan, cycles: int) -> np.ndarray:
     st = Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=FEED, period=PERIOD,
                  direction=plan.direction, end=None, closed=False, record=False,
                  max_cycles=cycles)
-    out = np.empty(cycles)
-    clock = time.perf_counter_ns
-    k = 0
-    while k < cycles:
-        t0 = clock()
-        dp = st.step()
-        out[k] = clock() - t0
-        if dp is None:
-            break
-        k += 1
-    return out[:k] / 1000.0
+    return step_times(st, cycles)
 
 
 def time_newton(plan, cycles: int) -> np.ndarray:

@@ -17,43 +17,17 @@ from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepTools import BRepTools
 from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
-from OCP.GeomAbs import (
-    GeomAbs_BezierSurface,
-    GeomAbs_BSplineSurface,
-    GeomAbs_Cone,
-    GeomAbs_Cylinder,
-    GeomAbs_OffsetSurface,
-    GeomAbs_Plane,
-    GeomAbs_Sphere,
-    GeomAbs_SurfaceOfExtrusion,
-    GeomAbs_SurfaceOfRevolution,
-    GeomAbs_Torus,
-)
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.GProp import GProp_GProps
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
-from OCP.TopoDS import TopoDS, TopoDS_Face
 
 from . import differential as dg
+from .surface_data import SURFACE_KINDS, SurfaceData, as_topods_face, surface_data
+from .trim_grid import TrimGrid
 from ..errors import GeometryError, InputError, SingularPointError
 from ..tolerances import DEFAULT, Tolerances
 from ..trim import BOUNDARY, INSIDE, OUTSIDE
-
-SURFACE_KINDS = {
-    GeomAbs_Plane: "plane",
-    GeomAbs_Cylinder: "cylinder",
-    GeomAbs_Cone: "cone",
-    GeomAbs_Sphere: "sphere",
-    GeomAbs_Torus: "torus",
-    GeomAbs_BezierSurface: "bezier",
-    GeomAbs_BSplineSurface: "bspline",
-    GeomAbs_SurfaceOfRevolution: "revolution",
-    GeomAbs_SurfaceOfExtrusion: "extrusion",
-    GeomAbs_OffsetSurface: "offset",
-}
-
-
 
 @dataclass(frozen=True)
 class Derivatives:
@@ -65,19 +39,6 @@ class Derivatives:
     ruu: np.ndarray
     ruw: np.ndarray
     rww: np.ndarray
-
-
-def as_topods_face(face) -> TopoDS_Face:
-    """Accept a CadQuery ``Face``, a ``TopoDS_Face`` or a ``FaceSurface``."""
-    if isinstance(face, FaceSurface):
-        return face.topods
-    wrapped = getattr(face, "wrapped", face)
-    if isinstance(wrapped, TopoDS_Face):
-        return wrapped
-    try:
-        return TopoDS.Face_s(wrapped)
-    except Exception as exc:  # OCP raises Standard_TypeMismatch for non-faces
-        raise InputError(f"expected a face, got {type(face).__name__}") from exc
 
 
 class FaceSurface:
@@ -102,6 +63,7 @@ class FaceSurface:
         self.u_period = self._adaptor.UPeriod() if self._adaptor.IsUPeriodic() else None
         self.w_period = self._adaptor.VPeriod() if self._adaptor.IsVPeriodic() else None
         self._classifier = None
+        self._kernel: tuple | None = None
         # scratch objects reused by every evaluation (keeps allocation out of hot loops)
         self._p = gp_Pnt()
         self._v = [gp_Vec() for _ in range(9)]
@@ -138,6 +100,16 @@ class FaceSurface:
     def contains(self, u: float, w: float) -> bool:
         """True for points inside the trimmed face or on its boundary."""
         return self.classify(u, w) != OUTSIDE
+
+    @property
+    def kernel(self) -> tuple[SurfaceData, TrimGrid] | None:
+        """(surface data, trim grid) for the compiled stepper, built on first use (the
+        grid build is planning time, reported by benchmarks/bench_trim_grid.py); None
+        where the kernel cannot evaluate this face (OCCT's evaluation is used)."""
+        if self._kernel is None:
+            data = surface_data(self)
+            self._kernel = (data, TrimGrid.build(self)) if data is not None else ()
+        return self._kernel or None
 
     # -- evaluation ---------------------------------------------------------------------
     def point(self, u: float, w: float) -> np.ndarray:

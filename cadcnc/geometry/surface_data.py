@@ -59,8 +59,37 @@ from OCP.GeomAbs import (
     GeomAbs_Torus,
 )
 from OCP.TopLoc import TopLoc_Location
+from OCP.TopoDS import TopoDS, TopoDS_Face
 
-from .face_surface import SURFACE_KINDS, as_topods_face
+from ..errors import InputError
+
+SURFACE_KINDS = {
+    GeomAbs_Plane: "plane",
+    GeomAbs_Cylinder: "cylinder",
+    GeomAbs_Cone: "cone",
+    GeomAbs_Sphere: "sphere",
+    GeomAbs_Torus: "torus",
+    GeomAbs_BezierSurface: "bezier",
+    GeomAbs_BSplineSurface: "bspline",
+    GeomAbs_SurfaceOfRevolution: "revolution",
+    GeomAbs_SurfaceOfExtrusion: "extrusion",
+    GeomAbs_OffsetSurface: "offset",
+}
+"""OCCT surface types and the names FaceSurface.kind gives them."""
+
+
+def as_topods_face(face) -> TopoDS_Face:
+    """Accept a CadQuery ``Face``, a ``TopoDS_Face`` or a ``FaceSurface``."""
+    if isinstance(getattr(face, "topods", None), TopoDS_Face):   # a FaceSurface
+        return face.topods
+    wrapped = getattr(face, "wrapped", face)
+    if isinstance(wrapped, TopoDS_Face):
+        return wrapped
+    try:
+        return TopoDS.Face_s(wrapped)
+    except Exception as exc:  # OCP raises Standard_TypeMismatch for non-faces
+        raise InputError(f"expected a face, got {type(face).__name__}") from exc
+
 
 MAX_DEGREE = BSplCLib.MaxDegree_s()  # 25: no B-spline is higher; the kernel is sized for it
 _KIND_CODES = {

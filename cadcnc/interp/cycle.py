@@ -36,7 +36,10 @@ CURVATURE = "curvature"      # concave curvature tighter than the ball: R' k >= 
 SINGULAR = "singular"        # a singular parameter point (pole, apex, collapsed edge)
 DIVERGED = "diverged"        # the carried error exceeded its safety limit
 MAX_CYCLES = "max_cycles"    # the cycle limit was reached
-STOP_REASONS = (END, CLOSED, BOUNDARY, TANGENT, CURVATURE, SINGULAR, DIVERGED, MAX_CYCLES)
+COLLISION = "collision"      # the ball or shank would come closer than allowed to a third
+                             # face (the stepper's guard, docs/interpolator.md)
+STOP_REASONS = (END, CLOSED, BOUNDARY, TANGENT, CURVATURE, SINGULAR, DIVERGED, MAX_CYCLES,
+                COLLISION)
 
 
 class SurfaceLike(Protocol):
@@ -102,12 +105,41 @@ class Contact:
 
 
 class StopCycle(Exception):
-    """Raised inside a cycle when the geometry forbids it; carries a stop reason."""
+    """Raised inside a cycle when the geometry forbids it; carries a stop reason and, for a
+    rule with a continuous measure, its ``margin`` (< 0 or, for curvature, <= 0 broken;
+    NaN where the rule is a yes/no answer). Landing solves for the margin's zero."""
 
-    def __init__(self, reason: str, detail: str):
+    def __init__(self, reason: str, detail: str, margin: float = math.nan):
         super().__init__(detail)
         self.reason = reason
         self.detail = detail
+        self.margin = margin
+
+
+def tangent_detail(s: float, tol: Tolerances) -> str:
+    return f"faces tangent: |n1 x n2| = {s:.3g} < {tol.tangent_sin:g}"
+
+
+def curvature_detail(label: str, k: float, rk: float) -> str:
+    return (f"{label}: concave curvature k = {k:.6g} 1/mm is tighter than the ball "
+            f"(R' k = {rk:.4g} >= 1)")
+
+
+def singular_detail(label: str, u: float, w: float) -> str:
+    return f"{label}: contact reaches a singular parameter point (u={u:.6g}, w={w:.6g})"
+
+
+def diverged_detail(label: str, eps: float, tol: Tolerances) -> str:
+    return f"{label}: carried error {eps:.4g} mm exceeds {tol.diverged:g} mm"
+
+
+def boundary_detail(left: str) -> str:
+    return f"contact on {left} reached the boundary of its face"
+
+
+CORRECTION_SINGULAR = ("correction system singular: the two spheres' normals are parallel "
+                       "(tangent faces)")
+MOVE_UNDEFINED = "the contact's move is undefined: a principal curvature equals 1/R'"
 
 
 def track_direction(c1: Contact, c2: Contact, t_prev: Vec, tol: Tolerances) -> Vec:
@@ -115,7 +147,7 @@ def track_direction(c1: Contact, c2: Contact, t_prev: Vec, tol: Tolerances) -> V
     m = cross(c1.n, c2.n)
     s = norm(m)
     if s < tol.tangent_sin:
-        raise StopCycle(TANGENT, f"faces tangent: |n1 x n2| = {s:.3g} < {tol.tangent_sin:g}")
+        raise StopCycle(TANGENT, tangent_detail(s, tol))
     if dot(m, t_prev) < 0.0:
         s = -s
     return scale(m, 1.0 / s)
@@ -140,8 +172,7 @@ def correct(p_star: Vec, c1: Contact, c2: Contact, k1: float, k2: float,
     e2, b2 = _sphere_row(c2, k2, p_star, tol)
     dp = solve3(e1, e2, cross(e1, e2), (b1, b2, 0.0))
     if dp is None:
-        raise StopCycle(TANGENT, "correction system singular: the two spheres' normals are "
-                                 "parallel (tangent faces)")
+        raise StopCycle(TANGENT, CORRECTION_SINGULAR)
     return add(p_star, dp)
 
 
@@ -173,8 +204,7 @@ def inverse_exact(c: Contact, p_e: Vec) -> tuple[float, float]:
     b1, b2 = dot(d, c.ru), dot(d, c.rw)
     det = a11 * a22 - a12 * a12
     if det == 0.0:
-        raise StopCycle(CURVATURE, "the contact's move is undefined: a principal curvature "
-                                   "equals 1/R'")
+        raise StopCycle(CURVATURE, MOVE_UNDEFINED)
     return (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
 
 
@@ -204,8 +234,7 @@ def paper_inverse_ratio(c: Contact, k: float) -> float:
 def check_curvature(c: Contact, k: float, label: str) -> None:
     """Refuse a concave curvature the ball cannot follow without gouging (R' k >= 1)."""
     if c.offset * k >= 1.0:
-        raise StopCycle(CURVATURE, f"{label}: concave curvature k = {k:.6g} 1/mm is tighter "
-                                   f"than the ball (R' k = {c.offset * k:.4g} >= 1)")
+        raise StopCycle(CURVATURE, curvature_detail(label, k, c.offset * k), 1.0 - c.offset * k)
 
 
 class Track(NamedTuple):

@@ -3,8 +3,9 @@
 Row K holds the state after cycle K (row 0: the start): the cutter centre, both contacts'
 parameters and local geometry, the commanded step f of the cycle that led to it and the
 actual step |dp| (both 0 for the start). Arrays grow in chunks (doubling), so a cycle
-writes numbers into existing memory and creates no Python objects that outlive it: 45
-float64 per cycle, 360 bytes. Index 0/1 of the second axis is surface 1/2.
+writes numbers into existing memory and creates no Python objects that outlive it: 46
+float64 per cycle, 368 bytes (one row of one array). Index 0/1 of the second axis is
+surface 1/2.
 """
 
 from __future__ import annotations
@@ -26,56 +27,72 @@ FIELDS = {
 }
 
 
+COLUMNS = {}
+"""name -> (first column, per-row shape) in the record's (capacity, ROW) array."""
+_col = 0
+for _name, _shape in FIELDS.items():
+    COLUMNS[_name] = (_col, _shape)
+    _col += int(np.prod(_shape, dtype=int))
+ROW = _col   # 46 float64: 368 bytes per cycle
+
+
 class PathRecord:
     """Per-point log of the cutter centre and both contacts' geometry; see the module doc.
 
     Each field is a property returning the filled rows as a numpy view, e.g.
-    ``record.points`` (N, 3) or ``record.forms`` (N, 2, 6).
+    ``record.points`` (N, 3) or ``record.forms`` (N, 2, 6). All fields live in one
+    (capacity, ROW) float64 array, ``rows``, which the compiled stepper writes directly.
     """
 
-    __slots__ = ("_n", "_data")
+    __slots__ = ("_n", "rows")
 
     def __init__(self, capacity: int = 1024):
         self._n = 0
-        self._data = {k: np.empty((capacity, *shape)) for k, shape in FIELDS.items()}
+        self.rows = np.empty((capacity, ROW))
 
     def __len__(self) -> int:
         return self._n
 
     @property
     def nbytes_per_row(self) -> int:
-        return sum(a[0].nbytes if a.ndim > 1 else a.itemsize for a in self._data.values())
+        return self.rows[0].nbytes
 
-    def _grow(self) -> None:
-        for k, a in self._data.items():
-            bigger = np.empty((2 * len(a), *a.shape[1:]))
-            bigger[:len(a)] = a
-            self._data[k] = bigger
+    def grow(self) -> None:
+        """Double the capacity (the filled rows are kept)."""
+        bigger = np.empty((2 * len(self.rows), ROW))
+        bigger[:len(self.rows)] = self.rows
+        self.rows = bigger
+
+    def set_length(self, n: int) -> None:
+        """Rows 0..n-1 are filled (after the compiled stepper wrote them)."""
+        self._n = n
 
     def add(self, p, c1, c2, f: float, step: float, ratio: float = 1.0) -> None:
         """Append one row: centre ``p`` (3-tuple), contacts ``c1``/``c2``, f and |dp| (mm),
         and the accuracy rule's step ratio."""
         n = self._n
-        d = self._data
-        if n == len(d["steps"]):
-            self._grow()
-        d["points"][n] = p
-        for side, c in ((0, c1), (1, c2)):
-            d["uv"][n, side] = c.u, c.w
-            d["contacts"][n, side] = c.r
-            d["ru"][n, side] = c.ru
-            d["rw"][n, side] = c.rw
-            d["normals"][n, side] = c.n
-            d["forms"][n, side] = c.E, c.F, c.G, c.L, c.M, c.N
-        d["commanded"][n] = f
-        d["steps"][n] = step
-        d["ratio"][n] = ratio
+        if n == len(self.rows):
+            self.grow()
+        row = self.rows[n]
+        row[0:3] = p
+        row[3:7] = c1.u, c1.w, c2.u, c2.w
+        col = 7
+        for name in ("r", "ru", "rw", "n"):
+            row[col:col + 3] = getattr(c1, name)
+            row[col + 3:col + 6] = getattr(c2, name)
+            col += 6
+        row[31:37] = c1.E, c1.F, c1.G, c1.L, c1.M, c1.N
+        row[37:43] = c2.E, c2.F, c2.G, c2.L, c2.M, c2.N
+        row[43:46] = f, step, ratio
         self._n = n + 1
 
     def field(self, name: str) -> np.ndarray:
         """The filled rows of field ``name`` (a view; copy it to keep it past new rows)."""
-        return self._data[name][:self._n]
-
+        col, shape = COLUMNS[name]
+        width = int(np.prod(shape, dtype=int))
+        if not shape:
+            return self.rows[:self._n, col]
+        return self.rows[:self._n, col:col + width].reshape((self._n, *shape))
     points = property(lambda self: self.field("points"))
     uv = property(lambda self: self.field("uv"))
     contacts = property(lambda self: self.field("contacts"))

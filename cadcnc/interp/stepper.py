@@ -9,13 +9,17 @@ Kernel-free, like :mod:`cadcnc.interp.cycle`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import Protocol
 
 from ..job import MIN_STEP, check_number, check_step
 from .cycle import (
-    BOUNDARY, CLOSED, DIVERGED, END, MAX_CYCLES, SINGULAR, Contact, StopCycle, SurfaceLike,
-    Track, accurate_step, advance, check_curvature, track,
+    BOUNDARY, CLOSED, COLLISION, CURVATURE, DIVERGED, END, MAX_CYCLES, SINGULAR, Contact, StopCycle,
+    SurfaceLike, Track, accurate_step, advance, boundary_detail, check_curvature,
+    diverged_detail, singular_detail, track,
 )
+from .landing import LANDING_TOL, MAX_TRIALS, land
 from ..tolerances import DEFAULT, Tolerances
 from ..trim import OUTSIDE
 from .record import PathRecord
@@ -29,6 +33,18 @@ class Tangency:
     p: Vec
     uv1: tuple[float, float]
     uv2: tuple[float, float]
+
+
+class Guard(Protocol):
+    """Clearance from the faces other than the two followed (docs/interpolator.md).
+
+    ``margin(p)``: the signed clearance (mm) of the cutter centre p (3-tuple) from those
+    faces, >= 0 clear, < 0 when the ball or shank comes closer than allowed, and a detail
+    naming what is touched (e.g. "ball touches face 7"). Continuous in p: the stepper lands
+    on its zero.
+    """
+
+    def margin(self, p: Vec) -> tuple[float, str]: ...
 
 
 class Stepper:
@@ -45,13 +61,30 @@ class Stepper:
     override, this is counted: ``accuracy_cycles`` steps were shortened, the shortest to
     ``accuracy_ratio`` of F Ts; ``record.ratio`` holds it per cycle. The commanded step
     of the job must be at least MIN_STEP (1e-6 mm); a later override may ask for less.
+
+    ``guard`` (a :class:`Guard`, optional) is asked for every trial that passes the other
+    rules; a negative margin stops the path with ``collision``, landed tangent to the
+    third face like any other limit. ``compiled``: None (default) runs the compiled
+    kernel (cadcnc.interp.compiled) when both surfaces have compiled data, False forces
+    this plain-Python reference.
     """
+
+    compiled_class: type | None = None
+    """Set by cadcnc.interp.compiled: the stepper used when both surfaces have compiled
+    data (``surface.kernel``) and ``compiled`` is not False."""
+
+    def __new__(cls, s1, s2, *args, compiled: bool | None = None, **kwargs):
+        if (cls is Stepper and compiled is not False and Stepper.compiled_class is not None
+                and getattr(s1, "kernel", None) and getattr(s2, "kernel", None)):
+            cls = Stepper.compiled_class
+        return object.__new__(cls)
 
     def __init__(self, s1: SurfaceLike, s2: SurfaceLike, offsets: tuple[float, float],
                  start: Tangency, *, feed: float, period: float, direction: Vec,
                  end: Tangency | None = None, closed: bool = False,
                  tol: Tolerances = DEFAULT, max_cycles: int = 1_000_000,
-                 record: bool = True, check_boundary: bool = True):
+                 record: bool = True, check_boundary: bool = True, guard: Guard | None = None,
+                 compiled: bool | None = None):
         self.tol = tol
         self.period = check_number("period", period, "s")
         self.feed = self._check_feed(feed)
@@ -67,6 +100,10 @@ class Stepper:
         self.closed = closed
         self.max_cycles = max_cycles
         self.check_boundary = check_boundary
+        self.guard = guard
+        self._watch: str | None = None   # the rule whose margin a trial reports (landing)
+        self._margin = math.nan          # that margin at the last trial
+        self.landing_trials = 0          # trial cycles of the last landing (failed step incl.)
         self.cycles = 0
         self.travelled = 0.0
         self.stop_reason: str | None = None
@@ -96,14 +133,20 @@ class Stepper:
     def _stop(self, reason: str, detail: str) -> None:
         self.stop_reason, self.stop_detail = reason, detail
 
-    def step(self, feed: float | None = None) -> Vec | None:
-        """Compute the next period's axis increment dp_K (mm); None once stopped."""
+    def _may_step(self, feed: float | None) -> bool:
+        """Take a feed override and apply the cycle limit: False when no step follows."""
         if self.stop_reason is not None:
-            return None
+            return False
         if feed is not None:
             self.feed = self._check_feed(feed)
         if self.cycles >= self.max_cycles:
             self._stop(MAX_CYCLES, f"cycle limit {self.max_cycles} reached")
+            return False
+        return True
+
+    def step(self, feed: float | None = None) -> Vec | None:
+        """Compute the next period's axis increment dp_K (mm); None once stopped."""
+        if not self._may_step(feed):
             return None
         f_cmd = self.step_length
         self._ratio = 1.0
@@ -142,58 +185,116 @@ class Stepper:
 
     # -- pieces of a step -----------------------------------------------------------------
     def _advance(self, f: float) -> tuple[Vec, Vec]:
-        """Run one cycle into the spare contacts; raises StopCycle on a geometric stop."""
+        """Run one cycle into the spare contacts; raises StopCycle on a geometric stop.
+
+        Every rule with a continuous margin keeps the smallest one of the watched rule
+        (``self._watch``) in ``self._margin``; a StopCycle carries its own rule's margin."""
         t = self._tr.t
-        p_e, uv1, uv2 = advance(self.p, self.c1, self.c2, self._tr, f, self.tol)
+        tol, watch = self.tol, self._watch
+        p_e, uv1, uv2 = advance(self.p, self.c1, self.c2, self._tr, f, tol)
         for spare, uv, label in ((self._n1, uv1, 1), (self._n2, uv2, 2)):
             spare.move_to(*uv)
-            if spare.singularity < self.tol.near_singular:
-                raise StopCycle(SINGULAR, f"surface {label}: contact reaches a singular "
-                                          f"parameter point (u={spare.u:.6g}, w={spare.w:.6g})")
+            m = spare.singularity - tol.near_singular
+            if m < 0.0:
+                raise StopCycle(SINGULAR, singular_detail(f"surface {label}", spare.u, spare.w),
+                                m)
+            if watch == SINGULAR:
+                self._margin = min(self._margin, m)
             eps = norm(sub(p_e, spare.centre()))
-            if eps > self.tol.diverged:
-                raise StopCycle(DIVERGED, f"surface {label}: carried error {eps:.4g} mm "
-                                          f"exceeds {self.tol.diverged:g} mm")
+            if eps > tol.diverged:
+                raise StopCycle(DIVERGED, diverged_detail(f"surface {label}", eps, tol),
+                                tol.diverged - eps)
+            if watch == DIVERGED:
+                self._margin = min(self._margin, tol.diverged - eps)
             # the new contact too: a point whose ball cannot touch there is never emitted
-            check_curvature(spare, spare.curvature(t), f"surface {label}")
+            k = spare.curvature(t)
+            check_curvature(spare, k, f"surface {label}")
+            if watch == CURVATURE:
+                self._margin = min(self._margin, 1.0 - spare.offset * k)
         return p_e, t
 
     def _try(self, f: float) -> tuple[str, str] | None:
         """Attempt a cycle of step f: None (and ``self._trial`` = (p_e, t)) on success,
-        else the (reason, detail) that forbids it."""
+        else the (reason, detail) that forbids it. ``self._margin``: the margin of the
+        failing rule, or on success of the watched one (NaN for yes/no rules)."""
+        self._margin = math.inf
         try:
             p_e, t = self._advance(f)
         except StopCycle as stop:
+            self._margin = stop.margin
             return stop.reason, stop.detail
+        if self._watch not in (SINGULAR, DIVERGED, CURVATURE):
+            self._margin = math.nan
         if self.check_boundary:
             left = self._left_face(p_e, t)
             if left:
-                return BOUNDARY, f"contact on {left} reached the boundary of its face"
+                return BOUNDARY, boundary_detail(left)
+        if self.guard is not None:
+            clearance, detail = self.guard.margin(p_e)
+            if self._watch == COLLISION or clearance < 0.0:
+                self._margin = clearance
+            if clearance < 0.0:
+                return COLLISION, detail
         self._trial = (p_e, t)
         return None
 
     def _land_on_limit(self, f: float, failure: tuple[str, str]) -> Vec | None:
         """Shorten the step to the limit the geometry allows (a contact on its face's
-        boundary, R' k reaching 1, a singular point, tangent faces), commit it, and stop.
+        boundary, R' k reaching 1, a singular point, tangent faces, a guard's zero
+        clearance), commit it, and stop.
 
-        Bisection on the step length, 48 halvings (to ~f * 4e-15); the reason reported is
-        the one found next to the limit. Only trials that pass every check are committed.
+        At most MAX_TRIALS cycles in all (:func:`~cadcnc.interp.landing.land`: regula falsi
+        on the failing rule's margin, bisection for yes/no rules), to LANDING_TOL of step
+        where the trials allow it; the reason reported is the one found next to the limit.
+        Only trials that pass every check are committed.
         """
-        lo, hi = 0.0, 1.0
-        for _ in range(48):
-            mid = 0.5 * (lo + hi)
-            found = self._try(mid * f)
+        state = {"failure": failure, "kept": False}
+
+        def trial(s: float) -> tuple[bool, float, bool]:
+            self._watch = state["failure"][0]
+            found = self._try(s * f)
             if found is None:
-                lo = mid
-            else:
-                hi, failure = mid, found
-        reason, detail = failure
-        if lo * f < 1e-12 or self._try(lo * f) is not None:
+                self._keep_trial()
+                state["kept"] = True
+                return True, self._margin, False
+            changed = found[0] != state["failure"][0]
+            state["failure"] = found
+            return False, self._margin, changed
+
+        margin_hi = self._margin
+        lo, used = land(trial, self._state_margin(failure[0]), margin_hi, MAX_TRIALS - 1,
+                        LANDING_TOL / f)
+        self._watch = None
+        self.landing_trials = used + 1
+        reason, detail = state["failure"]
+        if lo * f < 1e-12 or not state["kept"]:
             self._stop(reason, detail + " (no step possible from the current point)")
             return None
-        dp = self._commit(*self._trial, lo * f)
+        dp = self._commit_kept(lo * f)
         self._stop(reason, detail)
         return dp
+
+    def _keep_trial(self) -> None:
+        """Keep the trial that just passed (the landing commits the last one kept)."""
+        self._kept = (*self._trial, self._n1.copy(), self._n2.copy())
+
+    def _commit_kept(self, f: float) -> Vec:
+        p_e, t, self._n1, self._n2 = self._kept
+        return self._commit(p_e, t, f)
+
+    def _state_margin(self, rule: str) -> float:
+        """The margin of ``rule`` at the current point (the landing's s = 0), NaN if none."""
+        c1, c2 = self.c1, self.c2
+        if rule == SINGULAR:
+            return min(c1.singularity, c2.singularity) - self.tol.near_singular
+        if rule == DIVERGED:
+            return self.tol.diverged - max(norm(sub(self.p, c.centre())) for c in (c1, c2))
+        if rule == CURVATURE:
+            t = self._tr.t
+            return 1.0 - max(c.offset * c.curvature(t) for c in (c1, c2))
+        if rule == COLLISION:
+            return self.guard.margin(self.p)[0]
+        return math.nan
 
     def _left_face(self, p_e: Vec, t: Vec) -> str:
         """Which spare contact lies outside its trimmed face ('' if none).

@@ -1,0 +1,219 @@
+"""The real-time figures of issue 11 for the compiled stepper, ratios taken in one process.
+
+Per fixture pair (ball 3 mm, f = 0.1 mm): per step (``Stepper.step`` from Python, record
+off; compiled and the plain-Python reference) against two bare OCCT D2 calls from Python
+with their .Coord() calls; per cycle with the loop compiled (``Stepper.run``); the whole
+path (``intersection_path``, planning included) against ``GeomAPI_IntSS`` of the two
+offset surfaces, with the trim-grid build separately; latency p50 / p99 / p99.9 / max over
+``--steps`` steps with GC off; a landing step against the median step; memory per cycle
+with the record on, and growth over ``--streamed`` cycles with it off. docs/performance.md
+records a run. Times are minima or percentiles of perf_counter_ns, in microseconds.
+
+    .venv/bin/python benchmarks/bench_kernel.py [--steps 100000] [--streamed 1000000]
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.Geom import Geom_OffsetSurface
+from OCP.GeomAPI import GeomAPI_IntSS
+from OCP.gp import gp_Pnt, gp_Vec
+
+import cadcnc
+from cadcnc.interp.stepper import Stepper
+from cadcnc.ops.pair_path import pair_job, plan_path
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = [("bspline_boss", 4, 5), ("crossing_cylinders", 1, 2), ("sphere_cylinder", 1, 2),
+         ("torus_cone", 1, 2)]
+R, FEED, PERIOD = 3.0, 1500.0, 0.004
+clock = time.perf_counter_ns
+
+
+def plan_of(name: str, i: int, j: int):
+    part = cadcnc.load_step(ROOT / "fixtures" / f"{name}.step")
+    s1, s2, job = pair_job(part.face(i), part.face(j), radius=R, feed=FEED, period=PERIOD)
+    return part, plan_path(s1, s2, job), job
+
+
+def stepper(plan, job, compiled=None, record=False, end=True, max_cycles=10**9, guard=None):
+    return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
+                   period=job.period, direction=plan.direction,
+                   end=plan.end if end else None, closed=plan.closed and end,
+                   tol=job.tolerances, check_boundary=plan.check_boundary,
+                   compiled=compiled, record=record, max_cycles=max_cycles, guard=guard)
+
+
+class PlaneGuard:
+    """A wall x = c the ball centre must stay ``gap`` before (a linear clearance)."""
+
+    def __init__(self, c: float, gap: float):
+        self.c, self.gap = c, gap
+
+    def margin(self, p):
+        return self.c - self.gap - p[0], "ball touches the wall"
+
+
+LANDINGS = [("ramp_wall", 3, 7, None),                   # boundary: a yes/no rule, bisected
+            ("pocket", 10, 17, PlaneGuard(5.0123456789, 3.0))]   # collision: regula falsi
+
+
+def step_times(st, n: int) -> np.ndarray:
+    """Per-step times (us) of n steps with GC off (fewer if the path stops)."""
+    out = np.empty(n)
+    gc.collect()
+    gc.disable()
+    try:
+        k = 0
+        while k < n:
+            t0 = clock()
+            dp = st.step()
+            out[k] = clock() - t0
+            if dp is None:
+                break
+            k += 1
+    finally:
+        gc.enable()
+    return out[:k] / 1000.0
+
+
+def bare_d2(plan, n: int = 20000) -> float:
+    """Minimum time (us) of two OCCT D2 calls from Python with their 12 .Coord() calls."""
+    adaptors = [BRepAdaptor_Surface(s.topods, True) for s in (plan.s1, plan.s2)]
+    uvs = [plan.start.uv1, plan.start.uv2]
+    p, v = gp_Pnt(), [gp_Vec() for _ in range(5)]
+    best = float("inf")
+    for _ in range(n):
+        t0 = clock()
+        for a, (u, w) in zip(adaptors, uvs):
+            a.D2(u, w, p, v[0], v[1], v[2], v[3], v[4])
+            p.Coord(), v[0].Coord(), v[1].Coord(), v[2].Coord(), v[4].Coord(), v[3].Coord()
+        best = min(best, clock() - t0)
+    return best / 1000.0
+
+
+def int_ss(plan) -> float:
+    """Time (us) of GeomAPI_IntSS of the two offset surfaces (signed by face normal)."""
+    surfaces = [Geom_OffsetSurface(s.geom_surface, s.normal_sign * off)
+                for s, off in zip((plan.s1, plan.s2), plan.offsets)]
+    best = float("inf")
+    for _ in range(3):
+        t0 = clock()
+        inter = GeomAPI_IntSS(surfaces[0], surfaces[1], 1e-7)
+        best = min(best, clock() - t0)
+        assert inter.IsDone()
+    return best / 1000.0
+
+
+def whole_path(part, i: int, j: int) -> tuple[float, float, int]:
+    """(best time of intersection_path us, of which trim-grid builds us, points)."""
+    best, grids, points = float("inf"), 0.0, 0
+    for _ in range(3):
+        fa, fb = part.face(i), part.face(j)
+        for f in (fa, fb):
+            f._kernel = None   # rebuilt inside the timed call: planning includes it
+        t0 = clock()
+        tp = cadcnc.intersection_path(fa, fb, radius=R, feed=FEED, period=PERIOD)
+        t = clock() - t0
+        if t < best:
+            best, points = t, len(tp.points)
+            grids = sum(f.kernel[1].stats["build_s"] for f in (fa, fb)) * 1e9
+    return best / 1000.0, grids / 1000.0, points
+
+
+def loop_per_cycle(plan, job, cycles: int) -> float:
+    st = stepper(plan, job, end=False, max_cycles=cycles)
+    t0 = clock()
+    st.run()
+    return (clock() - t0) / 1000.0 / max(st.cycles, 1)
+
+
+def landing(plan, job, guard=None, reps: int = 20) -> tuple[float, float, str, int]:
+    """(minimum time us of the step that lands on a limit, median step us of the same
+    stepper, stop reason, trial cycles of the landing)."""
+    best, steps = float("inf"), []
+    for _ in range(reps):
+        st = stepper(plan, job, guard=guard)
+        dp = 0.0
+        while dp is not None:
+            t0 = clock()
+            dp = st.step()
+            last = clock() - t0
+            if st.stopped:
+                break
+            steps.append(last)
+        best = min(best, last)
+    return best / 1000.0, float(np.median(steps)) / 1000.0, st.stop_reason, st.landing_trials
+
+
+def memory(plan, job, cycles: int, streamed: int) -> tuple[float, float, int]:
+    """(bytes per cycle with the record on, traced growth in bytes over ``streamed``
+    cycles with it off (Python loop of step()), cycles run)."""
+    tracemalloc.start()
+    base = tracemalloc.get_traced_memory()[0]
+    st = stepper(plan, job, record=True, end=False, max_cycles=cycles)
+    st.run()
+    per_cycle = (tracemalloc.get_traced_memory()[0] - base) / st.cycles
+    del st
+    st = stepper(plan, job, record=False, end=False, max_cycles=streamed)
+    for _ in range(1000):
+        st.step()
+    before = tracemalloc.get_traced_memory()[0]
+    while st.step() is not None:
+        pass
+    growth = tracemalloc.get_traced_memory()[0] - before
+    tracemalloc.stop()
+    return per_cycle, growth, st.cycles
+
+
+def pct(us: np.ndarray) -> str:
+    p50, p99, p999 = np.percentile(us, [50, 99, 99.9])
+    return (f"p50 {p50:6.2f}  p99 {p99:6.2f}  p99.9 {p999:6.2f}  max {us.max():8.2f}  "
+            f"(p99.9 / p50 {p999 / p50:.2f})")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--steps", type=int, default=100_000)
+    ap.add_argument("--streamed", type=int, default=1_000_000)
+    args = ap.parse_args()
+    for name, i, j in CASES:
+        part, plan, job = plan_of(name, i, j)
+        stepper(plan, job).run()                                   # warm-up (JIT load)
+        d2 = bare_d2(plan)
+        ref = step_times(stepper(plan, job, compiled=False), 2000)
+        fast = step_times(stepper(plan, job, end=False), args.steps)
+        per_cycle = loop_per_cycle(plan, job, 200_000)
+        path_us, grid_us, points = whole_path(part, i, j)
+        ss = int_ss(plan)
+        print(f"{name} faces {i},{j} (f = 0.1 mm)")
+        print(f"  two bare OCCT D2 + .Coord() : {d2:6.2f} us (min)")
+        print(f"  step, compiled (min / p50)  : {fast.min():6.2f} / {np.median(fast):6.2f} us"
+              f"  = {np.median(fast) / d2:.2f}x the two D2")
+        print(f"  step, reference (min / p50) : {ref.min():6.2f} / {np.median(ref):6.2f} us"
+              f"  ({np.median(ref) / np.median(fast):.1f}x the compiled)")
+        print(f"  cycle, loop compiled        : {per_cycle:6.3f} us")
+        print(f"  whole path ({points} points)  : {path_us / 1000:8.2f} ms (trim grids "
+              f"{grid_us / 1000:.2f} ms), GeomAPI_IntSS {ss / 1000:8.2f} ms: "
+              f"{ss / path_us:.1f}x faster")
+        print(f"  latency, {len(fast)} steps, GC off: {pct(fast)}")
+        if name == CASES[0][0]:
+            per, growth, n = memory(plan, job, 100_000, args.streamed)
+            print(f"  memory: record on {per:.0f} B/cycle (traced, doubling chunks incl.); "
+                  f"record off: {growth} B growth over {n} streamed cycles")
+    for name, i, j, guard in LANDINGS:
+        _, plan, job = plan_of(name, i, j)
+        land, median, reason, trials = landing(plan, job, guard)
+        print(f"landing {name} faces {i},{j}: {reason} in {trials} trial cycles, "
+              f"{land:6.1f} us = {land / median:.1f}x the median step ({median:.2f} us)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,289 @@
+"""The stepper on the compiled kernel: Stepper's rules, with the period's work in numba.
+
+``Stepper(...)`` builds a :class:`CompiledStepper` when both surfaces offer compiled data
+(``surface.kernel`` = (surface data, trim grid), see cadcnc.geometry.face_surface) and
+``compiled`` is not False. Each period is one call of ``kernel.step.step`` (track,
+accurate step, end landing, trial cycle on the compiled evaluators, O(1) trim check,
+commit, record row); Python is entered only for what the kernel leaves to it: an exact
+trim classification where a contact's grid cell is MIXED, the guard, a landing (the same
+``landing.land`` as the reference) and the messages. ``run`` loops in the kernel
+(``kernel.step.run``) between such events. The plain-Python Stepper stays the reference:
+tests compare the two paths point for point. No OCCT here.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import GeometryError
+from ..job import MIN_STEP as JOB_MIN_STEP
+from ..job import check_number, check_step
+from ..tolerances import DEFAULT
+from ..trim import OUTSIDE
+from .cycle import (
+    BOUNDARY, CLOSED, COLLISION, CORRECTION_SINGULAR, CURVATURE, DIVERGED, END, MAX_CYCLES,
+    Contact,
+    MOVE_UNDEFINED, SINGULAR, TANGENT, boundary_detail, curvature_detail, diverged_detail,
+    singular_detail, tangent_detail,
+)
+from .kernel import entry as E
+from .kernel import step as K
+from .kernel.cycle_math import C_OFF, C_SING, C_U, C_W, CS
+from .record import ROW, PathRecord
+from .stepper import Stepper, Tangency
+from .vec3 import Vec
+
+_CODES = {SINGULAR: K.SINGULAR, DIVERGED: K.DIVERGED, CURVATURE: K.CURVATURE}
+_NO_ROWS = np.zeros((1, ROW))
+
+
+def kernel_data(surface) -> tuple | None:
+    """The surface's (surface data, trim grid) when it has them, else None."""
+    return getattr(surface, "kernel", None)
+
+
+def pack(surfaces, grids) -> tuple[np.ndarray, np.ndarray]:
+    """F (float64) and I (int64) holding both surfaces' evaluator arrays, trim grids and
+    wrap data in the layout of kernel/step.py."""
+    floats, ints = [np.zeros(32)], [np.zeros(32, dtype=np.int64)]
+    nf, ni = 32, 32
+    for s, (surface, (data, grid)) in enumerate(zip(surfaces, grids)):
+        kind, params, iarr, ku, kv, poles, weights = data.args
+        h = 16 * s
+        head = ints[0]
+        head[h] = kind
+        for slot, arr in ((1, params), (5, ku), (7, kv), (9, poles), (12, weights)):
+            head[h + slot] = nf
+            floats.append(np.ascontiguousarray(arr, dtype=np.float64).ravel())
+            nf += floats[-1].size
+        head[h + 2], head[h + 6], head[h + 8] = len(params), len(ku), len(kv)
+        head[h + 10], head[h + 11] = poles.shape[0], poles.shape[1]
+        head[h + 3], head[h + 4] = ni, len(iarr)
+        ints.append(np.asarray(iarr, dtype=np.int64))
+        ni += len(iarr)
+        labels, u0, w0, du, dw, nu, nw = grid.kernel_args
+        head[h + 13], head[h + 14], head[h + 15] = ni, nu, nw
+        ints.append(labels.astype(np.int64).ravel())
+        ni += nu * nw
+        (umin, _), (wmin, _) = surface.u_range, surface.w_range
+        floats[0][h:h + 13] = (u0, w0, du, dw, *grid.window, umin, surface.u_period or 0.0,
+                               wmin, surface.w_period or 0.0, surface.normal_sign)
+    return np.concatenate(floats), np.concatenate(ints)
+
+
+class CompiledStepper(Stepper):
+    """:class:`Stepper` with the per-period work compiled; the same attributes, steps and
+    stop rules (its state lives in the kernel's array ``S``)."""
+
+    def __init__(self, s1, s2, offsets: tuple[float, float], start: Tangency, *,
+                 feed: float, period: float, direction: Vec, end: Tangency | None = None,
+                 closed: bool = False, tol=None, max_cycles: int = 1_000_000,
+                 record: bool = True, check_boundary: bool = True, guard=None,
+                 compiled: bool | None = None):
+        tol = DEFAULT if tol is None else tol
+        self.tol, self.surfaces = tol, (s1, s2)
+        self.period = check_number("period", period, "s")
+        self.feed = self._check_feed(feed)
+        check_step(self.feed, self.period)
+        self._grids = (kernel_data(s1)[1], kernel_data(s2)[1])
+        self.F, self.I = pack((s1, s2), (kernel_data(s1), kernel_data(s2)))
+        self.S = S = np.zeros(K.STATE_SIZE)
+        self.record = PathRecord() if record else None
+        S[K.P:K.P + 3] = start.p
+        d = math.sqrt(sum(float(x) ** 2 for x in direction))
+        S[K.T:K.T + 3] = [float(x) / d for x in direction] if d > 0 else 0.0
+        self.end = Tangency(start.p, start.uv1, start.uv2) if closed else end
+        if self.end is not None:
+            S[K.END_P:K.END_P + 3] = self.end.p
+            S[K.END_UV1:K.END_UV1 + 2] = self.end.uv1
+            S[K.END_UV2:K.END_UV2 + 2] = self.end.uv2
+            S[K.HAS_END] = 1.0
+        S[K.TOL_TANGENT:K.TOL_END + 1] = (tol.tangent_sin, tol.flat_curvature,
+                                         tol.near_singular, tol.diverged, tol.accuracy,
+                                         tol.end_reached)
+        S[K.MIN_STEP], S[K.CHECK_BOUNDARY] = JOB_MIN_STEP, float(check_boundary)
+        S[K.AUTO_COMMIT], S[K.ACC_RATIO], S[K.RATIO] = float(guard is None), 1.0, 1.0
+        for side, o in enumerate((K.C1, K.C2)):
+            for block in (o, o + K.N1 - K.C1, o + K.KEPT1 - K.C1):
+                S[block + C_OFF] = float(offsets[side])
+            uv = (start.uv1, start.uv2)[side]
+            S[E.ARG_U], S[E.ARG_W] = uv
+            if self._call(E.OP_MOVE_TO, -1, 0.0, side)[0] != 0:
+                raise GeometryError(f"surface {side + 1}: the compiled evaluator cannot "
+                                    f"evaluate the start contact {tuple(uv)}")
+        self.closed, self.max_cycles, self.check_boundary = closed, max_cycles, check_boundary
+        self.guard, self.stop_reason, self.stop_detail = guard, None, ""
+        self._watch, self._margin, self.landing_trials = None, math.nan, 0
+        if self.record is not None:
+            self._call(E.OP_FIRST_ROW, 0)
+            self.record.set_length(1)
+
+    # -- state read from the kernel's array ------------------------------------------------
+    p = property(lambda self: tuple(self.S[K.P:K.P + 3].tolist()))
+    t = property(lambda self: tuple(self.S[K.T:K.T + 3].tolist()))
+    cycles = property(lambda self: int(self.S[K.CYCLES]))
+    travelled = property(lambda self: float(self.S[K.TRAVELLED]))
+    accuracy_cycles = property(lambda self: int(self.S[K.ACC_CYCLES]))
+    accuracy_ratio = property(lambda self: float(self.S[K.ACC_RATIO]))
+    c1 = property(lambda self: self._contact(0))
+    c2 = property(lambda self: self._contact(1))
+
+    def _contact(self, side: int) -> Contact:
+        """A snapshot of contact 1 or 2 as the reference's Contact (for inspection)."""
+        o, S = (K.C1, K.C2)[side], self.S
+        c = object.__new__(Contact)
+        c.surface, c.offset, c.u, c.w = self.surfaces[side], S[o + C_OFF], S[o + C_U], S[o + C_W]
+        c.r, c.ru, c.rw, c.n = (tuple(S[o + k:o + k + 3].tolist()) for k in (2, 5, 8, 11))
+        c.E, c.F, c.G, c.L, c.M, c.N = S[o + 14:o + 20].tolist()
+        c.singularity = float(S[o + C_SING])
+        return c
+
+    def _call(self, op: int, n: int, x: float = 0.0, k: int = 0) -> tuple:
+        """One kernel operation (kernel/step.py ``entry``)."""
+        return E.entry(op, self.F, self.I, self.S, self._rows(), n, x, k)
+
+    def _row(self) -> int:
+        """The record row the next commit writes (-1: record off), growing it if full."""
+        rec = self.record
+        if rec is None:
+            return -1
+        if len(rec) == len(rec.rows):
+            rec.grow()
+        return len(rec)
+
+    def _rows(self) -> np.ndarray:
+        return _NO_ROWS if self.record is None else self.record.rows
+
+    def _committed(self, n: int) -> Vec:
+        if n >= 0:
+            self.record.set_length(n + 1)
+        return tuple(self.S[K.DP:K.DP + 3].tolist())
+
+    def step(self, feed: float | None = None) -> Vec | None:
+        """As :meth:`Stepper.step`: the next period's dp_K (mm), None once stopped."""
+        if not self._may_step(feed):
+            return None
+        n = self._row()
+        status = E.entry(E.OP_STEP, self.F, self.I, self.S, self._rows(), n,
+                         self.step_length, 0)[0]
+        if status == K.DONE:
+            return self._committed(n)
+        return self._finish(status, n)
+
+    def run(self, progress=None, every: int = 10000) -> "Stepper":
+        """As :meth:`Stepper.run`, with the loop in the kernel between events."""
+        reported = -1
+        while self.stop_reason is None:
+            limit = self.max_cycles
+            if progress is not None:
+                limit = min(limit, (self.cycles // every + 1) * every)
+            n = self._row()
+            status, n, _ = self._call(E.OP_RUN, n, self.step_length, limit)
+            if self.record is not None:
+                self.record.set_length(n)
+            if status == K.MAX_CYCLES:
+                if self.cycles >= self.max_cycles:
+                    self._stop(MAX_CYCLES, f"cycle limit {self.max_cycles} reached")
+            elif status != K.RECORD_FULL and self._finish(status, self._row()) is None:
+                continue
+            cycles = self.cycles
+            if progress is not None and cycles % every == 0 and cycles != reported:
+                reported = cycles
+                progress(cycles, self.travelled)
+        return self
+
+    def _finish(self, status: int, n: int) -> Vec | None:
+        """Complete a period the kernel handed back: end, a stop, the exact checks."""
+        S = self.S
+        if status in (K.END_STOP, K.END_LANDED):
+            done = "closed intersection completed" if self.closed else "end point reached"
+            self._stop(CLOSED if self.closed else END,
+                       done if status == K.END_LANDED else "end point reached")
+            return self._committed(n) if status == K.END_LANDED else None
+        if S[K.TR_OK] == 0.0:
+            reason, detail = self._failure(status)
+            self._stop(reason, detail + " (no step possible from the current point)")
+            return None
+        self._margin = S[K.MARGIN]
+        failure = self._resolve(status)
+        if failure is None:
+            self._call(E.OP_COMMIT_TRIAL, n)
+            return self._committed(n)
+        return self._land_on_limit(float(S[K.F_TRIAL]), failure)
+
+    def _failure(self, status: int) -> tuple[str, str]:
+        S = self.S
+        label, a, b = f"surface {int(S[K.DIAG])}", S[K.DIAG + 1], S[K.DIAG + 2]
+        if status == K.TRACK_TANGENT:
+            return TANGENT, tangent_detail(a, self.tol)
+        if status == K.TANGENT:
+            return TANGENT, CORRECTION_SINGULAR
+        if status == K.MOVE_UNDEFINED:
+            return CURVATURE, MOVE_UNDEFINED
+        if status == K.CURVATURE:
+            return CURVATURE, curvature_detail(label, a, b)
+        if status == K.SINGULAR:
+            return SINGULAR, singular_detail(label, a, b)
+        if status == K.DIVERGED:
+            return DIVERGED, diverged_detail(label, a, self.tol)
+        if status == K.BOUNDARY:
+            return BOUNDARY, boundary_detail(self._left())
+        return SINGULAR, (f"{label}: the compiled evaluator cannot evaluate "
+                          f"(u={a:.6g}, w={b:.6g}) (offset surface with a singular basis)")
+
+    def _left(self) -> str:
+        """Stepper._left_face's names from the kernel's trim states; state 2 (MIXED cell)
+        is classified exactly here: left if the contact and its re-estimate are outside."""
+        S, names = self.S, []
+        for side in range(2):
+            state = S[K.TRIM_STATE + side]
+            if state == 2:
+                o = (K.N1, K.N2)[side]
+                grid = self._grids[side]
+                state = float(grid.classify(S[o + C_U], S[o + C_W]) == OUTSIDE and grid.classify(
+                    S[K.REESTIMATE + 2 * side], S[K.REESTIMATE + 2 * side + 1]) == OUTSIDE)
+            if state == 1:
+                names.append(f"surface {side + 1}")
+        return " and ".join(names)
+
+    def _resolve(self, status: int) -> tuple[str, str] | None:
+        """The rest of Stepper._try after the kernel's trial: exact trim checks, guard."""
+        if status == K.CHECK_TRIM:
+            left = self._left()
+            if left:
+                return BOUNDARY, boundary_detail(left)
+        elif status != K.PASSED:
+            return self._failure(status)
+        if self.guard is not None:
+            clearance, detail = self.guard.margin(tuple(self.S[K.P_E:K.P_E + 3].tolist()))
+            if self._watch == COLLISION or clearance < 0.0:
+                self._margin = clearance
+            if clearance < 0.0:
+                return COLLISION, detail
+        return None
+
+    # -- the landing's primitives (Stepper._land_on_limit drives them) ----------------------
+    def _try(self, f: float) -> tuple[str, str] | None:
+        self.S[K.WATCH] = _CODES.get(self._watch, K.WATCH_NONE)
+        status, _, self._margin = self._call(E.OP_TRIAL, -1, f)
+        return self._resolve(status)
+
+    def _keep_trial(self) -> None:
+        self._call(E.OP_KEEP, -1)
+
+    def _commit_kept(self, f: float) -> Vec:
+        n = self._row()
+        self._call(E.OP_COMMIT_KEPT, n, f)
+        return self._committed(n)
+
+    def _state_margin(self, rule: str) -> float:
+        if rule == COLLISION:
+            return self.guard.margin(self.p)[0]
+        return self._call(E.OP_STATE_MARGIN, -1, 0.0, _CODES[rule])[2] if rule in _CODES \
+            else math.nan
+
+
+assert K.N1 - K.C1 == K.KEPT1 - K.N1 == 2 * CS   # the contact blocks' layout
+Stepper.compiled_class = CompiledStepper

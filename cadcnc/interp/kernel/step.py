@@ -1,0 +1,374 @@
+"""The stepper's period compiled: track, accurate step, end landing, trial cycle, commit.
+
+Mirrors ``Stepper.step`` of cadcnc/interp/stepper.py (the reference) on flat arrays:
+
+- ``F`` float64 / ``I`` int64: both surfaces packed by ``cadcnc.interp.compiled.pack``
+  (evaluator arrays, trim grid, wrap); per surface s a header I[16 s : 16 s + 16]
+  (kind, offsets and lengths into F / I) and F[16 s : 16 s + 16] (grid origin, cell
+  size, window, wrap ranges and periods, normal sign).
+- ``S`` float64 (STATE_SIZE,): the state (centre, direction, contacts c1 c2, spares n1 n2,
+  the kept landing trial, counters, tolerances) and scratch; offsets below.
+- ``R`` (capacity, 46): the record's rows (PathRecord layout), written at commit when
+  ``n_rec`` >= 0.
+
+Statuses are small ints (below); the Python side turns them into stop reasons and
+messages. Nothing allocates; one trial costs two evaluations and a few hundred flops.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from .cycle_math import (
+    C_OFF, C_R, C_SING, C_U, C_W, CS, PAPER_INVERSE_LIMIT, accurate_step, axpy, centre,
+    correct, cross, curvature, dot, inverse, inverse_exact, norm, paper_inverse_ratio, put,
+    scale, set_geometry, sub, tangent_coords, vec,
+)
+from .evaluators import OK as EVAL_OK
+from .evaluators import d2
+from . import trim_lookup
+from .trim_lookup import CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE
+
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+lookup = _jit(trim_lookup.lookup)
+wrap = _jit(trim_lookup.wrap)
+
+# statuses
+DONE, TANGENT, CURVATURE, SINGULAR, DIVERGED, BOUNDARY, EVAL_FAIL, MOVE_UNDEFINED = range(8)
+TRACK_TANGENT, END_STOP, END_LANDED, PASSED, CHECK_TRIM, MAX_CYCLES, RECORD_FULL = range(8, 15)
+"""DONE: a step committed. PASSED: a trial passed every compiled rule (the caller asks the
+guard, then commits). CHECK_TRIM: a spare contact's cell is MIXED (TRIM_STATE says which):
+the caller classifies exactly. END_STOP / END_LANDED: at the end (no step / last step)."""
+
+# state offsets
+P, T, TR_T, K1, K2, EX1, EX2, TR_OK = 0, 3, 6, 9, 10, 11, 12, 13
+LAST_K1, LAST_K2, LAST_R1, LAST_R2, HAS_LAST = 14, 15, 16, 19, 22
+P_E, RATIO, F_TRIAL, MARGIN, DIAG, DP = 23, 27, 28, 29, 30, 33   # DIAG: label, a, b
+CYCLES, TRAVELLED, ACC_CYCLES, ACC_RATIO = 36, 37, 38, 39
+END_P, END_UV1, END_UV2, HAS_END, CLOSED = 40, 43, 45, 47, 48
+TOL_TANGENT, TOL_FLAT, TOL_SINGULAR, TOL_DIVERGED, TOL_ACCURACY = 49, 50, 51, 52, 53
+TOL_END, MIN_STEP, CHECK_BOUNDARY, WATCH, AUTO_COMMIT = 54, 55, 56, 57, 58
+TRIM_STATE, REESTIMATE = 60, 62          # 2 states (0 in, 1 out, 2 ask), 2 x (u, w)
+C1, C2, N1, N2, KEPT1, KEPT2, KEPT_P, KEPT_T = 80, 104, 128, 152, 176, 200, 224, 227
+D_OUT, WORK = 240, 260
+STATE_SIZE = WORK + 2048
+ROW = 46                                 # record columns (record.FIELDS)
+WATCH_NONE = -1.0
+
+
+@_jit
+def move_to(F: np.ndarray, I: np.ndarray, S: np.ndarray, s: int, o: int, u: float,
+            w: float) -> int:
+    """Contact.move_to: wrap, evaluate (compiled d2), refresh the contact row at o."""
+    h = 16 * s
+    if F[h + 9] > 0.0:
+        u = F[h + 8] + (u - F[h + 8]) % F[h + 9]
+    if F[h + 11] > 0.0:
+        w = F[h + 10] + (w - F[h + 10]) % F[h + 11]
+    a = I[h + 1]
+    b = I[h + 3]
+    nu = I[h + 10]
+    nv = I[h + 11]
+    out = S[D_OUT:D_OUT + 18].reshape((6, 3))
+    status = d2(I[h], F[a:a + I[h + 2]], I[b:b + I[h + 4]], F[I[h + 5]:I[h + 5] + I[h + 6]],
+                F[I[h + 7]:I[h + 7] + I[h + 8]],
+                F[I[h + 9]:I[h + 9] + nu * nv * 3].reshape((nu, nv, 3)),
+                F[I[h + 12]:I[h + 12] + nu * nv].reshape((nu, nv)), u, w,
+                S[WORK:WORK + 2048], out)
+    if status != EVAL_OK:
+        return status
+    set_geometry(S, o, F[h + 12], u, w, out)
+    return EVAL_OK
+
+
+@_jit
+def trim_cell(F: np.ndarray, I: np.ndarray, s: int, u: float, w: float) -> int:
+    h = 16 * s
+    if I[h + 14] == 0:
+        return CELL_MIXED
+    g = I[h + 13]
+    nu = I[h + 14]
+    nw = I[h + 15]
+    return lookup(I[g:g + nu * nw].reshape((nu, nw)), F[h], F[h + 1], F[h + 2], F[h + 3],
+                  nu, nw, wrap(u, F[h + 4], F[h + 5]), wrap(w, F[h + 6], F[h + 7]))
+
+
+@_jit
+def _fail(S: np.ndarray, status: int, label: int, a: float, b: float, margin: float) -> int:
+    S[DIAG] = label
+    S[DIAG + 1] = a
+    S[DIAG + 2] = b
+    S[MARGIN] = margin
+    return status
+
+
+@_jit
+def _watch(S: np.ndarray, rule: int, m: float) -> None:
+    if S[WATCH] == rule:
+        S[MARGIN] = min(S[MARGIN], m)
+
+
+@_jit
+def trial(F: np.ndarray, I: np.ndarray, S: np.ndarray, f: float) -> int:
+    """Stepper._try without the guard: a cycle of step f into the spares (n1, n2) and
+    its checks. PASSED, CHECK_TRIM (the trim states in S[TRIM_STATE]) or a failure."""
+    S[MARGIN] = math.inf
+    S[F_TRIAL] = f
+    t = vec(S, TR_T)
+    k1 = S[K1]
+    k2 = S[K2]
+    ok, p_e = correct(S, C1, C2, k1, k2, axpy(f, t, vec(S, P)), S[TOL_FLAT])
+    if not ok:
+        return _fail(S, TANGENT, 0, 0.0, 0.0, math.nan)
+    put(S, P_E, p_e)
+    for side in range(2):
+        o = C1 if side == 0 else C2
+        if S[EX1 + side] != 0.0:
+            ok, du, dw = inverse_exact(S, o, p_e)
+            if not ok:
+                return _fail(S, MOVE_UNDEFINED, 0, 0.0, 0.0, math.nan)
+        else:
+            du, dw = inverse(S, o, S[K1 + side], p_e)
+        S[REESTIMATE + 2 * side] = S[o + C_U] + du
+        S[REESTIMATE + 2 * side + 1] = S[o + C_W] + dw
+    for side in range(2):
+        o = N1 if side == 0 else N2
+        status = move_to(F, I, S, side, o, S[REESTIMATE + 2 * side],
+                         S[REESTIMATE + 2 * side + 1])
+        if status != EVAL_OK:
+            return _fail(S, EVAL_FAIL, side + 1, S[REESTIMATE + 2 * side],
+                         S[REESTIMATE + 2 * side + 1], math.nan)
+        m = S[o + C_SING] - S[TOL_SINGULAR]
+        if m < 0.0:
+            return _fail(S, SINGULAR, side + 1, S[o + C_U], S[o + C_W], m)
+        _watch(S, SINGULAR, m)
+        eps = norm(sub(p_e, centre(S, o)))
+        if eps > S[TOL_DIVERGED]:
+            return _fail(S, DIVERGED, side + 1, eps, 0.0, S[TOL_DIVERGED] - eps)
+        _watch(S, DIVERGED, S[TOL_DIVERGED] - eps)
+        k = curvature(S, o, t)
+        if S[o + C_OFF] * k >= 1.0:
+            return _fail(S, CURVATURE, side + 1, k, S[o + C_OFF] * k, 1.0 - S[o + C_OFF] * k)
+        _watch(S, CURVATURE, 1.0 - S[o + C_OFF] * k)
+    if not (S[WATCH] == SINGULAR or S[WATCH] == DIVERGED or S[WATCH] == CURVATURE):
+        S[MARGIN] = math.nan
+    if S[CHECK_BOUNDARY] == 0.0:
+        return PASSED
+    ask = False
+    left = False
+    for side in range(2):
+        o = N1 if side == 0 else N2
+        state = 0
+        cell = trim_cell(F, I, side, S[o + C_U], S[o + C_W])
+        if cell != CELL_INSIDE:   # Stepper._left_face: re-estimate one step towards p_e
+            first = cell
+            k = curvature(S, o, t)
+            du, dw = tangent_coords(S, o, scale(sub(p_e, centre(S, o)),
+                                                1.0 / (1.0 - k * S[o + C_OFF])))
+            S[REESTIMATE + 2 * side] = S[o + C_U] + du
+            S[REESTIMATE + 2 * side + 1] = S[o + C_W] + dw
+            cell = trim_cell(F, I, side, S[o + C_U] + du, S[o + C_W] + dw)
+            if first == CELL_MIXED:
+                state = 0 if cell == CELL_INSIDE else 2   # inside: not left, whatever q is
+            else:
+                state = 1 if cell == CELL_OUTSIDE else (2 if cell == CELL_MIXED else 0)
+        S[TRIM_STATE + side] = state
+        ask = ask or state == 2
+        left = left or state == 1
+    if ask:
+        return CHECK_TRIM
+    if left:
+        return _fail(S, BOUNDARY, 0, 0.0, 0.0, math.nan)
+    return PASSED
+
+
+@_jit
+def track(S: np.ndarray) -> int:
+    """cycle.track at the current contacts into S[TR_T], S[K1], ...; 0 or a failure."""
+    S[TR_OK] = 0.0
+    m = cross(vec(S, C1 + 11), vec(S, C2 + 11))
+    s = norm(m)
+    if s < S[TOL_TANGENT]:
+        return _fail(S, TRACK_TANGENT, 0, s, 0.0, math.nan)
+    if dot(m, vec(S, T)) < 0.0:
+        s = -s
+    t = scale(m, 1.0 / s)
+    k1 = curvature(S, C1, t)
+    k2 = curvature(S, C2, t)
+    for side in range(2):
+        o = C1 if side == 0 else C2
+        k = k1 if side == 0 else k2
+        if S[o + C_OFF] * k >= 1.0:
+            return _fail(S, CURVATURE, side + 1, k, S[o + C_OFF] * k, 1.0 - S[o + C_OFF] * k)
+    put(S, TR_T, t)
+    S[K1] = k1
+    S[K2] = k2
+    S[EX1] = 1.0 if paper_inverse_ratio(S, C1, k1) > PAPER_INVERSE_LIMIT else 0.0
+    S[EX2] = 1.0 if paper_inverse_ratio(S, C2, k2) > PAPER_INVERSE_LIMIT else 0.0
+    S[TR_OK] = 1.0
+    return DONE
+
+
+@_jit
+def accurate(S: np.ndarray, f_cmd: float) -> float:
+    """Stepper._accurate: the commanded step shortened for accuracy; sets S[RATIO]."""
+    slope1 = 0.0
+    slope2 = 0.0
+    if S[HAS_LAST] != 0.0:
+        d = norm(sub(vec(S, C1 + C_R), vec(S, LAST_R1)))
+        slope1 = abs(S[K1] - S[LAST_K1]) / d if d > 0.0 else 0.0
+        d = norm(sub(vec(S, C2 + C_R), vec(S, LAST_R2)))
+        slope2 = abs(S[K2] - S[LAST_K2]) / d if d > 0.0 else 0.0
+    f = accurate_step(S, vec(S, P), C1, C2, vec(S, TR_T), S[K1], S[K2], f_cmd,
+                      S[TOL_ACCURACY], slope1, slope2)
+    if f < f_cmd:
+        f = max(f, min(S[MIN_STEP], f_cmd))
+        S[RATIO] = f / f_cmd
+    else:
+        S[RATIO] = 1.0
+    return f
+
+
+@_jit
+def _copy(S: np.ndarray, dst: int, src: int, n: int) -> None:
+    for i in range(n):
+        S[dst + i] = S[src + i]
+
+
+@_jit
+def _swap(S: np.ndarray, a: int, b: int) -> None:
+    for i in range(CS):
+        x = S[a + i]
+        S[a + i] = S[b + i]
+        S[b + i] = x
+
+
+@_jit
+def keep(S: np.ndarray) -> None:
+    """Save the passed trial (spares, p_e, t) for a landing's commit."""
+    _copy(S, KEPT1, N1, CS)
+    _copy(S, KEPT2, N2, CS)
+    _copy(S, KEPT_P, P_E, 3)
+    _copy(S, KEPT_T, TR_T, 3)
+
+
+@_jit
+def commit(S: np.ndarray, R: np.ndarray, n_rec: int, p_e: tuple, t: tuple, f: float) -> None:
+    """Stepper._commit: the spares become the contacts; one record row when n_rec >= 0."""
+    dp = sub(p_e, vec(S, P))
+    step = norm(dp)
+    if S[TR_OK] != 0.0:
+        S[LAST_K1] = S[K1]
+        S[LAST_K2] = S[K2]
+        _copy(S, LAST_R1, C1 + C_R, 3)
+        _copy(S, LAST_R2, C2 + C_R, 3)
+        S[HAS_LAST] = 1.0
+    put(S, P, p_e)
+    put(S, T, t)
+    put(S, DP, dp)
+    _swap(S, C1, N1)
+    _swap(S, C2, N2)
+    S[CYCLES] += 1.0
+    S[TRAVELLED] += step
+    if S[RATIO] < 1.0:
+        S[ACC_CYCLES] += 1.0
+        S[ACC_RATIO] = min(S[ACC_RATIO], S[RATIO])
+    if n_rec >= 0:
+        write_row(S, R, n_rec, f, step)
+
+
+@_jit
+def commit_kept(S: np.ndarray, R: np.ndarray, n_rec: int, f: float) -> None:
+    _copy(S, N1, KEPT1, CS)
+    _copy(S, N2, KEPT2, CS)
+    commit(S, R, n_rec, vec(S, KEPT_P), vec(S, KEPT_T), f)
+
+
+@_jit
+def write_row(S: np.ndarray, R: np.ndarray, n: int, f: float, step: float) -> None:
+    """PathRecord.add from the state: the columns of record.FIELDS in order."""
+    _row(S, R, n, 0, P, 3)
+    R[n, 3] = S[C1 + C_U]
+    R[n, 4] = S[C1 + C_W]
+    R[n, 5] = S[C2 + C_U]
+    R[n, 6] = S[C2 + C_W]
+    col = 7
+    for field in range(4):           # contacts, ru, rw, normals: 3 floats per surface
+        _row(S, R, n, col, C1 + C_R + 3 * field, 3)
+        _row(S, R, n, col + 3, C2 + C_R + 3 * field, 3)
+        col += 6
+    _row(S, R, n, col, C1 + 14, 6)   # forms E F G L M N
+    _row(S, R, n, col + 6, C2 + 14, 6)
+    R[n, 43] = f
+    R[n, 44] = step
+    R[n, 45] = S[RATIO]
+
+
+@_jit
+def _row(S: np.ndarray, R: np.ndarray, n: int, col: int, o: int, k: int) -> None:
+    for i in range(k):
+        R[n, col + i] = S[o + i]
+
+
+@_jit
+def begin(F: np.ndarray, I: np.ndarray, S: np.ndarray, R: np.ndarray, n_rec: int,
+          f_cmd: float) -> int:
+    """Stepper.step up to the trial: track, accurate step, landing on the end. Returns
+    DONE (go on with trial(S[F_TRIAL])), END_STOP, END_LANDED or the track's failure."""
+    S[RATIO] = 1.0
+    failure = track(S)
+    f = f_cmd if S[TR_OK] == 0.0 else accurate(S, f_cmd)
+    S[F_TRIAL] = f
+    if S[HAS_END] != 0.0 and S[TRAVELLED] >= 2.0 * f:
+        d = sub(vec(S, END_P), vec(S, P))
+        dist = norm(d)
+        if dist <= S[TOL_END]:
+            return END_STOP
+        if not (dist > f or dot(d, vec(S, T)) <= 0.0):
+            status = move_to(F, I, S, 0, N1, S[END_UV1], S[END_UV1 + 1])
+            status = max(status, move_to(F, I, S, 1, N2, S[END_UV2], S[END_UV2 + 1]))
+            if status != EVAL_OK:
+                return _fail(S, EVAL_FAIL, 0, 0.0, 0.0, math.nan)
+            commit(S, R, n_rec, vec(S, END_P), vec(S, T), dist)
+            return END_LANDED
+    return failure
+
+
+@_jit
+def step(F: np.ndarray, I: np.ndarray, S: np.ndarray, R: np.ndarray, n_rec: int,
+         f_cmd: float) -> int:
+    """One period: DONE when committed (S[AUTO_COMMIT] set: no guard), else the status
+    the caller finishes (PASSED, CHECK_TRIM, a failure to land on, END_*)."""
+    status = begin(F, I, S, R, n_rec, f_cmd)
+    if status != DONE:
+        return status
+    S[WATCH] = WATCH_NONE
+    status = trial(F, I, S, S[F_TRIAL])
+    if status == PASSED and S[AUTO_COMMIT] != 0.0:
+        commit(S, R, n_rec, vec(S, P_E), vec(S, TR_T), S[F_TRIAL])
+        return DONE
+    return status
+
+
+@_jit
+def commit_trial(S: np.ndarray, R: np.ndarray, n_rec: int) -> None:
+    """Commit the trial that just passed (after the caller's exact checks and guard)."""
+    commit(S, R, n_rec, vec(S, P_E), vec(S, TR_T), S[F_TRIAL])
+
+
+@_jit
+def state_margin(S: np.ndarray, rule: int) -> float:
+    """Stepper._state_margin for SINGULAR, DIVERGED, CURVATURE at the current point."""
+    if rule == SINGULAR:
+        return min(S[C1 + C_SING], S[C2 + C_SING]) - S[TOL_SINGULAR]
+    if rule == DIVERGED:
+        p = vec(S, P)
+        return S[TOL_DIVERGED] - max(norm(sub(p, centre(S, C1))), norm(sub(p, centre(S, C2))))
+    if rule == CURVATURE:
+        t = vec(S, TR_T)
+        return 1.0 - max(S[C1 + C_OFF] * curvature(S, C1, t), S[C2 + C_OFF] * curvature(S, C2, t))
+    return math.nan
+
