@@ -19,7 +19,7 @@ from cadcnc.io import read_json
 from cadcnc.io.plot import PICTURE_SUFFIXES, picture_bytes
 from cadcnc.io.output_set import OutputSet, check_destination
 from cadcnc.io.outputs import SUFFIXES, render
-from cadcnc.io.summary import partial_reason, summary
+from cadcnc.io.summary import summary
 from cadcnc.ops.pair_path import path_for_job
 from cadcnc.verification import gouge_gate, verify as run_verify
 
@@ -94,7 +94,7 @@ def judge(args, tp, part, what: str) -> tuple[bool, int]:
     write, code = True, 0
     if not tp.complete:
         write, code = args.allow_partial, PARTIAL
-        say_error(f"cadcnc: {what}: partial: {partial_reason(tp)}"
+        say_error(f"cadcnc: {what}: partial: {tp.partial_reason}"
                   + ("" if write else "; nothing written (--allow-partial writes it)"))
     if write:
         gate = gouge_gate(tp, part, tp.job.tolerances)

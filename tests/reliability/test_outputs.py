@@ -126,13 +126,20 @@ def test_partial_path_exits_6_and_is_written_only_when_allowed(tmp_path):
     out = tmp_path / "ramp.json"
     args = ["path", FIXTURES / "ramp_wall.step", "--faces", "3", "7", *JOB, "-o", out]
     run = cadcnc_cli(*args)
-    assert run.returncode == 6 and "partial: stopped on boundary" in run.stderr
+    # how far of how much, and why: the same words on stderr and in the summary
+    why = "partial: stopped at 28.000 of 40.0 mm (the edge's length): boundary"
+    assert run.returncode == 6 and why in run.stderr
     assert not out.exists()
     run = cadcnc_cli(*args, "--allow-partial")
-    assert run.returncode == 6 and out.exists() and "result     partial" in run.stdout
+    assert run.returncode == 6 and out.exists() and f"result     {why}" in run.stdout
 
 
-def test_complete_path_says_so():
+def test_complete_path_says_so(tmp_path):
+    """... and the steps the accuracy shortened are reported like a feed override."""
+    run = cadcnc_cli("path", BOSS, "--faces", "4", "5", "--radius", "3", "--feed", "12000",
+                     "--period", "4ms", "-o", tmp_path / "b.json")
+    assert run.returncode == 0 and "result     complete\n" in run.stdout
+    assert "accuracy   feed reduced on " in run.stdout and "for accuracy (0.001 mm)" in run.stdout
     run = cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", "/dev/null/x.json")
     assert run.returncode == 4  # the destination is checked before computing
     ok = cadcnc_cli("verify", FIXTURES / "crossing_cylinders.step", "--faces", "1", "2", *JOB,
