@@ -153,7 +153,8 @@ def _cli(*args):
 
 @pytest.mark.parametrize("delay", [0.3, 1.2, 2.0, 2.6])
 def test_ctrl_c_at_any_moment_keeps_a_whole_set(tmp_path, delay):
-    """Old outputs intact (or the whole new set), no temporary files left, exit 130."""
+    """Old outputs intact (or the whole new set), no temporary files left, exit 130 (or 0
+    when the run had finished)."""
     outs = [tmp_path / f"b{s}" for s in (".json", ".csv", ".ngc")]
     for o in outs:
         o.write_text("old")
@@ -167,18 +168,22 @@ def test_ctrl_c_at_any_moment_keeps_a_whole_set(tmp_path, delay):
     assert contents == ["old"] * 3 or all(c != "old" for c in contents), contents
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
     assert "Traceback" not in err, err
-    assert proc.returncode in (0, 130, -signal.SIGINT), proc.returncode
+    assert proc.returncode in (0, 130), proc.returncode
+    assert (proc.returncode == 130) == ("cadcnc: interrupted" in err), err
 
 
-@pytest.mark.xfail(strict=False, reason="known open defect: on a cold start (fresh clone, "
-                   "numba and OCCT first loaded) a Ctrl-C about 2 s in can end the process "
-                   "by the signal itself (-2) instead of exit 130; files stay whole")
-@pytest.mark.parametrize("delay", [0.3, 1.2, 2.0, 2.6])
-def test_ctrl_c_exits_130(tmp_path, delay):
-    proc = subprocess.Popen(_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o",
-                                 tmp_path / "b.json"),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(delay)
-    proc.send_signal(signal.SIGINT)
+def test_ctrl_c_after_the_files_are_written_keeps_the_exit_code(tmp_path):
+    """Was exit -2 (killed by the signal) with the files complete: after ``main`` returned,
+    Python's teardown reset SIGINT to the system default and spent ~0.7 s freeing OCCT and
+    numba objects. The program now ends at once after flushing its output."""
+    out = tmp_path / "b.json"
+    proc = subprocess.Popen(_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", out),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    for line in proc.stdout:   # the summary's last line: the files are in place
+        if line.lstrip().startswith("wrote"):
+            proc.send_signal(signal.SIGINT)
+            break
     proc.communicate(timeout=60)
-    assert proc.returncode in (0, 130)
+    assert proc.returncode in (0, 130), proc.returncode
+    assert json.loads(out.read_text())["faces"] == [4, 5]
