@@ -36,7 +36,8 @@ def one_line_error(run, code: int, *needles: str) -> None:
     ("--spindle", "nan", "--spindle"), ("--spindle", "-100", "--spindle"),
     ("--spindle", "inf", "--spindle"), ("--gouge-tolerance", "abc", "gouge tolerance"),
     ("--gouge-tolerance", "nan", "gouge tolerance"), ("--gouge-tolerance", "-1", "gouge"),
-    ("--gouge-tolerance", "inf", "gouge tolerance"),
+    ("--gouge-tolerance", "inf", "'inf' is not a finite number"),
+    ("--gouge-tolerance", "-Infinity", "is not a finite number"),
 ])
 def test_non_finite_and_negative_options_are_refused(tmp_path, flag, value, needle):
     out = tmp_path / "p.ngc"
