@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 from ..job import MIN_STEP, check_number, check_step
 from .cycle import (
-    BOUNDARY, CLOSED, DIVERGED, END, MAX_CYCLES, SINGULAR, Contact, StopCycle, SurfaceLike,
-    Track, accurate_step, advance, check_curvature, track,
+    BOUNDARY, CLOSED, CURVATURE, DIVERGED, END, MAX_CYCLES, SINGULAR, Contact, StopCycle,
+    SurfaceLike, Track, accurate_step, advance, check_curvature, track,
 )
 from ..tolerances import DEFAULT, Tolerances
 from ..trim import OUTSIDE
@@ -152,11 +152,24 @@ class Stepper:
                                           f"parameter point (u={spare.u:.6g}, w={spare.w:.6g})")
             eps = norm(sub(p_e, spare.centre()))
             if eps > self.tol.diverged:
+                self._raise_if_at_curvature_limit(eps)
                 raise StopCycle(DIVERGED, f"surface {label}: carried error {eps:.4g} mm "
                                           f"exceeds {self.tol.diverged:g} mm")
             # the new contact too: a point whose ball cannot touch there is never emitted
             check_curvature(spare, spare.curvature(t), f"surface {label}")
         return p_e, t
+
+    def _raise_if_at_curvature_limit(self, eps: float) -> None:
+        """Lost track where R' k_max nears 1: stop as the curvature limit, the true cause.
+        There the offset surface folds: its contact moves 1 / (1 - R' k) times as fast as
+        the centre along the principal direction, and no step keeps it."""
+        for c, label in ((self.c1, 1), (self.c2, 2)):
+            k = c.max_curvature()
+            if c.offset * k >= 1.0 - self.tol.curvature_near:
+                raise StopCycle(CURVATURE, f"surface {label}: concave curvature k = {k:.6g} "
+                                           f"1/mm reaches the ball's (R' k = "
+                                           f"{c.offset * k:.6g}): the contact runs away "
+                                           f"(carried error {eps:.4g} mm)")
 
     def _try(self, f: float) -> tuple[str, str] | None:
         """Attempt a cycle of step f: None (and ``self._trial`` = (p_e, t)) on success,
