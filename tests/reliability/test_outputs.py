@@ -151,10 +151,11 @@ def _cli(*args):
     return [sys.executable, "-m", "cadcnc.cli", *map(str, args)]
 
 
-@pytest.mark.parametrize("delay", [0.3, 1.2, 2.0, 2.6])
+@pytest.mark.parametrize("delay", [0.3, 1.2, 2.0])
 def test_ctrl_c_at_any_moment_keeps_a_whole_set(tmp_path, delay):
     """Old outputs intact (or the whole new set), no temporary files left, exit 130 (or 0
-    when the run had finished)."""
+    when the run had finished). Start-up, computing, writing; the moment after the files
+    are in place is the next test's."""
     outs = [tmp_path / f"b{s}" for s in (".json", ".csv", ".ngc")]
     for o in outs:
         o.write_text("old")
