@@ -18,3 +18,18 @@ def progress(args, label: str):
         say_error(f"cadcnc: {label}: {cycles} cycles, {mm:.1f} mm")
 
     return report
+
+
+def stage_progress(args, label: str):
+    """A progress(stage, done, total) callback: one stderr line per stage (the stages
+    count differently), or None with --quiet."""
+    if args.quiet:
+        return None
+    seen = set()
+
+    def report(stage: str, done: int, total: int) -> None:
+        if stage not in seen:
+            seen.add(stage)
+            say_error(f"cadcnc: {label}: {stage} ...")
+
+    return report
