@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import time
 
 
 def say_error(text: str) -> None:
@@ -20,15 +21,16 @@ def progress(args, label: str):
     return report
 
 
-def stage_progress(args, label: str):
+def stage_progress(args, label: str, after_s: float = 0.0):
     """A progress(stage, done, total) callback: one stderr line per stage (the stages
-    count differently), or None with --quiet."""
+    count differently) once ``after_s`` seconds have passed, or None with --quiet."""
     if args.quiet:
         return None
     seen = set()
+    start = time.monotonic()
 
     def report(stage: str, done: int, total: int) -> None:
-        if stage not in seen:
+        if stage not in seen and time.monotonic() - start >= after_s:
             seen.add(stage)
             say_error(f"cadcnc: {label}: {stage} ...")
 
