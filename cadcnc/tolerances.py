@@ -33,6 +33,10 @@ class Tolerances:
       side) has reached it; no extra zero-length step is emitted.
     - ``diverged`` (mm): the carried error |p - (q + R' n)| above which the interpolator
       stops rather than emit a point computed from a lost state.
+    - ``curvature_near`` (ratio): a step that loses track (carried error past
+      ``diverged``) where R' k along the track is within this of 1 is stopped as the
+      curvature limit, its true cause: there the contact moves 1 / (1 - R' k) times as
+      fast as the centre and no step keeps it.
     - ``accuracy`` (mm): the accuracy a written path promises: every point within this of
       both offset surfaces, and the chord between points within it too.
     - ``closed`` (mm): a curve (edge, intersection branch, polyline) whose ends are closer
@@ -77,6 +81,7 @@ class Tolerances:
     on_boundary: float = 1e-6
     end_reached: float = 1e-7
     diverged: float = 0.5
+    curvature_near: float = 1e-3
     accuracy: float = 1e-3
     closed: float = 1e-6
     gouge: float = 1e-3

@@ -15,12 +15,15 @@ from .errors import InputError
 
 _NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _QUANTITY = re.compile(rf"^\s*({_NUMBER})\s*([A-Za-zµ/]*)\s*$")
+_NON_FINITE = re.compile(r"^\s*[+-]?(?:inf(?:inity)?|nan)\b", re.IGNORECASE)
 DURATION_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
 
 
 def _split(text: str, name: str, expected: str) -> tuple[float, str]:
     m = _QUANTITY.match(str(text))
     if not m:
+        if _NON_FINITE.match(str(text)):
+            raise InputError(f"{name}: {text!r} is not a finite number ({expected})")
         raise InputError(f"{name}: cannot read {text!r} as a number ({expected})")
     value = float(m.group(1))
     if not math.isfinite(value):

@@ -18,13 +18,14 @@ from cadcnc.geometry.report import concave_edges, faces_report
 from cadcnc.io import read_json
 from cadcnc.io.plot import PICTURE_SUFFIXES, picture_bytes
 from cadcnc.io.output_set import OutputSet, check_destination
+from cadcnc.io.gcode import written_moves
 from cadcnc.io.outputs import SUFFIXES, render
-from cadcnc.io.summary import partial_reason, summary
+from cadcnc.io.summary import summary
 from cadcnc.ops.pair_path import path_for_job
 from cadcnc.verification import gouge_gate, verify as run_verify
 
 from . import demo as demo_command
-from .feedback import progress, say_error
+from .feedback import progress, say_error, stage_progress
 from .options import clearance, gcode_options, job_from_args, tolerances, wants_gcode
 
 GOUGE_REFUSED = 5  # exit code: the whole-part check found a gouge deeper than the limit
@@ -77,7 +78,7 @@ def path(args) -> int:
     gopts = gcode_options(args, job.clearance, [part]) if wants_gcode(args.output) else {}
     i, j = job.operation.faces
     tp = path_for_job(part, job, progress=progress(args, f"faces {i} {j}"))
-    write, code = judge(args, tp, part, "path")
+    write, code = judge(args, tp, part, "path", gopts or None)
     if not write:
         return code
     title = f"faces {i} {j} of {Path(args.step).name}"
@@ -88,9 +89,11 @@ def path(args) -> int:
     return code
 
 
-def judge(args, tp, part, what: str) -> tuple[bool, int]:
+def judge(args, tp, part, what: str, gopts: dict | None = None) -> tuple[bool, int]:
     """(write it?, exit code) for a computed path: the exit code is 0 only for a complete
-    path that passed the whole-part gouge gate.
+    path that passed the whole-part gouge gate. With G-code options ``gopts`` (a program is
+    written), the gate checks the moves as written: points dropped, rounded, tool-tip
+    offset taken back, approach and retract.
 
     A partial path exits 6 and is written only with ``--allow-partial``; a gouging one
     exits 5 and is written only with ``--allow-gouge``. Messages go to stderr.
@@ -98,21 +101,32 @@ def judge(args, tp, part, what: str) -> tuple[bool, int]:
     write, code = True, 0
     if not tp.complete:
         write, code = args.allow_partial, PARTIAL
-        say_error(f"cadcnc: {what}: partial: {partial_reason(tp)}"
+        say_error(f"cadcnc: {what}: partial: {tp.partial_reason}"
                   + ("" if write else "; nothing written (--allow-partial writes it)"))
     if write:
-        gate = gouge_gate(tp, part, tp.job.tolerances)
+        moves = None if gopts is None else written_moves(tp, **gopts)
+        gate = gouge_gate(tp, part, tp.job.tolerances, moves=moves,
+                          progress=stage_progress(args, f"{what}: gouge check", after_s=1.0))
         if not gate.ok:
             write, code = args.allow_gouge, GOUGE_REFUSED
             if write:
                 what_cut = gate.message.replace("refused: ", "").replace("; nothing written", "")
                 say_error(f"cadcnc: {what}: {what_cut}; written anyway (--allow-gouge)")
             else:
-                # a smaller ball helps a side cut, not a centre on (or in) the part
-                shallow = math.isfinite(gate.depth_mm) and gate.depth_mm < tp.job.tool.offset
-                hint = "A smaller --radius may fit; " if shallow else ""
-                say_error(f"cadcnc: {what}: {gate.message}. {hint}--allow-gouge writes it")
+                say_error(f"cadcnc: {what}: {gate.message}. {_hint(tp, gate, gopts)}"
+                          "--allow-gouge writes it")
     return write, code
+
+
+def _hint(tp, gate, gopts) -> str:
+    """What may help: fewer dropped points when only the moves between the written points
+    cut (the centres are clear); a smaller ball for a side cut, not for a centre on or in
+    the part."""
+    if gopts and gopts.get("tolerance") and not any(
+            h.depth_mm > gate.limit_mm for h in gate.hits):
+        return "A smaller --tolerance (fewer points dropped) may pass; "
+    shallow = math.isfinite(gate.depth_mm) and gate.depth_mm < tp.job.tool.offset
+    return "A smaller --radius may fit; " if shallow and not gate.in_material else ""
 
 
 # -- run -------------------------------------------------------------------------------------
@@ -132,6 +146,9 @@ def run(args) -> int:
     if args.stream:
         return _stream(args, checked, source)
     paths, status = [], 0
+    ngc = [out for out in names if Path(out).suffix.lower() == ".ngc"]
+    gopts = (gcode_options(args, checked[0][0].job.clearance, [p for _, p in checked])
+             if ngc else None)
     for entry, part in checked:
         tp = apt.run_job(entry, part, progress(args, f"PATH {entry.name}"), source)
         paths.append(tp)
@@ -140,14 +157,14 @@ def run(args) -> int:
         if not requested:
             status = status or (0 if tp.complete else PARTIAL)
             continue
-        write, code = judge(args, tp, part, f"{source}:{entry.line}: PATH {entry.name}")
+        write, code = judge(args, tp, part, f"{source}:{entry.line}: PATH {entry.name}",
+                            gopts)
         if not write:
             return code
         status = status or code
     contents = {}
     for out, group in names.items():
-        if Path(out).suffix.lower() == ".ngc":
-            gopts = gcode_options(args, checked[0][0].job.clearance, [p for _, p in checked])
+        if out in ngc:
             contents[out] = render(paths, out, title=title or Path(source).name, **gopts)
         else:
             contents.update({name: render([tp], name) for name, tp in zip(group, paths)})
@@ -230,7 +247,7 @@ def verify(args) -> int:
         job = job_from_args(args, args.input)
         part = cadcnc.load_step(args.input, flip_material=job.flip_material)
         tp = path_for_job(part, job, progress=progress(args, "verify"))
-    report = run_verify(tp, part, tol=tol, progress=_verify_progress(args))
+    report = run_verify(tp, part, tol=tol, progress=stage_progress(args, "verify"))
     if args.json:
         print(json.dumps(report.to_dict(), indent=1))
     else:
@@ -243,19 +260,6 @@ def verify(args) -> int:
     say_error(f"cadcnc: verify: gouge {report.max_gouge_mm:.4g} mm deep exceeds the "
               f"tolerance {tol.gouge:g} mm (see max over-cut and whole-part hits)")
     return GOUGE_REFUSED
-
-
-def _verify_progress(args):
-    if args.quiet:
-        return None
-    seen = set()
-
-    def report(stage: str, done: int, total: int) -> None:
-        if stage not in seen:  # one line per stage: the stages count differently
-            seen.add(stage)
-            say_error(f"cadcnc: verify: {stage} ...")
-
-    return report
 
 
 COMMANDS = {"faces": faces, "path": path, "run": run, "demo": demo_command.demo,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import time
 
 
 def say_error(text: str) -> None:
@@ -16,5 +17,21 @@ def progress(args, label: str):
 
     def report(cycles: int, mm: float) -> None:
         say_error(f"cadcnc: {label}: {cycles} cycles, {mm:.1f} mm")
+
+    return report
+
+
+def stage_progress(args, label: str, after_s: float = 0.0):
+    """A progress(stage, done, total) callback: one stderr line per stage (the stages
+    count differently) once ``after_s`` seconds have passed, or None with --quiet."""
+    if args.quiet:
+        return None
+    seen = set()
+    start = time.monotonic()
+
+    def report(stage: str, done: int, total: int) -> None:
+        if stage not in seen and time.monotonic() - start >= after_s:
+            seen.add(stage)
+            say_error(f"cadcnc: {label}: {stage} ...")
 
     return report

@@ -14,12 +14,15 @@ from dataclasses import dataclass
 import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepTools import BRepTools
 from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.GProp import GProp_GProps
+from OCP.ShapeAnalysis import ShapeAnalysis_Surface
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
 
 from . import differential as dg
@@ -154,18 +157,26 @@ class FaceSurface:
         """(u, w, distance mm) of the nearest point of the surface to ``point``.
 
         OCCT's exact projection (GeomAPI_ProjectPointOnSurf), restricted to the face's
-        parameter box when ``within_face_box``. Raises GeometryError when it finds none.
+        parameter box when ``within_face_box``. Where that finds no interior extremum (a
+        point beyond the face's edges), falls back to the nearest point of the trimmed
+        face (BRepExtrema_DistShapeShape). Raises GeometryError when both find none.
         """
-        pnt = gp_Pnt(*map(float, point))
+        xyz = tuple(float(c) for c in point)
+        if not all(math.isfinite(c) for c in xyz):
+            raise InputError(f"{self!r}: cannot project the non-finite point {xyz}")
+        pnt = gp_Pnt(*xyz)
         if within_face_box:
             proj = GeomAPI_ProjectPointOnSurf(pnt, self.geom_surface, *self.u_range,
                                               *self.w_range)
         else:
             proj = GeomAPI_ProjectPointOnSurf(pnt, self.geom_surface)
-        if not proj.IsDone() or proj.NbPoints() == 0:
-            raise GeometryError(f"{self!r}: no projection of point {tuple(point)} found")
-        u, w = proj.LowerDistanceParameters()
-        return u, w, proj.LowerDistance()
+        if proj.IsDone() and proj.NbPoints() > 0:
+            u, w = proj.LowerDistanceParameters()
+            return u, w, proj.LowerDistance()
+        found = nearest_on_face(self.topods, self.geom_surface, pnt)
+        if found is None:
+            raise GeometryError(f"{self!r}: no projection of point {xyz} found")
+        return found
 
     def third_derivatives(self, u: float, w: float) -> tuple[np.ndarray, ...]:
         """r_uuu, r_uuw, r_uww, r_www at (u, w), where OCCT provides D3."""
@@ -233,3 +244,15 @@ class FaceSurface:
         props = GProp_GProps()
         BRepGProp.SurfaceProperties_s(self.topods, props)
         return props.Mass()
+
+
+def nearest_on_face(face: TopoDS_Face, surface, pnt: gp_Pnt):
+    """(u, w, distance mm) of the nearest point of the trimmed ``face`` to ``pnt``, or
+    None. The point may lie on an edge or a vertex: its (u, w) comes from
+    ShapeAnalysis_Surface.ValueOfUV of that point, which lies on the surface."""
+    dss = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(pnt).Vertex(), face)
+    if not dss.IsDone() or dss.NbSolution() == 0:
+        return None
+    near = dss.PointOnShape2(1)
+    uv = ShapeAnalysis_Surface(surface).ValueOfUV(near, 1e-7)
+    return uv.X(), uv.Y(), float(dss.Value())

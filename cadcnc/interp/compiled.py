@@ -227,7 +227,7 @@ class CompiledStepper(Stepper):
         if status == K.SINGULAR:
             return SINGULAR, singular_detail(label, a, b)
         if status == K.DIVERGED:
-            return DIVERGED, diverged_detail(label, a, self.tol)
+            return self._curvature_limit(a) or (DIVERGED, diverged_detail(label, a, self.tol))
         if status == K.BOUNDARY:
             return BOUNDARY, boundary_detail(self._left())
         return SINGULAR, (f"{label}: the compiled evaluator cannot evaluate "

@@ -99,6 +99,15 @@ class Contact:
         return ((self.L * a * a + 2.0 * self.M * a * b + self.N * b * b)
                 / (self.E * a * a + 2.0 * self.F * a * b + self.G * b * b))
 
+    def max_curvature(self) -> float:
+        """The larger principal curvature (1/mm; > 0 concave seen from the cutter): the
+        largest normal curvature over all tangent directions, the root of
+        det(II - k I) = 0."""
+        a = self.E * self.G - self.F * self.F
+        b = self.E * self.N - 2.0 * self.F * self.M + self.G * self.L
+        c = self.L * self.N - self.M * self.M
+        return (b + math.sqrt(max(b * b - 4.0 * a * c, 0.0))) / (2.0 * a)
+
     def centre(self) -> Vec:
         """q + offset n: where this contact puts the cutter centre."""
         return axpy(self.offset, self.n, self.r)

@@ -202,6 +202,9 @@ class Stepper:
                 self._margin = min(self._margin, m)
             eps = norm(sub(p_e, spare.centre()))
             if eps > tol.diverged:
+                limit = self._curvature_limit(eps)
+                if limit is not None:
+                    raise StopCycle(*limit)
                 raise StopCycle(DIVERGED, diverged_detail(f"surface {label}", eps, tol),
                                 tol.diverged - eps)
             if watch == DIVERGED:
@@ -212,6 +215,18 @@ class Stepper:
             if watch == CURVATURE:
                 self._margin = min(self._margin, 1.0 - spare.offset * k)
         return p_e, t
+
+    def _curvature_limit(self, eps: float) -> tuple[str, str] | None:
+        """Lost track where R' k_max nears 1: (CURVATURE, detail), the true cause, or None.
+        There the offset surface folds: its contact moves 1 / (1 - R' k) times as fast as
+        the centre along the principal direction, and no step keeps it."""
+        for c, label in ((self.c1, 1), (self.c2, 2)):
+            k = c.max_curvature()
+            if c.offset * k >= 1.0 - self.tol.curvature_near:
+                return CURVATURE, (f"surface {label}: concave curvature k = {k:.6g} 1/mm "
+                                   f"reaches the ball's (R' k = {c.offset * k:.6g}): the "
+                                   f"contact runs away (carried error {eps:.4g} mm)")
+        return None
 
     def _try(self, f: float) -> tuple[str, str] | None:
         """Attempt a cycle of step f: None (and ``self._trial`` = (p_e, t)) on success,

@@ -192,3 +192,11 @@ def programmed_moves(text: str, tool_tip_offset: float = 0.0) -> np.ndarray:
         if not any(math.isnan(v) for v in pos):
             out.append((pos[0], pos[1], pos[2] + tool_tip_offset))
     return np.array(out, dtype=float).reshape(-1, 3)
+
+
+def written_moves(path, **options) -> np.ndarray:
+    """(M, 3) ball-centre positions the machine is commanded to visit for ``path`` alone,
+    written with :func:`to_ngc` ``options``: points dropped, rounded, the tool-tip offset
+    taken back, the approach and retract included. What the gouge gate must check."""
+    text = to_ngc([path], **options)
+    return programmed_moves(text, path.job.tool.radius if options.get("tool_tip") else 0.0)

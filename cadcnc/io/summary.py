@@ -12,9 +12,11 @@ def xyz(p) -> str:
 
 
 def summary(path: Toolpath, part_name: str = "") -> str:
-    """Faces, job, points, length, time, stop, predicted error, start and end."""
+    """Faces, job, points, length, time, stop, complete or partial (and why), the steps
+    the accuracy shortened (like a feed override), predicted error, start and end."""
     job = path.job
     i, j = path.faces
+    note = path.accuracy_note
     return "\n".join([
         f"faces {i} and {j}" + (f" of {part_name}" if part_name else ""),
         f"  ball R {job.tool.radius:g} mm, allowance {job.tool.allowance:g} mm, feed "
@@ -23,13 +25,10 @@ def summary(path: Toolpath, part_name: str = "") -> str:
         f"  length     {path.length:.4f} mm",
         f"  time       {path.duration:.4f} s",
         f"  stop       {path.stop_reason}: {path.stop_detail}",
-        f"  result     {'complete' if path.complete else 'partial: ' + partial_reason(path)}",
+        f"  result     {'complete' if path.complete else 'partial: ' + path.partial_reason}",
+        *([f"  accuracy   {note}"] if note else []),
         f"  predicted  {path.worst_predicted_mm:.3g} mm worst steady-state error (eq. 16)",
         f"  start      {xyz(path.points[0])}",
         f"  end        {xyz(path.points[-1])}",
     ])
 
-
-def partial_reason(path: Toolpath) -> str:
-    """Why a path that is not complete stopped short, for the user."""
-    return f"stopped on {path.stop_reason} after {path.length:.3f} mm ({path.stop_detail})"

@@ -20,10 +20,11 @@ from OCP.BRep import BRep_Tool
 from OCP.Extrema import Extrema_GenLocateExtPS
 from OCP.GeomAdaptor import GeomAdaptor_Surface
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
+from OCP.GeomLProp import GeomLProp_SLProps
 from OCP.gp import gp_Pnt
 
 import cadcnc
-from cadcnc.interp.cycle import CLOSED, DIVERGED, END, paper_inverse_ratio, track
+from cadcnc.interp.cycle import CLOSED, CURVATURE, DIVERGED, END, paper_inverse_ratio, track
 from cadcnc.interp.stepper import Stepper
 from cadcnc.job import MIN_STEP, Job, PairPath, Tool
 from cadcnc.ops.pair_path import pair_job, plan_path, stepper_for
@@ -69,8 +70,8 @@ def worst_deviation(faces, tp, *, chords: bool = True) -> float:
 
 
 def fixture_faces(name, i, j):
-    if name == "r0901_fillet":
-        part = cadcnc.load_step(FIXTURES / "r0901_fillet.step")
+    if name in ("r0901_fillet", "abc_fold"):
+        part = cadcnc.load_step(FIXTURES / f"{name}.step")
     else:
         part = load_fixture(name)
     return part.face(i), part.face(j)
@@ -116,6 +117,27 @@ def test_r0901_fillet_no_longer_drifts_off_face_220():
     assert tp.stop_reason == CLOSED and tp.complete
     assert len(tp) == 1328 and tp.length == pytest.approx(132.663, abs=1e-3)
     assert worst_deviation(faces, tp) < ACC
+
+
+def test_a_blend_that_folds_under_the_ball_stops_at_the_curvature_limit_not_diverged():
+    """Was: `diverged` (carried error 3.3 mm) 2.375 mm along the 3.8 mm edge of
+    bug32596_abc_0_13.step faces 3 and 66 at R 2: the blend's larger principal curvature
+    reaches 1/R' there, the offset surface folds and the contact runs away.
+
+    fixtures/abc_fold.step is cut from that OCCT test part (faces 3 and 66 are its faces
+    17 and 18; fixtures/build_abc_fold.py). Oracle: OCCT's principal curvatures
+    (GeomLProp_SLProps) at the last contact on the blend."""
+    faces = fixture_faces("abc_fold", 17, 18)
+    tp = cadcnc.intersection_path(*faces, radius=2.0, **KW)
+    assert tp.stop_reason == CURVATURE and not tp.complete
+    assert "reaches the ball's" in tp.stop_detail and "runs away" in tp.stop_detail
+    assert tp.partial_reason.startswith("stopped at 2.375 of 3.8 mm")
+    u, w = tp.uv[-1, 1]
+    props = GeomLProp_SLProps(BRep_Tool.Surface_s(faces[1].topods), float(u), float(w), 2,
+                              1e-9)
+    k = max(abs(props.MaxCurvature()), abs(props.MinCurvature()))
+    assert 2.0 * k >= 1.0 - DEFAULT.curvature_near
+    assert worst_deviation(faces, tp) < ACC   # what it did write is still accurate
 
 
 def test_a_period_in_seconds_gives_short_accurate_steps_not_a_diverged_path():

@@ -10,6 +10,7 @@ import json
 import os
 import stat
 
+import numpy as np
 import pytest
 
 import cadcnc
@@ -35,7 +36,8 @@ def one_line_error(run, code: int, *needles: str) -> None:
     ("--spindle", "nan", "--spindle"), ("--spindle", "-100", "--spindle"),
     ("--spindle", "inf", "--spindle"), ("--gouge-tolerance", "abc", "gouge tolerance"),
     ("--gouge-tolerance", "nan", "gouge tolerance"), ("--gouge-tolerance", "-1", "gouge"),
-    ("--gouge-tolerance", "inf", "gouge tolerance"),
+    ("--gouge-tolerance", "inf", "'inf' is not a finite number"),
+    ("--gouge-tolerance", "-Infinity", "is not a finite number"),
 ])
 def test_non_finite_and_negative_options_are_refused(tmp_path, flag, value, needle):
     out = tmp_path / "p.ngc"
@@ -151,3 +153,28 @@ def test_job_is_validated_where_it_is_built():
     with pytest.raises(cadcnc.InputError, match="clearance"):
         Job(Tool(3.0), 1500.0, 0.004, clearance=float("inf"))
     assert Tool(3.0).shank == 30.0 and Job(Tool(3.0), 1500, 0.004).step == pytest.approx(0.1)
+
+
+def test_a_point_beyond_the_faces_edges_projects_to_the_nearest_point_of_the_face():
+    """GeomAPI finds no interior extremum there; the fallback is the trimmed face's
+    nearest point. Closed form: the boss (r 8 about (5, -3), top z 45) seen from
+    (15, -3, 50) is nearest at its top rim (13, -3, 45), sqrt(29) mm away."""
+    boss = load_fixture("bspline_boss").face(5)
+    u, w, d = boss.project((15, -3, 50))
+    assert d == pytest.approx(29 ** 0.5, abs=1e-9)
+    assert boss.point(u, w) == pytest.approx([13, -3, 45], abs=1e-9)
+    with pytest.raises(cadcnc.InputError, match=r"\(nan, 1.0, 2.0\)"):
+        boss.project((float("nan"), 1, 2))
+
+
+@pytest.mark.parametrize("z", [19.0, 17.0])
+def test_a_start_point_near_an_edge_is_accepted(z):
+    """Was: 'no projection of point (np.float64(...)) found' for a start 0.2 mm outside
+    the boss (99 of 130 API fuzz refusals). The path goes once around, as from the edge."""
+    part = load_fixture("bspline_boss")
+    path = cadcnc.intersection_path(part.face(4), part.face(5), radius=3, feed=1500,
+                                    period=0.004, start=(13.2, -3.0, z))
+    assert path.complete, path.stop_reason
+    assert path.stop_reason == "closed"
+    length = float(np.linalg.norm(np.diff(path.points, axis=0), axis=1).sum())
+    assert length > 2 * np.pi * 8

@@ -296,3 +296,25 @@ def test_a_ball_within_the_allowance_is_refused_with_the_reason():
     gate = gouge_gate(tp, part)
     assert not gate.ok and "runs on the faces" in gate.message
     assert gate.depth_mm <= LIMIT and not gate.sweep.proven
+
+
+def test_the_cli_gates_the_program_it_writes(tmp_path):
+    """Was exit 0: points dropped at 0.002 mm left chords 2.05 um deep into the sphere
+    (the fuzz's draw, confirmed by OCCT distances at the written moves' midpoints), while
+    the CLI gated only the computed points. The JSON keeps every computed point: it passes."""
+    from test_cli import cadcnc_cli
+
+    args = ["path", FIXTURES / "sphere_cylinder.step", "--faces", "1", "2", "--radius",
+            "6.6", "--feed", "21000", "--period", "4ms", "--tolerance", "0.002"]
+    ngc = tmp_path / "s.ngc"
+    run = cadcnc_cli(*args, "-o", ngc)
+    assert run.returncode == 5 and not ngc.exists(), run.stderr
+    assert "along 149 moves between points" in run.stderr
+    assert "A smaller --tolerance (fewer points dropped) may pass" in run.stderr
+    part = load_fixture("sphere_cylinder")
+    text = to_ngc([cadcnc.intersection_path(part.face(1), part.face(2), radius=6.6,
+                                            feed=21000, period=0.004)], tolerance=0.002)
+    oracle = midpoint_depths(part, 2, programmed_moves(text), 6.6)
+    assert oracle.max() > LIMIT   # the refusal is real
+    assert cadcnc_cli(*args, "-o", tmp_path / "s.json").returncode == 0
+    assert cadcnc_cli(*args[:-2], "-o", ngc).returncode == 0   # every point kept: passes

@@ -126,13 +126,20 @@ def test_partial_path_exits_6_and_is_written_only_when_allowed(tmp_path):
     out = tmp_path / "ramp.json"
     args = ["path", FIXTURES / "ramp_wall.step", "--faces", "3", "7", *JOB, "-o", out]
     run = cadcnc_cli(*args)
-    assert run.returncode == 6 and "partial: stopped on boundary" in run.stderr
+    # how far of how much, and why: the same words on stderr and in the summary
+    why = "partial: stopped at 28.000 of 40.0 mm (the edge's length): boundary"
+    assert run.returncode == 6 and why in run.stderr
     assert not out.exists()
     run = cadcnc_cli(*args, "--allow-partial")
-    assert run.returncode == 6 and out.exists() and "result     partial" in run.stdout
+    assert run.returncode == 6 and out.exists() and f"result     {why}" in run.stdout
 
 
-def test_complete_path_says_so():
+def test_complete_path_says_so(tmp_path):
+    """... and the steps the accuracy shortened are reported like a feed override."""
+    run = cadcnc_cli("path", BOSS, "--faces", "4", "5", "--radius", "3", "--feed", "12000",
+                     "--period", "4ms", "-o", tmp_path / "b.json")
+    assert run.returncode == 0 and "result     complete\n" in run.stdout
+    assert "accuracy   feed reduced on " in run.stdout and "for accuracy (0.001 mm)" in run.stdout
     run = cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", "/dev/null/x.json")
     assert run.returncode == 4  # the destination is checked before computing
     ok = cadcnc_cli("verify", FIXTURES / "crossing_cylinders.step", "--faces", "1", "2", *JOB,
@@ -144,9 +151,11 @@ def _cli(*args):
     return [sys.executable, "-m", "cadcnc.cli", *map(str, args)]
 
 
-@pytest.mark.parametrize("delay", [0.3, 1.2, 2.0, 2.6])
+@pytest.mark.parametrize("delay", [0.3, 1.2, 2.0])
 def test_ctrl_c_at_any_moment_keeps_a_whole_set(tmp_path, delay):
-    """Old outputs intact (or the whole new set), no temporary files left, exit 130."""
+    """Old outputs intact (or the whole new set), no temporary files left, exit 130 (or 0
+    when the run had finished). Start-up, computing, writing; the moment after the files
+    are in place is the next test's."""
     outs = [tmp_path / f"b{s}" for s in (".json", ".csv", ".ngc")]
     for o in outs:
         o.write_text("old")
@@ -160,18 +169,22 @@ def test_ctrl_c_at_any_moment_keeps_a_whole_set(tmp_path, delay):
     assert contents == ["old"] * 3 or all(c != "old" for c in contents), contents
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
     assert "Traceback" not in err, err
-    assert proc.returncode in (0, 130, -signal.SIGINT), proc.returncode
+    assert proc.returncode in (0, 130), proc.returncode
+    assert (proc.returncode == 130) == ("cadcnc: interrupted" in err), err
 
 
-@pytest.mark.xfail(strict=False, reason="known open defect: on a cold start (fresh clone, "
-                   "numba and OCCT first loaded) a Ctrl-C about 2 s in can end the process "
-                   "by the signal itself (-2) instead of exit 130; files stay whole")
-@pytest.mark.parametrize("delay", [0.3, 1.2, 2.0, 2.6])
-def test_ctrl_c_exits_130(tmp_path, delay):
-    proc = subprocess.Popen(_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o",
-                                 tmp_path / "b.json"),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(delay)
-    proc.send_signal(signal.SIGINT)
+def test_ctrl_c_after_the_files_are_written_keeps_the_exit_code(tmp_path):
+    """Was exit -2 (killed by the signal) with the files complete: after ``main`` returned,
+    Python's teardown reset SIGINT to the system default and spent ~0.7 s freeing OCCT and
+    numba objects. The program now ends at once after flushing its output."""
+    out = tmp_path / "b.json"
+    proc = subprocess.Popen(_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", out),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    for line in proc.stdout:   # the summary's last line: the files are in place
+        if line.lstrip().startswith("wrote"):
+            proc.send_signal(signal.SIGINT)
+            break
     proc.communicate(timeout=60)
-    assert proc.returncode in (0, 130)
+    assert proc.returncode in (0, 130), proc.returncode
+    assert json.loads(out.read_text())["faces"] == [4, 5]
