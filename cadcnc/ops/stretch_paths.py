@@ -37,14 +37,17 @@ def refuse_without_stretch(s1, s2, found: list[EdgeStretches]) -> None:
 
 
 def stretch_paths(s1, s2, job: Job, guard: ClearanceGuard | None = None,
-                  max_cycles: int = 1_000_000) -> list[tuple[Stretch, Toolpath]]:
-    """(stretch, toolpath) for every feasible stretch of the pair, edge by edge.
+                  max_cycles: int = 1_000_000, found: list[EdgeStretches] | None = None
+                  ) -> list[tuple[Stretch, Toolpath]]:
+    """(stretch, toolpath) for every feasible stretch of the pair, edge by edge
+    (``found``: the pair's stretches when already computed).
 
     The stepper runs between the stretch's limits; until it carries the clearance guard
     itself, the stretch's limits (located to 1e-7 mm) are what keep the path clear of
     third faces, and the whole-part gouge gate stays the final check.
     """
-    found = pair_stretches(s1, s2, job, guard)
+    if found is None:
+        found = pair_stretches(s1, s2, job, guard)
     refuse_without_stretch(s1, s2, found)
     return [(st, run_plan(plan_for_stretch(s1, s2, job, st), max_cycles))
             for edge in found for st in edge.stretches]

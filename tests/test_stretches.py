@@ -1,0 +1,113 @@
+"""Every feasible stretch of a corner, against the closed forms of the stretch fixtures.
+
+The sidecar (fixtures/stretch_fixtures.json, written by build_stretch_fixtures.py from
+the fixtures' construction) gives each stretch's limits as nominal ball centres; the
+spec's 1 µm tolerances (a third face nearer than R' - 1 µm, a contact 1 µm off its face)
+move each limit outward by ``outward_per_um`` µm along the curve. Every corner runs
+along +x, so a limit's place along the curve is its x.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import cadcnc
+from cadcnc.errors import FacePairError
+from cadcnc.geometry.clearance import guard_for
+from cadcnc.job import Tool
+from cadcnc.ops.pair_path import pair_job
+from cadcnc.ops.stretch_paths import nearest_start, stretch_paths
+from cadcnc.ops.stretches import COLLISION, REASONS, Feasibility, pair_stretches
+
+from conftest import FIXTURES
+
+SIDECAR = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
+UM = 1e-6
+_cache: dict = {}
+
+
+def setup(name):
+    """(s1, s2, job, per-edge stretches) of a fixture's pair, computed once."""
+    if name not in _cache:
+        facts = SIDECAR[name]
+        part = cadcnc.load_step(FIXTURES / facts["file"])
+        i, j = facts["pair"]
+        s1, s2, job = pair_job(part.face(i), part.face(j), radius=facts["radius"],
+                               feed=1500.0, period=0.004)
+        job = replace(job, tool=Tool(facts["radius"], 0.0, facts["shank"]))
+        _cache[name] = (s1, s2, job, pair_stretches(s1, s2, job))
+    return _cache[name]
+
+
+def check_limit(limit, expected, outward: float):
+    """A located limit against its closed form: place along +x to 1 µm, off-curve
+    coordinates to 1 µm, its rule, and the face (and ball/shank) it names."""
+    x, y, z = expected["p"]
+    x_tol = x + outward * expected["outward_per_um"] * UM
+    assert limit.p[0] == pytest.approx(x_tol, abs=UM), (limit, expected)
+    assert limit.p[1:] == pytest.approx((y, z), abs=UM)
+    assert limit.rule == expected["rule"], limit.detail
+    if expected["faces"]:
+        named = [int(w.split()[0]) for w in limit.detail.split("face ")[1:]]
+        assert named and set(named) <= set(expected["faces"]), limit.detail
+    if "who" in expected:
+        assert limit.detail.startswith(expected["who"] + " touches"), limit.detail
+
+
+@pytest.mark.parametrize("name", [n for n in SIDECAR if SIDECAR[n]["stretches"]])
+def test_stretch_limits_match_closed_forms(name):
+    *_, found = setup(name)
+    (edge,) = found
+    assert edge.missed == 0
+    assert len(edge.stretches) == len(SIDECAR[name]["stretches"])
+    for got, want in zip(edge.stretches, SIDECAR[name]["stretches"]):
+        check_limit(got.start, want["start"], -1.0)
+        check_limit(got.end, want["end"], +1.0)
+        # the length follows the limits (straight corner)
+        assert got.length == pytest.approx(got.end.p[0] - got.start.p[0], abs=UM)
+        assert got.direction[0] > 0.0
+
+
+@pytest.mark.parametrize("name", [n for n in SIDECAR if "refusal" in SIDECAR[n]])
+def test_edge_without_stretch_is_refused_with_its_reason(name):
+    s1, s2, job, found = setup(name)
+    want = SIDECAR[name]["refusal"]
+    (edge,) = found
+    assert edge.stretches == [] and edge.missed == 0
+    msg = edge.refusal
+    assert REASONS[COLLISION] in msg
+    assert f"{want['who']} touches face {want['faces'][0]}" in msg
+    # the depth named is the closed form's (R' - 1 µm is the threshold)
+    too_near = -(want["margin"] + UM)
+    assert f"({too_near:.4g} mm too near)" in msg
+    with pytest.raises(FacePairError, match=f"faces {s1.number} and {s2.number}: no feasible"):
+        stretch_paths(s1, s2, job, found=found)
+
+
+def test_a_path_per_stretch_runs_between_its_limits():
+    s1, s2, job, found = setup("shelf")
+    paths = stretch_paths(s1, s2, job, found=found)
+    assert len(paths) == 2
+    for stretch, path in paths:
+        assert path.stop_reason == "end"
+        assert np.allclose(path.points[0], stretch.start.p, atol=1e-9)
+        assert np.allclose(path.points[-1], stretch.end.p, atol=1e-9)
+        # the corner is straight: every centre on the line y = 8, z = 11
+        assert np.abs(path.points[:, 1:] - (8.0, 11.0)).max() < UM
+
+
+def test_user_start_outside_the_stretch_moves_to_the_nearest_limit():
+    s1, s2, job, found = setup("shelf")
+    feas = Feasibility(s1, s2, job, guard_for(s1.part, (s1.number, s2.number), job))
+    inside, note = nearest_start(found, feas, (12.0, 8.0, 11.0))
+    assert note == "" and inside.p == pytest.approx((12.0, 8.0, 11.0), abs=1e-9)
+    # under the shelf (x 22..38 is blocked): from x = 31 the nearest limit is x = 38
+    moved, note = nearest_start(found, feas, (31.0, 8.0, 11.0))
+    assert moved.p[0] == pytest.approx(38.0 - UM, abs=UM)
+    assert "moved to the nearest stretch limit" in note and "collision" in note
+    moved, _ = nearest_start(found, feas, (24.0, 8.0, 11.0))
+    assert moved.p[0] == pytest.approx(22.0 + UM, abs=UM)
