@@ -132,33 +132,40 @@ class ClearanceGuard:
     def _exact(self, k: int, p) -> tuple[float, str]:
         """The exact margin of face k at p (OCCT distances) and who is nearest; cached.
 
+        A face lying wholly below the centre (its box's top at or under p_z) is nearest
+        to the segment at p itself (|p + s z - q| >= |p - q| for q_z <= p_z, s >= 0):
+        the ball decides, and one point distance is enough; for the pair's own faces it
+        cannot come nearer to the shank than to the ball (margin tol).
         A third face met only on an edge or vertex it shares with face i or j is met
         where the pair's own face is (a wall's top edge beside a shank tangent to the
         wall): that contact belongs to the own face's rule, and counts as clear.
         """
         face = self._faces[k - 1].topods
-        d_seg, own_edge = self._segment_distance(face, p)
-        if k in self.pair:
-            m = d_seg - (self._point_distance(face, p) - self.tol)
-            self._bound[k] = (p, m, 2.0)
-            return m, "shank"
-        m = d_seg - self.threshold
-        if own_edge:
-            m = max(m, 0.0)
-        self._bound[k] = (p, m, 1.0)
-        if m >= 0.0:
-            return m, "tool"
-        return m, "ball" if self._point_distance(face, p) < self.threshold else "shank"
+        below = self._hi[k - 1][2] - BOX_SLACK <= p[2]
+        own = k in self.pair
+        if own and below:
+            m = self.tol
+        elif own:
+            m = self._segment_distance(face, p)[0] - (self._point_distance(face, p)
+                                                     - self.tol)
+        else:
+            d, own_edge = (self._point_distance(face, p), False) if below or \
+                self.shank == 0.0 else self._segment_distance(face, p)
+            m = d - self.threshold
+            if own_edge:
+                m = max(m, 0.0)
+        self._bound[k] = (p, m, 2.0 if own else 1.0)
+        if own or m >= 0.0:
+            return m, "shank" if own else "tool"
+        return m, "ball" if below or self._point_distance(face, p) < self.threshold \
+            else "shank"
 
     def _segment_distance(self, face, p) -> tuple[float, bool]:
         """(distance mm from the segment p .. p + L z to the face, whether every nearest
         point of the face lies on an edge or vertex of face i or j)."""
         self.exact_calls += 1
         a = gp_Pnt(*p)
-        if self.shank > 0.0:
-            shape = BRepBuilderAPI_MakeEdge(a, gp_Pnt(p[0], p[1], p[2] + self.shank)).Edge()
-        else:
-            shape = BRepBuilderAPI_MakeVertex(a).Vertex()
+        shape = BRepBuilderAPI_MakeEdge(a, gp_Pnt(p[0], p[1], p[2] + self.shank)).Edge()
         ext = BRepExtrema_DistShapeShape(shape, face)
         if not ext.IsDone() or ext.NbSolution() == 0:
             return -math.inf, False  # fail closed: an unknown distance is a hit
