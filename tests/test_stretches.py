@@ -3,8 +3,9 @@
 The sidecar (fixtures/stretch_fixtures.json, written by build_stretch_fixtures.py from
 the fixtures' construction) gives each stretch's limits as nominal ball centres; the
 spec's 1 µm tolerances (a third face nearer than R' - 1 µm, a contact 1 µm off its face)
-move each limit outward by ``outward_per_um`` µm along the curve. Every corner runs
-along +x, so a limit's place along the curve is its x.
+move each limit outward by ``outward_per_um`` µm along the curve. The straight corners
+run along +x, so a limit's place along the curve is its x; the boss's base edge is a
+closed curve with its own test.
 """
 
 from __future__ import annotations
@@ -58,7 +59,8 @@ def check_limit(limit, expected, outward: float):
         assert limit.detail.startswith(expected["who"] + " touches"), limit.detail
 
 
-@pytest.mark.parametrize("name", [n for n in SIDECAR if SIDECAR[n]["stretches"]])
+@pytest.mark.parametrize("name", [n for n in SIDECAR if SIDECAR[n]["stretches"]
+                                  and n != "boss"])
 def test_stretch_limits_match_closed_forms(name):
     *_, found = setup(name)
     (edge,) = found
@@ -70,6 +72,34 @@ def test_stretch_limits_match_closed_forms(name):
         # the length follows the limits (straight corner)
         assert got.length == pytest.approx(got.end.p[0] - got.start.p[0], abs=UM)
         assert got.direction[0] > 0.0
+
+
+def test_closed_edge_boss_on_curved_floor_has_two_mirror_stretches():
+    """The boss contact leaves the boss over its top circle: at each limit it is within
+    the 1 µm boundary tolerance above the circle, and the centre is the closed form for
+    that contact height (on r = boss_r + R' about z, R' from the floor cylinder)."""
+    facts = SIDECAR["boss"]
+    s1, s2, job, found = setup("boss")
+    (edge,) = found
+    assert edge.missed == 0 and len(edge.stretches) == 2
+    expected = [np.array(lim["p"]) for st in facts["stretches"]
+                for lim in (st["start"], st["end"])]
+    got = [lim for st in edge.stretches for lim in (st.start, st.end)]
+    r, top, rb, rf = facts["radius"], facts["top"], facts["boss_r"], facts["floor_r"]
+    for lim in got:
+        assert lim.rule == "boundary" and lim.detail == f"contact off face {s2.number}"
+        q = s2.point(*lim.tangency.uv2)
+        assert np.hypot(q[0], q[1]) == pytest.approx(rb, abs=1e-9)
+        delta = q[2] - top
+        assert -1e-9 <= delta <= UM
+        y = np.sqrt((rf + r) ** 2 - (top + delta + rf) ** 2)
+        x = np.sqrt((rb + r) ** 2 - y * y)
+        assert np.abs(np.abs(lim.p) - (x, y, top + delta)).max() < 1e-8
+        nearest = min(expected, key=lambda e: np.linalg.norm(e - lim.p))
+        assert np.linalg.norm(nearest - lim.p) < 20 * UM   # mirror images: one each
+        expected = [e for e in expected if e is not nearest]
+    lengths = [st.length for st in edge.stretches]
+    assert lengths[0] == pytest.approx(lengths[1], abs=UM)
 
 
 @pytest.mark.parametrize("name", [n for n in SIDECAR if "refusal" in SIDECAR[n]])
