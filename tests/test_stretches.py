@@ -141,3 +141,46 @@ def test_user_start_outside_the_stretch_moves_to_the_nearest_limit():
     assert "moved to the nearest stretch limit" in note and "collision" in note
     moved, _ = nearest_start(found, feas, (24.0, 8.0, 11.0))
     assert moved.p[0] == pytest.approx(22.0 + UM, abs=UM)
+
+
+class _Circle:
+    """A closed edge stub: a circle of circumference 10 mm, walked by arc length."""
+
+    closed, length = True, 10.0
+
+    def point_tangent(self, s):
+        a = 2 * np.pi * (s % self.length) / self.length
+        r = self.length / (2 * np.pi)
+        return np.array([r * np.cos(a), r * np.sin(a), 0.0]), np.array([-np.sin(a),
+                                                                           np.cos(a), 0.0])
+
+
+class _Window:
+    """Feasible for arc length (mod 10) in [8, 10) and [0, 2.5]: a window across the seam;
+    the ball centre is the anchor itself."""
+
+    def sample(self, s, anchor, tangent, seed=None):
+        from cadcnc.interp.stepper import Tangency
+        from cadcnc.ops.stretches import BOUNDARY, FEASIBLE, Sample
+
+        u = s % 10.0
+        ok = u >= 8.0 or u <= 2.5
+        tan = Tangency(tuple(map(float, anchor)), (0.0, 0.0), (0.0, 0.0))
+        return Sample(s, FEASIBLE if ok else BOUNDARY, "" if ok else "off", tan,
+                      tuple(map(float, tangent)))
+
+
+def test_a_stretch_across_the_seam_of_a_closed_edge_is_one_stretch():
+    from cadcnc.ops.stretches import _refine, _stretches, EdgeStretches
+
+    curve, feas = _Circle(), _Window()
+    grid = np.arange(0.0, 10.0, 0.2)
+    samples = [feas.sample(s, *curve.point_tangent(s)) for s in grid]
+    samples = _refine(feas, curve, samples, EdgeStretches(0, curve.length))
+    (st,) = _stretches(feas, curve, samples, 0)
+    assert st.start.s % 10.0 == pytest.approx(8.0, abs=1e-6)
+    assert st.end.s % 10.0 == pytest.approx(2.5, abs=1e-6)
+    assert st.start.rule == st.end.rule == "boundary"
+    # 4.5 mm of arc on a circle of radius 10 / 2 pi (not the 5.5 mm the other way round):
+    # the polyline of 0.2 mm chords is shorter by about 22 x 0.2^3 / (24 r^2) = 3e-3 mm
+    assert 4.5 - 5e-3 < st.length <= 4.5

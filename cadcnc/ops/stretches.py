@@ -27,7 +27,7 @@ there); they are never reported as feasible.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -270,9 +270,14 @@ def _locate(feas, curve, good: Sample, bad: Sample) -> tuple[Sample, Sample]:
 
 
 def _limit(feas, curve, good: Sample, bad: Sample | None) -> Limit:
+    """The limit between a feasible sample and its infeasible neighbour (None: the end of
+    the searched extension). On a closed edge the neighbour across the seam is moved by
+    one period of arc length, so that the bisection runs between the two."""
     if bad is None:
         return Limit(good.tangency, SEARCH, "the stretch goes on past the searched "
                      "extension of the edge", good.s)
+    if curve.closed and abs(bad.s - good.s) > 0.5 * curve.length:
+        bad = replace(bad, s=bad.s + math.copysign(curve.length, good.s - bad.s))
     good, bad = _locate(feas, curve, good, bad)
     return Limit(good.tangency, bad.rule, bad.detail, good.s)
 
@@ -283,7 +288,8 @@ def _stretches(feas, curve, samples: list[Sample], edge: int) -> list[Stretch]:
     if curve.closed and all(ok):
         first = samples[0]
         lim = Limit(first.tangency, CLOSED, "feasible all around the closed edge", first.s)
-        return [Stretch(edge, lim, lim, first.tangent, _polyline(samples + [first]), True)]
+        pts = [x.tangency for x in samples + [first]]
+        return [Stretch(edge, lim, lim, first.tangent, _polyline(pts), True)]
     order = list(range(len(samples)))
     if curve.closed:   # start the walk at an infeasible sample, wrapping around
         k = ok.index(False)
@@ -307,18 +313,13 @@ def _stretches(feas, curve, samples: list[Sample], edge: int) -> list[Stretch]:
                        samples[before])
         end = _limit(feas, curve, samples[last], None if after is None else samples[after])
         pts = [start.tangency] + [samples[i].tangency for i in run] + [end.tangency]
-        out.append(Stretch(edge, start, end, samples[first].tangent,
-                           _polyline([_Pt(t) for t in pts])))
+        out.append(Stretch(edge, start, end, samples[first].tangent, _polyline(pts)))
     return out
 
 
-class _Pt:
-    def __init__(self, tangency):
-        self.tangency = tangency
-
-
-def _polyline(samples) -> float:
-    pts = np.array([x.tangency.p for x in samples])
+def _polyline(tangencies: list[Tangency]) -> float:
+    """Length of the polyline through the tangencies' centres, mm."""
+    pts = np.array([t.p for t in tangencies])
     return float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
 
 
