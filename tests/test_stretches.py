@@ -156,15 +156,16 @@ class _Circle:
 
 
 class _Window:
-    """Feasible for arc length (mod 10) in [8, 10) and [0, 2.5]: a window across the seam;
-    the ball centre is the anchor itself."""
+    """Feasible for arc length (mod 10) in [9.9, 10) and [0, 2.5]: a window across the
+    seam whose start lies between the last sample (9.8) and the first (0); the ball
+    centre is the anchor itself."""
 
     def sample(self, s, anchor, tangent, seed=None):
         from cadcnc.interp.stepper import Tangency
         from cadcnc.ops.stretches import BOUNDARY, FEASIBLE, Sample
 
         u = s % 10.0
-        ok = u >= 8.0 or u <= 2.5
+        ok = u >= 9.9 or u <= 2.5
         tan = Tangency(tuple(map(float, anchor)), (0.0, 0.0), (0.0, 0.0))
         return Sample(s, FEASIBLE if ok else BOUNDARY, "" if ok else "off", tan,
                       tuple(map(float, tangent)))
@@ -178,9 +179,9 @@ def test_a_stretch_across_the_seam_of_a_closed_edge_is_one_stretch():
     samples = [feas.sample(s, *curve.point_tangent(s)) for s in grid]
     samples = _refine(feas, curve, samples, EdgeStretches(0, curve.length))
     (st,) = _stretches(feas, curve, samples, 0)
-    assert st.start.s % 10.0 == pytest.approx(8.0, abs=1e-6)
+    assert st.start.s % 10.0 == pytest.approx(9.9, abs=1e-6)
     assert st.end.s % 10.0 == pytest.approx(2.5, abs=1e-6)
     assert st.start.rule == st.end.rule == "boundary"
-    # 4.5 mm of arc on a circle of radius 10 / 2 pi (not the 5.5 mm the other way round):
-    # the polyline of 0.2 mm chords is shorter by about 22 x 0.2^3 / (24 r^2) = 3e-3 mm
-    assert 4.5 - 5e-3 < st.length <= 4.5
+    # 2.6 mm of arc on a circle of radius 10 / 2 pi (not 7.4 mm the other way round):
+    # the polyline of 0.2 mm chords is shorter by about 13 x 0.2^3 / (24 r^2) = 2e-3 mm
+    assert 2.6 - 3e-3 < st.length <= 2.6
