@@ -14,10 +14,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import FacePairError
+from ..geometry.clearance import ClearanceGuard
 from ..job import Job
 from ..program.toolpath import Toolpath
 from .pair_path import PathPlan, run_plan
-from .stretches import ClearanceGuard, EdgeStretches, Feasibility, Stretch, pair_stretches
+from .stretches import EdgeStretches, Feasibility, Stretch, pair_stretches
 
 
 def plan_for_stretch(s1, s2, job: Job, stretch: Stretch) -> PathPlan:
@@ -53,7 +54,7 @@ def stretch_paths(s1, s2, job: Job, guard: ClearanceGuard | None = None,
             for edge in found for st in edge.stretches]
 
 
-def nearest_start(found: list[EdgeStretches], feas: Feasibility, point, seed_edge=None):
+def nearest_start(found: list[EdgeStretches], feas: Feasibility, point):
     """(tangency, note) for a user's start ``point``: the tangency through it when that
     position is feasible (note ""), else the nearest stretch limit and a note saying so.
 
@@ -69,7 +70,7 @@ def nearest_start(found: list[EdgeStretches], feas: Feasibility, point, seed_edg
     near = min(edge_samples, key=lambda x: float(np.linalg.norm(
         np.subtract(x.tangency.p, point))), default=None)
     if near is not None:
-        here = feas.sample(-1.0, point, near.tangent, near.tangency)
+        here = feas.sample(near.s, point, near.tangent, near.tangency)
         if here.ok:
             return here.tangency, ""
         why = f"{here.rule}: {here.detail}"
