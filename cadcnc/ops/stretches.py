@@ -9,17 +9,17 @@ where the ball and its shank clear the rest of the part
 connected piece of the offset intersection curve made of feasible positions.
 
 Method: tangency samples anchored on planes normal to the edge, every ``spacing`` mm of
-edge (0.2 mm, at least 9 per edge) and continued ``R' + 1`` mm beyond each end of an
+edge (0.4 mm, at least 9 per edge) and continued ``R' + 1`` mm beyond each end of an
 open edge along its end tangent; a sample interval whose centres are more than
 ``MAX_CHORD`` apart is split until they are not. Each change feasible/infeasible
 between neighbouring samples is located by bisection on the anchor's arc length until
 the feasible and the infeasible centres are less than ``LIMIT_TOL`` apart; the limit is
 the feasible one, its rule the one that fails beside it.
 
-Guarantee: neighbouring samples' centres are at most MAX_CHORD = 0.4 mm apart, so a
+Guarantee: neighbouring samples' centres are at most MAX_CHORD = 0.45 mm apart, so a
 stretch (or a gap between stretches) can be missed only if it is shorter than the
-curve between two samples: under 0.5 mm wherever the curve turns less than ~70 deg
-over 0.4 mm. Intervals where a sample has no tangency, or could not be refined to
+curve between two samples: under 0.5 mm wherever the curve turns less than ~50 deg
+over 0.45 mm. Intervals where a sample has no tangency, or could not be refined to
 MAX_CHORD, are counted in ``EdgeStretches.missed`` (a stretch of any length may hide
 there); they are never reported as feasible.
 """
@@ -40,9 +40,9 @@ from ..interp.stepper import Tangency
 from ..interp.tangency import solve_tangency
 from ..job import Job
 
-SPACING = 0.2       # mm of edge between samples
+SPACING = 0.4       # mm of edge between samples (refined to MAX_CHORD of centres)
 MIN_SAMPLES = 9     # per edge
-MAX_CHORD = 0.4     # mm: neighbouring sample centres are refined to at most this apart
+MAX_CHORD = 0.45    # mm: neighbouring sample centres are refined to at most this apart
 LIMIT_TOL = 1e-7    # mm: a limit is located until its two sides are this close
 MAX_SPLITS = 6      # halvings of a sample interval whose centres are too far apart
 
