@@ -107,3 +107,13 @@ def test_broad_phase_and_cache_keep_exact_distances_rare():
     assert g.calls == n
     assert g.broad_calls < n / 5
     assert g.exact_calls < n * faces / 4
+
+
+def test_an_unknown_distance_fails_closed():
+    """When OCCT finds no distance, the face counts as hit (never as far away)."""
+    g = guard("undercut")
+    g._point_distance = lambda face, p: -math.inf
+    g._segment_distance = lambda face, p: (-math.inf, False)
+    lean = math.radians(10.0)
+    m, _ = g.margin((15.0, 15.0 - 3.0 * math.tan(lean) - 3.0 / math.cos(lean), 13.0))
+    assert m == -math.inf

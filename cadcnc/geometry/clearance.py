@@ -146,8 +146,9 @@ class ClearanceGuard:
         if own and below:
             m = self.tol
         elif own:
-            m = self._segment_distance(face, p)[0] - (self._point_distance(face, p)
-                                                     - self.tol)
+            d_seg, d_p = self._segment_distance(face, p)[0], self._point_distance(face, p)
+            # an unknown distance fails closed (-inf is a hit, never an inf margin)
+            m = d_seg - (d_p - self.tol) if math.isfinite(d_seg + d_p) else -math.inf
         else:
             d, own_edge = (self._point_distance(face, p), False) if below or \
                 self.shank == 0.0 else self._segment_distance(face, p)
