@@ -110,10 +110,16 @@ def test_broad_phase_and_cache_keep_exact_distances_rare():
 
 
 def test_an_unknown_distance_fails_closed():
-    """When OCCT finds no distance, the face counts as hit (never as far away)."""
-    g = guard("undercut")
-    g._point_distance = lambda face, p: -math.inf
-    g._segment_distance = lambda face, p: (-math.inf, False)
+    """When OCCT finds no distance, the face counts as hit (never as far away): a third
+    face, and the pair's own overhanging wall (whose rule compares two distances)."""
+    facts = SIDECAR["undercut"]
+    floor, wall = facts["pair"]
     lean = math.radians(10.0)
-    m, _ = g.margin((15.0, 15.0 - 3.0 * math.tan(lean) - 3.0 / math.cos(lean), 13.0))
-    assert m == -math.inf
+    p = (15.0, 15.0 - 3.0 * math.tan(lean) - 3.0 / math.cos(lean), 13.0)
+    g = guard("undercut")
+    g._point_distance = lambda face, q: -math.inf
+    g._segment_distance = lambda face, q: (1.0, False)
+    assert g._exact(wall, p)[0] == -math.inf
+    g._segment_distance = lambda face, q: (-math.inf, False)
+    third = next(k for k in range(1, len(part_of("undercut")) + 1) if k not in (floor, wall))
+    assert g._exact(third, p)[0] == -math.inf
