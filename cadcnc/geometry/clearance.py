@@ -1,0 +1,206 @@
+"""How far the ball and its shank are from the rest of the part: the third-face guard.
+
+For a pair of faces (i, j) followed by a ball of offset R' on a shank of radius R' and
+length L along +Z, :meth:`ClearanceGuard.margin` answers, for a ball centre p (mm), the
+signed clearance (mm) of the tool from the part: >= 0 clear, < 0 a hit, with a detail
+naming the face and whether the ball or the shank touches it.
+
+- Third faces (every face but i and j): the tool is the capsule half "ball at p, shank
+  up to p + L z", i.e. every point within R' of the segment p .. p + L z. Its clearance
+  from face K is dist(segment, K) - (R' - tol). The nearest point of the segment says
+  who touches: p itself (the ball) or a point above it (the shank).
+- The pair's own faces i and j touch the ball by construction (distance R', up to the
+  path's own error), so an absolute rule would fire on path noise. Their rule is
+  relative: the shank must come no nearer to face i than the ball is, minus tol:
+  dist(segment, i) - (dist(p, i) - tol). This is exact for a vertical wall (the shank
+  is tangent along it: margin tol) and catches an overhanging own face. It is skipped in
+  closed form for a plane whose outward normal has n_z >= 0 and for a cylinder with a
+  vertical axis (there the segment is never nearer than its foot).
+- Distances are unsigned (OCCT's BRepExtrema_DistShapeShape): along a valid path the
+  centre lies outside the part, on the cutter side of faces i and j, so a face within
+  reach is a hit whichever side the centre is on. The whole-part gouge gate stays the
+  final, material-aware check of every written path.
+
+Cost: a broad phase on the faces' boxes (re-done only after the centre has moved by
+``reach``), then a Lipschitz cache per face (a distance d measured at p0 bounds the
+distance at p from below by d - |p - p0|; the own-face margin is 2-Lipschitz), so exact
+OCCT distances are computed only for faces that may be within R' of the tool. The
+returned margin is exact when some face needs it (in particular whenever it is < 0
+or near 0), otherwise a positive lower bound.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_IsInFace
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_VERTEX
+from OCP.TopExp import TopExp
+from OCP.TopTools import TopTools_IndexedMapOfShape
+from OCP.gp import gp_Pnt
+
+from .part import optimal_box
+
+TIE = 1e-9  # mm: margins this close are the same contact
+BOX_SLACK = 1e-4  # mm added to each face box: OCCT's optimal box is tight, not outer-exact
+
+
+class ClearanceGuard:
+    """The clearance of ball + shank from a part, for the pair of faces ``pair``.
+
+    ``offset`` R' (mm), ``shank`` L (mm, 0 for a ball alone), ``tol`` (mm, the 1 µm of
+    the spec: a face nearer than R' - tol is a hit). ``reach`` (mm) is the broad phase's
+    radius: faces whose box is further than R' + reach from the tool are not looked at
+    again until the centre has moved by ``reach``.
+    """
+
+    def __init__(self, part, pair: tuple[int, int], offset: float, shank: float,
+                 tol: float = 1e-6, reach: float | None = None):
+        self.part = part
+        self.pair = (int(pair[0]), int(pair[1]))
+        self.offset = float(offset)
+        self.shank = float(shank)
+        self.tol = float(tol)
+        self.threshold = self.offset - self.tol   # mm: nearer than this is a hit
+        self.reach = max(self.offset, 1.0) if reach is None else float(reach)
+        n = len(part)
+        self._faces = [part.face(k) for k in range(1, n + 1)]
+        boxes = [optimal_box(f.topods, use_triangulation=False) for f in self._faces]
+        self._lo = np.array([b[0] for b in boxes]) - BOX_SLACK     # (n, 3)
+        self._hi = np.array([b[1] for b in boxes]) + BOX_SLACK     # (n, 3)
+        self._own_shapes = TopTools_IndexedMapOfShape()   # edges and vertices of i and j
+        for k in self.pair:
+            for kind in (TopAbs_EDGE, TopAbs_VERTEX):
+                TopExp.MapShapes_s(self._faces[k - 1].topods, kind, self._own_shapes)
+        self._own_rule = {k: _needs_own_rule(self._faces[k - 1]) for k in self.pair}
+        self._broad_at: tuple[float, float, float] | None = None
+        self._near: list[int] = []          # face numbers within reach at _broad_at
+        self._bound: dict[int, tuple] = {}  # face -> (p0, lower bound of the margin at p0, slope)
+        self.calls = 0
+        self.exact_calls = 0
+        self.broad_calls = 0
+
+    # -- the guard ------------------------------------------------------------------------
+    def margin(self, p) -> tuple[float, str]:
+        """(clearance mm, detail) of the tool with its ball centre at ``p`` (3 floats).
+
+        >= 0: clear ("" or the nearest face's name); < 0: a hit, with the detail
+        "ball touches face K" or "shank touches face K".
+        """
+        self.calls += 1
+        p = (float(p[0]), float(p[1]), float(p[2]))
+        moved = math.inf if self._broad_at is None else _dist(p, self._broad_at)
+        if moved > self.reach:
+            self._broad_phase(p)
+            moved = 0.0
+        best, detail = self.reach - moved, ""   # lower bound for the faces not near
+        for k in self._near:
+            p0, m0, slope = self._bound[k]
+            m = m0 - slope * _dist(p, p0)
+            who = ""
+            if m < 0.0:    # the bound cannot clear it: measure
+                m, who = self._exact(k, p)
+            # on a tie (a wall and its rim at once) name the ball: it is what the user sees
+            if m < best - TIE or (m < best + TIE and who == "ball"):
+                best = m
+                detail = f"{who} touches face {k}" if m < 0.0 else \
+                    (f"{who} nearest face {k}" if who else f"face {k} within reach")
+        return best, detail
+
+    def _broad_phase(self, p) -> None:
+        """Faces whose box may come within R' of the tool before the centre moves
+        ``reach``: box-to-box distance of the tool's segment box and each face box."""
+        self.broad_calls += 1
+        seg_lo = np.array(p)
+        seg_hi = seg_lo + (0.0, 0.0, self.shank)
+        gap = np.maximum(np.maximum(self._lo - seg_hi, seg_lo - self._hi), 0.0)
+        box_dist = np.sqrt((gap * gap).sum(axis=1))                     # (n,)
+        near = np.nonzero(box_dist < self.threshold + self.reach)[0] + 1
+        self._broad_at = p
+        self._near = []
+        for k in near.tolist():
+            if k in self.pair:
+                if not self._own_rule[k]:
+                    continue
+                self._bound.setdefault(k, (p, -1.0, 2.0))
+            elif k not in self._bound:
+                self._bound[k] = (p, float(box_dist[k - 1]) - self.threshold, 1.0)
+            self._near.append(k)
+
+    def _exact(self, k: int, p) -> tuple[float, str]:
+        """The exact margin of face k at p (OCCT distances) and who is nearest; cached.
+
+        A face lying wholly below the centre (its box's top at or under p_z) is nearest
+        to the segment at p itself (|p + s z - q| >= |p - q| for q_z <= p_z, s >= 0):
+        the ball decides, and one point distance is enough; for the pair's own faces it
+        cannot come nearer to the shank than to the ball (margin tol).
+        A third face met only on an edge or vertex it shares with face i or j is met
+        where the pair's own face is (a wall's top edge beside a shank tangent to the
+        wall): that contact belongs to the own face's rule, and counts as clear.
+        """
+        face = self._faces[k - 1].topods
+        below = self._hi[k - 1][2] - BOX_SLACK <= p[2]
+        own = k in self.pair
+        if own and below:
+            m = self.tol
+        elif own:
+            d_seg, d_p = self._segment_distance(face, p)[0], self._point_distance(face, p)
+            # an unknown distance fails closed (-inf is a hit, never an inf margin)
+            m = d_seg - (d_p - self.tol) if math.isfinite(d_seg + d_p) else -math.inf
+        else:
+            d, own_edge = (self._point_distance(face, p), False) if below or \
+                self.shank == 0.0 else self._segment_distance(face, p)
+            m = d - self.threshold
+            if own_edge:
+                m = max(m, 0.0)
+        self._bound[k] = (p, m, 2.0 if own else 1.0)
+        if own or m >= 0.0:
+            return m, "shank" if own else "tool"
+        return m, "ball" if below or self._point_distance(face, p) < self.threshold \
+            else "shank"
+
+    def _segment_distance(self, face, p) -> tuple[float, bool]:
+        """(distance mm from the segment p .. p + L z to the face, whether every nearest
+        point of the face lies on an edge or vertex of face i or j)."""
+        self.exact_calls += 1
+        a = gp_Pnt(*p)
+        shape = BRepBuilderAPI_MakeEdge(a, gp_Pnt(p[0], p[1], p[2] + self.shank)).Edge()
+        ext = BRepExtrema_DistShapeShape(shape, face)
+        if not ext.IsDone() or ext.NbSolution() == 0:
+            return -math.inf, False  # fail closed: an unknown distance is a hit
+        own = all(ext.SupportTypeShape2(n) != BRepExtrema_IsInFace
+                  and self._own_shapes.Contains(ext.SupportOnShape2(n))
+                  for n in range(1, ext.NbSolution() + 1))
+        return ext.Value(), own
+
+    def _point_distance(self, face, p) -> float:
+        self.exact_calls += 1
+        ext = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(), face)
+        return ext.Value() if ext.IsDone() and ext.NbSolution() else -math.inf
+
+
+def _needs_own_rule(face) -> bool:
+    """False where a shank above the ball can never come nearer to this face than the
+    ball's own contact: a plane whose outward normal has n_z >= 0, or a cylinder whose
+    axis is vertical (both in closed form)."""
+    surf = face._adaptor
+    if face.kind == "plane":
+        u, w = np.mean(face.u_range), np.mean(face.w_range)
+        return face.normal(u, w)[2] < -1e-12
+    if face.kind == "cylinder":
+        axis = surf.Cylinder().Axis().Direction()
+        return abs(abs(axis.Z()) - 1.0) > 1e-12
+    return True
+
+
+def _dist(a, b) -> float:
+    return math.sqrt((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 + (a[2] - b[2]) ** 2)
+
+
+def guard_for(part, pair: tuple[int, int], job, reach: float | None = None) -> ClearanceGuard:
+    """The guard of a :class:`~cadcnc.job.Job` (its tool's R', shank length and the
+    tolerance ``hit``) for faces ``pair`` of ``part``."""
+    return ClearanceGuard(part, pair, job.tool.offset, job.tool.shank,
+                          job.tolerances.hit, reach)
