@@ -112,13 +112,18 @@ class PairPath:
     ``offsets``: each surface's offset, None meaning R'; 0 makes that surface a guide
     surface carrying the ball centre. ``start``/``end``: points (mm) near the intersection;
     by default the ends of the faces' shared concave edge number ``edge`` (0-based).
+    A program of the pair (:func:`cadcnc.ops.pair_program.program_for_job`) follows every
+    feasible stretch of every shared concave edge, or of edge ``edge`` alone when it is
+    given (None: every edge), and of those only stretch number ``stretch`` (1-based along
+    the edge) when given.
     """
 
     faces: tuple[int | None, int | None] = (None, None)
     offsets: tuple[float | None, float | None] = (None, None)
     start: Point | None = None
     end: Point | None = None
-    edge: int = 0
+    edge: int | None = 0
+    stretch: int | None = None
 
     def __post_init__(self):
         faces = tuple(self.faces)
@@ -139,11 +144,17 @@ class PairPath:
         object.__setattr__(self, "end", check_point("end", self.end))
         if self.end is not None and self.start is None:
             raise InputError("an end point needs a start point too")
-        if isinstance(self.edge, bool) or not isinstance(self.edge, numbers.Integral) \
-                or self.edge < 0:
-            raise InputError(f"edge must be an index >= 0 among the shared concave edges, "
-                             f"got {_show(self.edge)}")
-        object.__setattr__(self, "edge", int(self.edge))
+        if self.edge is not None:
+            if isinstance(self.edge, bool) or not isinstance(self.edge, numbers.Integral) \
+                    or self.edge < 0:
+                raise InputError(f"edge must be an index >= 0 among the shared concave "
+                                 f"edges (or None: every edge), got {_show(self.edge)}")
+            object.__setattr__(self, "edge", int(self.edge))
+        if self.stretch is not None:
+            if isinstance(self.stretch, bool) or not isinstance(
+                    self.stretch, numbers.Integral) or self.stretch < 1:
+                raise InputError(f"stretch numbers start at 1, got {_show(self.stretch)}")
+            object.__setattr__(self, "stretch", int(self.stretch))
 
     def resolved_offsets(self, tool: Tool) -> tuple[float, float]:
         """Each surface's offset in mm, None resolved to the tool's R'."""
@@ -197,7 +208,8 @@ class Job:
         return dict(radius=self.tool.radius, allowance=self.tool.allowance, feed=self.feed,
                     period=self.period, start=None if op.start is None else list(op.start),
                     end=None if op.end is None else list(op.end),
-                    offsets=list(self.offsets), edge=op.edge, source=self.source,
+                    offsets=list(self.offsets), edge=op.edge, stretch=op.stretch,
+                    source=self.source,
                     shank_length=self.tool.shank_length, clearance=self.clearance,
                     flip_material=self.flip_material)
 
@@ -212,7 +224,7 @@ class Job:
                             for o in (inputs.get("offsets") or (None, None)))
             op = PairPath(faces=tuple(faces), offsets=offsets,
                           start=inputs.get("start"), end=inputs.get("end"),
-                          edge=inputs.get("edge", 0))
+                          edge=inputs.get("edge", 0), stretch=inputs.get("stretch"))
             return cls(tool, inputs["feed"], inputs["period"], op, inputs.get("source"),
                        inputs.get("clearance"),
                        flip_material=bool(inputs.get("flip_material", False)))

@@ -31,7 +31,7 @@ def _resolve(entry: ProgramEntry, part) -> ProgramEntry:
     s1, s2 = part.face(op.faces[0]), part.face(op.faces[1])
     if not entry.on_edge:
         return entry
-    edge = shared_edge_for(s1, s2, op.edge)
+    edge = shared_edge_for(s1, s2, op.edge or 0)
     if entry.pending is None:  # EDGE, EDGE: the job's own default
         return entry
     s, e = entry.pending

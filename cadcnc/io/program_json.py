@@ -5,11 +5,13 @@ Layout (``format: "cadcnc-program"``, ``version: 2``)::
     {"format": "cadcnc-program", "version": 2,
      "job": {...}                     the program's job (Job.to_inputs keys),
      "segments": [                    in machining order
-        {"kind": "cut", "faces": [i, j], "edge": k, "stretch": s, "points": [[x, y, z], ...],
+        {"kind": "cut", "faces": [i, j], "edge": k, "stretch": s, "at_limit": false,
+         "points": [[x, y, z], ...],
          "stop_reason": ..., ... every key of a version 1 toolpath (inputs, contacts,
          normals, uv, steps, commanded, bounds, accuracy_*)},
         {"kind": "link", "points": [[x, y, z], ...], "rapid": [true, false, ...]}, ...],
      "skipped": [{"faces": [i, j], "edge": k, "reason": ..., "detail": ...}, ...],
+     "notes": ["start (...) is outside every feasible stretch ...: moved ...", ...],
      "summary": {"complete": ..., "cut_length_mm": ..., "link_length_mm": ...,
                  "time_at_feed_s": ..., "cuts": ..., "links": ..., "skipped": ...}}
 
@@ -39,7 +41,7 @@ def _cut_to_dict(seg: CutSegment) -> dict:
     d = v1.toolpath_to_dict(seg.path)
     del d["format"], d["version"]
     return {"kind": "cut", "faces": d.pop("faces"), "edge": seg.edge,
-            "stretch": seg.stretch, "points": d.pop("points"), **d}
+            "stretch": seg.stretch, "at_limit": seg.at_limit, "points": d.pop("points"), **d}
 
 
 def program_to_dict(program: Program) -> dict:
@@ -57,6 +59,7 @@ def program_to_dict(program: Program) -> dict:
         "segments": segments,
         "skipped": [{"faces": list(s.faces), "edge": s.edge, "reason": s.reason,
                      "detail": s.detail} for s in program.skipped],
+        "notes": list(program.notes),
         "summary": plain({"complete": program.complete, **program.totals()},
                          nonfinite_as_strings=True),
     }
@@ -70,12 +73,13 @@ def _segment(d: dict, k: int):
             raise InputError(f"segment {k} (link) has a non-finite point")
         return LinkSegment(pts, d.get("rapid", [True] * (len(pts) - 1)))
     if kind == "cut":
-        body = {key: v for key, v in d.items() if key not in ("kind", "edge", "stretch")}
+        body = {key: v for key, v in d.items()
+                if key not in ("kind", "edge", "stretch", "at_limit")}
         try:
             path = v1.toolpath_from_dict({**body, "format": v1.FORMAT, "version": v1.VERSION})
         except InputError as e:
             raise InputError(f"segment {k} (cut): {e}") from None
-        return CutSegment(path, d.get("edge"), d.get("stretch"))
+        return CutSegment(path, d.get("edge"), d.get("stretch"), bool(d.get("at_limit")))
     raise InputError(f"segment {k}: kind must be \"cut\" or \"link\", got {kind!r}")
 
 
@@ -101,7 +105,7 @@ def program_from_dict(d: dict) -> Program:
                          f"{e})") from None
     if not cuts and not skipped:
         raise InputError("program JSON has no cut segment and nothing skipped")
-    return Program(job, segments, skipped)
+    return Program(job, segments, skipped, [str(n) for n in d.get("notes", [])])
 
 
 def program_json(program: Program) -> str:

@@ -108,7 +108,7 @@ def plan_path(s1: FaceSurface, s2: FaceSurface, job: Job) -> PathPlan:
     closed = False
     edge_length = None
     if start is None:
-        e = shared_edge_for(s1, s2, op.edge)
+        e = shared_edge_for(s1, s2, op.edge or 0)  # None (every edge): the first
         edge_length = float(e.length)
         anchors = [(e.start, e.start_tangent), (None if e.closed else (e.end, e.end_tangent))]
         direction, closed = e.start_tangent, e.closed

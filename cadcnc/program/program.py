@@ -11,7 +11,9 @@ program is machined in the order of ``segments``.
 - :class:`Skipped`: a corner, stretch or pass that was found and not cut, with its reason.
 
 A program is complete when every cut is complete (stopped where it was meant to, an
-intended end or the limit of a stretch): what could not be cut is listed in ``skipped``.
+intended end or the limit of a stretch) and nothing is listed as stopped short; what was
+found and could not be cut is listed in ``skipped``. ``notes`` are sentences for the user
+(a start moved into a stretch).
 """
 
 from __future__ import annotations
@@ -26,11 +28,17 @@ from .toolpath import Toolpath
 
 @dataclass
 class CutSegment:
-    """One cut: the toolpath, and the shared edge / stretch it follows (1-based, or None)."""
+    """One cut: the toolpath, and the shared edge / stretch it follows (1-based, or None).
+
+    ``at_limit``: the cut stopped at the limit of its stretch (a contact reaching its
+    face's boundary, a third face or the shank touching): an intended end, like the end
+    point itself.
+    """
 
     path: Toolpath
     edge: int | None = None
     stretch: int | None = None
+    at_limit: bool = False
 
     kind = "cut"
 
@@ -42,6 +50,11 @@ class CutSegment:
     @property
     def length(self) -> float:
         return self.path.length
+
+    @property
+    def complete(self) -> bool:
+        """Stopped where it was meant to: its end, once around, or its stretch's limit."""
+        return self.path.complete or self.at_limit
 
 
 @dataclass
@@ -72,6 +85,10 @@ class LinkSegment:
         return float(d[~self.rapid].sum())
 
 
+STOPPED_SHORT = "stopped short"
+"""Skipped reason of the rest of a stretch after a cut that stopped before its end."""
+
+
 @dataclass(frozen=True)
 class Skipped:
     """A corner, stretch or pass found and not cut: the faces, the shared edge (1-based,
@@ -96,6 +113,7 @@ class Program:
     job: Job
     segments: list = field(default_factory=list)
     skipped: list[Skipped] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
 
     @classmethod
     def of_paths(cls, paths: list[Toolpath], job: Job | None = None,
@@ -141,13 +159,14 @@ class Program:
     @property
     def complete(self) -> bool:
         """Every cut stopped where it was meant to (nothing partial passed as whole)."""
-        return all(s.path.complete for s in self.cuts)
+        return all(s.complete for s in self.cuts) and not any(
+            s.reason == STOPPED_SHORT for s in self.skipped)
 
     @property
     def partial_reasons(self) -> list[str]:
-        """One sentence per cut that stopped short ('' entries left out)."""
+        """One sentence per cut that stopped short of its intended end."""
         return [f"cut {k}: {s.path.partial_reason}" for k, s in enumerate(self.cuts, 1)
-                if not s.path.complete]
+                if not s.complete]
 
     def all_moves(self) -> np.ndarray:
         """(M, 3) every ball-centre position commanded, in order (cuts and links)."""

@@ -74,7 +74,8 @@ def followed_edge(toolpath, part):
     if op.start is not None:
         return None
     concave = [e for e in part.shared_edges(*toolpath.faces) if e.edge_class == CONCAVE]
-    return concave[op.edge] if op.edge < len(concave) else None
+    k = op.edge or 0  # None (every edge) in a program: its first edge
+    return concave[k] if k < len(concave) else None
 
 
 def intended_span(toolpath, edge) -> tuple[str, np.ndarray | None]:
