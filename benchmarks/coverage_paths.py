@@ -23,6 +23,7 @@ EXPECTED_CODES = {0, 2, 3, 4, 5, 6}  # anything else (or a traceback) is a crash
 REASONS = [  # (reason, pattern in cadcnc's message), first match wins
     ("start off a face", re.compile(r"touches face \d+ outside the face|outside the face")),
     ("ball cuts the part (gouge gate)", re.compile(r"cuts into the part")),
+    ("faces tangent at the start", re.compile(r"stopped at the start point \(tangent\)")),
     ("partial path", re.compile(r": partial: ")),
     ("no solid in the file", re.compile(r"holds no solid")),
     ("tangent edge", re.compile(r"tangent edge")),
@@ -47,7 +48,8 @@ def classify(code: int | None, stderr: str) -> str:
         return "written"
     for reason, pattern in REASONS:
         if pattern.search(stderr):
-            return reason
+            stop = re.search(r"partial: stopped on (\w+)", stderr)
+            return f"{reason} ({stop.group(1)})" if reason == "partial path" and stop else reason
     return f"other (exit {code})"
 
 
