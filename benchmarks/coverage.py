@@ -32,7 +32,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from coverage_oracle import TOL, Oracle, read_shape  # noqa: E402
-from coverage_paths import distance_to_polylines, run_path  # noqa: E402
+from coverage_paths import distance_to_polylines, run_faces, run_path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 COVERED = 5e-3  # mm: a feasible position within this of a cut polyline is covered
@@ -134,7 +134,10 @@ def tasks_for(args) -> tuple[list[dict], list[dict]]:
     tasks, notes = [], []
     for f in files:
         pairs, problem = pairs_of(str(f))
-        notes.append({"part": f.name, "pairs": len(pairs), "problem": problem})
+        note = {"part": f.name, "pairs": len(pairs), "problem": problem}
+        if not pairs:  # what cadcnc itself makes of a file with nothing to judge
+            note["cadcnc_faces"] = run_faces(str(f), args.timeout)
+        notes.append(note)
         print(f"coverage: {f.name}: {len(pairs)} concave pairs"
               + (f" ({problem})" if problem else ""), file=sys.stderr, flush=True)
         for radius in args.radius:
@@ -174,9 +177,10 @@ def table(records: list[dict], notes: list[dict]) -> str:
     rows.append("")
     rows.append("runs not written, by reason: " + ", ".join(
         f"{k} {v}" for k, v in reasons.most_common()) if reasons else "every run wrote a path")
-    unread = [n for n in notes if n["problem"]]
-    for n in unread:
-        rows.append(f"{n['part']}: not judged ({n['problem']})")
+    for n in notes:
+        if n["problem"] or not n["pairs"]:
+            rows.append(f"{n['part']}: no pair judged ({n['problem'] or 'no concave edge'}); "
+                        f"`cadcnc faces`: {n.get('cadcnc_faces', '-')}")
     return "\n".join(rows)
 
 

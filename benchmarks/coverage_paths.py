@@ -92,6 +92,19 @@ def run_path(step: str, faces: tuple[int, int], radius: float, feed: float, peri
             "seconds": round(seconds, 2), "version": version, "polylines": polylines}
 
 
+def run_faces(step: str, timeout: float) -> str:
+    """What ``cadcnc faces --json`` makes of a file: "N concave pairs" or the refusal."""
+    try:
+        proc = subprocess.run([*cadcnc_command(), "faces", step, "--json"], capture_output=True,
+                              text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return "timeout"
+    outcome = classify(proc.returncode, proc.stderr)
+    if outcome != "written":
+        return outcome
+    return f"{len(json.loads(proc.stdout).get('concave_pairs', []))} concave pairs"
+
+
 def distance_to_polylines(points: np.ndarray, polylines: list[np.ndarray]) -> np.ndarray:
     """Distance (mm) from each of ``points`` (k, 3) to the nearest segment of the polylines."""
     best = np.full(len(points), np.inf)
