@@ -201,8 +201,11 @@ class Oracle:
         sa = BRepAdaptor_Surface(f.face)
         pt, su, sv = gp_Pnt(), gp_Vec(), gp_Vec()
         sa.D1(u, v, pt, su, sv)
-        d = perp[0] * np.array(su.Coord()) + perp[1] * np.array(sv.Coord())
-        d -= (d @ n) * n
+        su, sv = np.array(su.Coord()), np.array(sv.Coord())
+        d = perp[0] * su + perp[1] * sv
+        along = du * su + dv * sv  # the edge's tangent: (u, v) axes need not be orthogonal
+        along /= max(np.linalg.norm(along), 1e-300)
+        d -= (d @ n) * n + (d @ along) * along
         norm = np.linalg.norm(d)
         if norm == 0.0:
             return None

@@ -28,7 +28,10 @@ REASONS = [  # (reason, pattern in cadcnc's message), first match wins
     ("no solid in the file", re.compile(r"holds no solid")),
     ("tangent edge", re.compile(r"tangent edge")),
     ("not a concave pair for cadcnc", re.compile(r"meet along a|not adjacent|no concave edge")),
-    ("no start found", re.compile(r"start|tangency", re.I)),
+    ("curvature tighter than the ball at the start",
+     re.compile(r"stopped at the start point \(curvature\)")),
+    ("no start tangency found", re.compile(r"no cutter position touching both surfaces")),
+    ("other start failure", re.compile(r"start|tangency", re.I)),
 ]
 
 
