@@ -32,7 +32,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from coverage_oracle import TOL, Oracle, read_shape  # noqa: E402
-from coverage_paths import distance_to_polylines, run_faces, run_path  # noqa: E402
+from coverage_paths import classify, distance_to_polylines, run_faces, run_path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 COVERED = 5e-3  # mm: a feasible position within this of a cut polyline is covered
@@ -153,15 +153,15 @@ def table(records: list[dict], notes: list[dict]) -> str:
     """The per-part and total figures as a Markdown table, then refusals by reason."""
     rows = ["| part | R mm | pairs | covered / feasible | % | ball only: covered / feasible "
             "| % | paths written | silent-bad | crashes |", "|" + "---|" * 10]
-    reasons = collections.Counter()
+    reasons = collections.defaultdict(collections.Counter)
     groups = collections.defaultdict(list)
     for r in records:
         groups[(r["part"], r["radius"])].append(r)
         for run in r.get("runs", []):
             if run["outcome"] != "written":
-                reasons[run["outcome"]] += 1
+                reasons[r["radius"]][run["outcome"]] += 1
         if "error" in r:
-            reasons["judge error"] += 1
+            reasons[r["radius"]]["judge error"] += 1
     for radius in sorted({r["radius"] for r in records}):
         groups[("**total**", radius)] = [x for x in records if x["radius"] == radius]
     for (part, radius), rs in groups.items():
@@ -175,13 +175,26 @@ def table(records: list[dict], notes: list[dict]) -> str:
         rows.append(f"| {part} | {radius} | {len(rs)} | {c} / {f} | {pct(c, f)} | {cb} / {fb} "
                     f"| {pct(cb, fb)} | {written} / {len(runs)} | {bad} | {crashes} |")
     rows.append("")
-    rows.append("runs not written, by reason: " + ", ".join(
-        f"{k} {v}" for k, v in reasons.most_common()) if reasons else "every run wrote a path")
+    for radius, counts in sorted(reasons.items()):
+        rows.append(f"R {radius}: runs not written, by reason: "
+                    + ", ".join(f"{k} {v}" for k, v in counts.most_common()))
     for n in notes:
         if n["problem"] or not n["pairs"]:
             rows.append(f"{n['part']}: no pair judged ({n['problem'] or 'no concave edge'}); "
                         f"`cadcnc faces`: {n.get('cadcnc_faces', '-')}")
     return "\n".join(rows)
+
+
+def print_table(path: str) -> int:
+    """The table of an earlier run's records, refusal reasons re-read from the messages."""
+    with open(path) as fh:
+        data = json.load(fh)
+    for rec in data["records"]:
+        for run in rec.get("runs", []):
+            if run["outcome"] not in ("written", "crash", "timeout"):
+                run["outcome"] = classify(run["code"], run["message"])
+    print(table(data["records"], data["notes"]))
+    return 0
 
 
 def main(argv=None) -> int:
@@ -200,7 +213,11 @@ def main(argv=None) -> int:
                     help="written points judged per cut polyline at most (silent-bad)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--json", help="write per-pair records here")
+    ap.add_argument("--table", metavar="JSON", help="print the table of an earlier --json "
+                    "file instead of running (refusals re-read with today's reasons)")
     args = ap.parse_args(argv)
+    if args.table:
+        return print_table(args.table)
     args.radius = args.radius or [2.0]
     if not args.fixtures and not args.parts:
         args.fixtures = True
