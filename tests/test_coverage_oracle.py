@@ -1,0 +1,113 @@
+"""The coverage benchmark's judge (benchmarks/coverage_oracle.py) against closed forms.
+
+The judge decides which ball positions are feasible along concave edges; coverage figures
+are only as good as it is. On the pocket fixture the floor (z = 15) meets the planar wall
+x = -30: every feasible centre sits at R' from both planes, (-30 + R', y, 15 + R'). In the
+4 mm slot a 6 mm ball has no feasible position (the opposite wall is nearer than R').
+Planes and offsets come from fixtures/fixtures.json, not from this file.
+"""
+
+import importlib.util
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _load(name: str):
+    """A benchmarks/ module by file path: benchmarks/ is not put on sys.path, where its
+    coverage.py would shadow the ``coverage`` package that numba looks for."""
+    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+_oracle, _paths = _load("coverage_oracle"), _load("coverage_paths")
+Oracle, read_shape = _oracle.Oracle, _oracle.read_shape
+classify, cut_polylines = _paths.classify, _paths.cut_polylines
+distance_to_polylines = _paths.distance_to_polylines
+
+FACTS = json.loads((ROOT / "fixtures" / "fixtures.json").read_text())
+
+
+def _plane(fixture: str, role_start: str) -> tuple[int, np.ndarray, float]:
+    for n, f in FACTS[fixture]["faces"].items():
+        if f["role"].startswith(role_start):
+            return int(n), np.array(f["normal"]), f["offset"]
+    raise AssertionError(f"{fixture}: no face {role_start!r}")
+
+
+@pytest.fixture(scope="module")
+def pocket():
+    return Oracle(read_shape(str(ROOT / "fixtures" / "pocket.step")))
+
+
+@pytest.mark.parametrize("radius", [2.0, 5.0])
+def test_floor_wall_corner_centres_sit_at_r_from_both_planes(pocket, radius):
+    wall, n_wall, d_wall = _plane("pocket", "pocket planar wall x=-30")
+    floor, n_floor, d_floor = _plane("pocket", "pocket floor z=15")
+    (edge,) = [e for e in pocket.concave_edges() if e.faces == tuple(sorted((wall, floor)))]
+    assert abs(edge.angles - 270.0).max() < 1e-6
+    ts = pocket.samples(edge, cap=15)
+    assert len(ts) == 15
+    verdicts = [pocket.judge(edge, t, radius, 10 * radius) for t in ts]
+    assert {v["verdict"] for v in verdicts} == {"feasible"}
+    p = np.array([v["p"] for v in verdicts])
+    assert np.abs(p @ n_wall - d_wall - radius).max() < 1e-6
+    assert np.abs(p @ n_floor - d_floor - radius).max() < 1e-6
+    # the samples cover the edge: y from one end of the 24 mm straight wall to the other
+    assert np.ptp(p[:, 1]) == pytest.approx(edge.length, abs=1e-6)
+
+
+def test_a_slot_narrower_than_the_ball_has_no_feasible_position():
+    slot = Oracle(read_shape(str(ROOT / "fixtures" / "narrow_slot.step")))
+    floor, *_ = _plane("narrow_slot", "slot floor")
+    wall, *_ = _plane("narrow_slot", "slot wall y=-10")
+    other, *_ = _plane("narrow_slot", "slot wall y=-6")
+    (edge,) = [e for e in slot.concave_edges() if e.faces == tuple(sorted((wall, floor)))]
+    ts = slot.samples(edge, cap=9)
+    wide = [slot.judge(edge, t, 3.0, 30.0) for t in ts]   # 2R' = 6 > 4 mm
+    assert {v["verdict"] for v in wide} == {"nearer"}
+    # inside the slot the opposite wall is 1 mm away; at the slot's open ends the block's
+    # end face (its notch's edge) is equally near and may be named instead
+    assert {v["face"] for v in wide[1:-1]} == {other}
+    fits = [slot.judge(edge, t, 1.5, 15.0) for t in ts]   # 2R' = 3 < 4 mm
+    assert {v["verdict"] for v in fits} == {"feasible"}
+
+
+def test_coverage_distance_and_formats():
+    line = np.array([[0.0, 0, 0], [10, 0, 0]])
+    pts = np.array([[5.0, 0.004, 0], [5.0, 0, 0.006], [-1.0, 0, 0]])
+    assert np.allclose(distance_to_polylines(pts, [line]), [0.004, 0.006, 1.0])
+    v2 = {"format": "cadcnc-program", "version": 2,
+          "segments": [{"kind": "cut", "points": line.tolist()},
+                       {"kind": "link", "points": [[0, 0, 50]]},
+                       {"kind": "cut", "points": [[1, 1, 1], [2, 2, 2]]}]}
+    assert [len(x) for x in cut_polylines(v2)] == [2, 2]
+    assert [len(x) for x in cut_polylines({"version": 1, "points": line.tolist()})] == [2]
+    assert classify(1, "Traceback (most recent call last):\n ...") == "crash"
+    assert classify(3, "cadcnc: error: x.step: holds no solid") == "no solid in the file"
+    assert classify(None, "") == "timeout"
+
+
+@pytest.mark.parametrize("fixture", ["bspline_boss", "dome_pole"])
+def test_edge_angles_agree_with_the_fixture_sidecar(fixture):
+    """The judge's material angles (interior samples) lie in the sidecar's sampled range,
+    B-spline faces (non-orthogonal parameters) included."""
+    judge = Oracle(read_shape(str(ROOT / "fixtures" / f"{fixture}.step")))
+    by_index = {e.index: e for e in judge.edges}
+    checked = 0
+    for pair in FACTS[fixture]["pairs"]:
+        for e in pair["edges"]:
+            lo, hi = e["material_angle_deg"]
+            angles = by_index[e["edge"]].angles
+            assert lo - 1e-3 <= angles.min() and angles.max() <= hi + 1e-3, (pair["faces"], e)
+            assert by_index[e["edge"]].concave == (e["class"] == "concave")
+            checked += 1
+    assert checked >= 10
