@@ -91,13 +91,27 @@ def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000, progress=Non
                              f"is no edge {op.edge + 1}")
         found = [found[op.edge]]
     refuse_without_stretch(s1, s2, found)
+    cuts, skipped = stretch_cuts(s1, s2, job, found, guard, max_cycles, progress)
+    if op.stretch is not None and not cuts:
+        n = max(len(e.stretches) for e in found)
+        raise InputError(f"faces {i} and {j}: there is no stretch {op.stretch} (the edges "
+                         f"have at most {n})")
+    return Program(job, linked(cuts, safe_height(part, job)), skipped)
+
+
+def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
+                 progress=None) -> tuple[list[CutSegment], list[Skipped]]:
+    """A cut per stretch of ``found`` (every stretch, or stretch ``job.operation.stretch``
+    of each edge), in order along each edge, and what was skipped: edges with no feasible
+    position, and the rest of a stretch whose cut stopped short of its end."""
+    i, j = s1.number, s2.number
     cuts, skipped = [], []
     for e in found:
         if not e.stretches:
             skipped.append(Skipped((i, j), NO_STRETCH, e.refusal, e.edge + 1))
             continue
         for k, st in enumerate(e.stretches, 1):
-            if op.stretch is not None and k != op.stretch:
+            if job.operation.stretch is not None and k != job.operation.stretch:
                 continue
             cjob = _cut_job(job, st, k)
             plan = replace(plan_for_stretch(s1, s2, cjob, st), job=cjob)
@@ -109,11 +123,7 @@ def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000, progress=Non
                     f"stretch {k} of edge {e.edge + 1}: {tp.partial_reason}; the rest of "
                     f"the stretch ({tp.length:.3f} of {st.length:.3f} mm cut) is not cut"),
                     e.edge + 1))
-    if op.stretch is not None and not cuts:
-        n = max(len(e.stretches) for e in found)
-        raise InputError(f"faces {i} and {j}: there is no stretch {op.stretch} (the edges "
-                         f"have at most {n})")
-    return Program(job, linked(cuts, safe_height(part, job)), skipped)
+    return cuts, skipped
 
 
 def _from_start(part, job, s1, s2, guard, max_cycles, progress) -> Program:
