@@ -1,4 +1,4 @@
-"""The pencil operation's corners: every inner corner of a part a ball of offset R' could clean.
+"""The pencil operation's corners: every inner corner of a part a ball of offset R' cleans.
 
 Two kinds (docs/pencil.md, "Corners found"):
 
@@ -158,8 +158,7 @@ def _blend_corners(part: Part, blends: dict[int, Blend], tight: set[int],
     for n, b in concave.items():
         radius = f"blend radius {b.r_max:.4g} mm"
         if b.umbilic:
-            reason = (BLEND_ROLLS, f"{radius} >= R' {rp:.4g} mm: the ball rolls on it, no "
-                      "pencil corner") if b.r_min >= rolls else (
+            reason = (BLEND_ROLLS, _rolls(b.r_max, rp)) if b.r_min >= rolls else (
                 VERTEX_BLEND, f"vertex blend of radius {b.r_max:.4g} mm < R': the ball "
                 "touches the faces around it, no corner of its own")
             out.append(_blend_record(b, tuple(sorted({m for m, _ in b.ends}))[:2], *reason))
@@ -188,13 +187,17 @@ def _blend_corners(part: Part, blends: dict[int, Blend], tight: set[int],
     return out
 
 
+def _rolls(r: float, rp: float) -> str:
+    return f"blend radius {r:.4g} mm >= R' {rp:.4g} mm: the ball rolls on it, no pencil corner"
+
+
 def _rolled_record(blends: dict[int, Blend], group: list[int], pair: tuple[int, int],
                    rp: float, rolls: float) -> Corner:
     """The skipped record of blend faces (one chain) not smaller than the ball."""
     lo = min(blends[n].r_min for n in group)
     hi = max(blends[n].r_max for n in group)
     if lo >= rolls:
-        detail = f"blend radius {hi:.4g} mm >= R' {rp:.4g} mm: the ball rolls on it, no pencil corner"
+        detail = _rolls(hi, rp)
     else:
         detail = (f"blend radius {lo:.4g}..{hi:.4g} mm straddles R' {rp:.4g} mm: not "
                   "handled as a corner")
