@@ -33,6 +33,7 @@ TANGENT_FACES, MIXED_EDGE, BLEND_ROLLS = "tangent", "mixed", "blend_rolls"
 NO_FIT, VERTEX_BLEND, BLEND_RAILS, NOT_SELECTED = ("no_fit", "vertex_blend", "blend_rails",
                                                    "not_selected")
 SAME_POINT = 1e-4  # mm: rail end points closer than this are one vertex
+SEED_ITERATIONS = 4  # tangent-plane solves of a blend seed (curved faces a, b)
 ROLLS = 1e-9      # relative: a blend of radius >= R' (1 - ROLLS) is one the ball rolls on
 
 
@@ -269,15 +270,29 @@ def _group_corner(part: Part, blends: dict[int, Blend], group: list[int],
 
 def _seed(part: Part, a: int, pa: np.ndarray, b: int, pb: np.ndarray,
           rp: float) -> np.ndarray:
-    """Ball centre (3,) mm at distance R' from the tangent planes of a at pa and b at pb,
-    in the cross-section through the two points."""
+    """Ball centre (3,) mm at distance R' from faces a and b, in the cross-section through
+    pa (on a) and pb (on b): solved on the tangent planes at the contacts, which are then
+    moved to the feet of the centre on each surface (SEED_ITERATIONS times; exact at once
+    on planes)."""
     fa, fb = part.face(a), part.face(b)
-    na = fa.normal(*fa.project(pa)[:2])
-    nb = fb.normal(*fb.project(pb)[:2])
-    t = np.cross(na, nb)
-    if np.linalg.norm(t) < part.tol.tangent_sin:
-        raise ValueError(f"faces {a} and {b} are parallel across it (the ball does not fit)")
-    t /= np.linalg.norm(t)
-    m = np.array([na, nb, t])
-    rhs = np.array([na @ pa + rp, nb @ pb + rp, t @ (pa + pb) / 2])
-    return np.linalg.solve(m, rhs)
+    qa, qb = np.asarray(pa, float), np.asarray(pb, float)
+    ua, ub = fa.project(qa)[:2], fb.project(qb)[:2]
+    t = None
+    x = None
+    for _ in range(SEED_ITERATIONS):
+        na, nb = fa.normal(*ua), fb.normal(*ub)
+        qa, qb = fa.point(*ua), fb.point(*ub)
+        if t is None:
+            t = np.cross(na, nb)
+            if np.linalg.norm(t) < part.tol.tangent_sin:
+                raise ValueError(f"faces {a} and {b} are parallel across it (the ball does "
+                                 "not fit)")
+            t /= np.linalg.norm(t)
+            mid = t @ (qa + qb) / 2
+        x = np.linalg.solve(np.array([na, nb, t]), np.array([na @ qa + rp, nb @ qb + rp, mid]))
+        try:  # feet of the centre on each surface (none on a cylinder's axis: keep x)
+            ua = fa.project(x, within_face_box=False)[:2]
+            ub = fb.project(x, within_face_box=False)[:2]
+        except GeometryError:
+            break
+    return x
