@@ -84,3 +84,15 @@ def test_skipped_blend_names_its_radius_and_the_ball():
     part = part_of("fillet_pocket")
     rolls = [c for c in find_corners(part, 3.0) if c.skip == "blend_rolls"]
     assert rolls and all("5 mm >= R' 3 mm" in c.detail for c in rolls)
+
+
+@pytest.mark.parametrize("name,rp", [c for c in CASES if c[1] != "1.0"])
+def test_every_seed_is_r_prime_from_both_surfaces(name, rp):
+    """Independent of the sidecar: OCCT's projection puts each seed R' from faces a, b."""
+    part = part_of(name)
+    seeds = [(c, s) for c in find_corners(part, float(rp)) if c.kind == BLEND and c.cut
+             for s in c.seeds]
+    for c, s in seeds:
+        for n in c.faces:
+            assert part.face(n).project(s, within_face_box=False)[2] == \
+                pytest.approx(float(rp), abs=1e-9), (c.faces, n, s)

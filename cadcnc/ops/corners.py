@@ -289,7 +289,11 @@ def _seed(part: Part, a: int, pa: np.ndarray, b: int, pb: np.ndarray,
                                  "not fit)")
             t /= np.linalg.norm(t)
             mid = t @ (qa + qb) / 2
-        x = np.linalg.solve(np.array([na, nb, t]), np.array([na @ qa + rp, nb @ qb + rp, mid]))
+        new = np.linalg.solve(np.array([na, nb, t]), np.array([na @ qa + rp, nb @ qb + rp,
+                                                               mid]))
+        if x is not None and not np.linalg.norm(new - x) < rp:
+            break  # the feet jumped (another branch of a surface): keep the last centre
+        x = new
         try:  # feet of the centre on each surface (none on a cylinder's axis: keep x)
             ua = fa.project(x, within_face_box=False)[:2]
             ub = fb.project(x, within_face_box=False)[:2]
