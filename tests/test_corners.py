@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
 
 import cadcnc
 from cadcnc.errors import FaceNumberError
@@ -96,3 +97,23 @@ def test_every_seed_is_r_prime_from_both_surfaces(name, rp):
         for n in c.faces:
             assert part.face(n).project(s, within_face_box=False)[2] == \
                 pytest.approx(float(rp), abs=1e-9), (c.faces, n, s)
+
+
+@pytest.mark.parametrize("rp", SIDECAR["fillet_pocket"]["corners_by_offset"])
+def test_blends_found_by_curvature_on_bspline_faces(rp):
+    """The fillet pocket with every face converted to a B-spline (same topology): the same
+    corners, skips and seeds, so blends are found by curvature, not by surface type."""
+    analytic = part_of("fillet_pocket")
+    if "nurbs" not in _parts:
+        _parts["nurbs"] = cadcnc.Part(BRepBuilderAPI_NurbsConvert(analytic.shape, True).Shape())
+    nurbs = _parts["nurbs"]
+    assert {f.kind for f in nurbs.faces} == {"bspline"}
+    a, b = find_corners(analytic, float(rp)), find_corners(nurbs, float(rp))
+    assert [(c.kind, c.faces, c.blend_faces, c.skip) for c in a] == \
+        [(c.kind, c.faces, c.blend_faces, c.skip) for c in b]
+    assert sum(c.cut for c in b) == sum(e["skip"] is None for e in
+                                        SIDECAR["fillet_pocket"]["corners_by_offset"][rp])
+    for ca, cb in zip(a, b):
+        if ca.cut and ca.kind == BLEND:
+            assert np.abs(np.array(ca.seeds) - np.array(cb.seeds)).max() < 1e-6
+            assert cb.radius == pytest.approx(ca.radius, rel=1e-3)
