@@ -117,3 +117,26 @@ def test_blends_found_by_curvature_on_bspline_faces(rp):
         if ca.cut and ca.kind == BLEND:
             assert np.abs(np.array(ca.seeds) - np.array(cb.seeds)).max() < 1e-6
             assert cb.radius == pytest.approx(ca.radius, rel=1e-3)
+
+
+BASE = json.loads((FIX / "fixtures.json").read_text())
+
+
+@pytest.mark.parametrize("name", sorted(BASE))
+def test_edge_corners_are_the_concave_edges_of_the_base_fixtures(name):
+    """A tiny ball (R' 0.01 mm, nothing tighter) finds one edge corner per concave edge that
+    fixtures/build_fixtures.py classified independently (11 samples, ends included)."""
+    part = cadcnc.load_step(FIX / BASE[name]["file"])
+    want = {}
+    for p in BASE[name]["pairs"]:
+        inside = p.get("interior_class") if p.get("end_class") == "tangent" else None
+        # concave inside and tangent only at its ends counts as concave (conventions.md)
+        n = sum(e["class"] == "concave" or (e["class"] == "mixed" and inside == "concave")
+                for e in p["edges"])
+        if n:
+            want[tuple(sorted(p["faces"]))] = n
+    got = {}
+    for c in find_corners(part, 0.01):
+        if c.kind == EDGE and c.skip is None:
+            got[c.faces] = got.get(c.faces, 0) + 1
+    assert got == want
