@@ -23,7 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import GeometryError
-from ..geometry.blends import Blend, face_curvatures, find_blends
+from ..geometry.blends import Blend, find_blends
 from ..geometry.part import CONCAVE, MIXED, TANGENT, Part
 from ..job import Tool
 from ..program.program import Skipped
@@ -84,7 +84,8 @@ def find_corners(part: Part, radius: float, allowance: float = 0.0,
     """
     rp = Tool(radius, allowance).offset
     blends, kranges = find_blends(part)
-    tight = {n for n, (klo, _) in kranges.items() if klo * rp >= 1.0}
+    # faces concave tighter than the ball at every sample: {face: least k_max, 1/mm}
+    tight = {n: klo for n, (klo, _) in kranges.items() if klo * rp >= 1.0}
     corners = _blend_corners(part, blends, tight, rp)
     corners += _edge_corners(part, blends, tight, rp)
     if faces is not None:
@@ -97,7 +98,7 @@ def find_corners(part: Part, radius: float, allowance: float = 0.0,
     return sorted(corners, key=Corner.sort_key)
 
 
-def _edge_corners(part: Part, blends: dict[int, Blend], tight: set[int],
+def _edge_corners(part: Part, blends: dict[int, Blend], tight: dict[int, float],
                   rp: float) -> list[Corner]:
     """Concave edges (cut unless a face is tighter than the ball), mixed and tangent edges
     not belonging to a blend (skipped)."""
@@ -109,7 +110,7 @@ def _edge_corners(part: Part, blends: dict[int, Blend], tight: set[int],
             c = Corner(EDGE, (i, j), edge=k, length=float(e.length), closed=e.closed)
             small = [n for n in (i, j) if n in tight]
             if small:
-                r = 1.0 / _kmin_of(part, small[0], blends)
+                r = 1.0 / tight[small[0]]
                 c = replace(c, skip=NO_FIT, detail=(
                     f"face {small[0]} is concave tighter than the ball everywhere (radius "
                     f"<= {r:.4g} mm < R' {rp:.4g} mm): the ball cannot touch it"))
@@ -127,14 +128,6 @@ def _edge_corners(part: Part, blends: dict[int, Blend], tight: set[int],
     return out
 
 
-def _kmin_of(part: Part, n: int, blends: dict[int, Blend]) -> float:
-    """1 / (largest radius) of a tight face, 1/mm."""
-    b = blends.get(n)
-    if b is not None:
-        return 1.0 / b.r_max
-    return float(face_curvatures(part, n)[0].min())
-
-
 def _outer(blends: dict[int, Blend], small: set[int], n: int, seen: set[int]) -> set[int]:
     """Faces reached across the rails of small blend n, walking through small blends."""
     seen.add(n)
@@ -149,7 +142,7 @@ def _outer(blends: dict[int, Blend], small: set[int], n: int, seen: set[int]) ->
     return out
 
 
-def _blend_corners(part: Part, blends: dict[int, Blend], tight: set[int],
+def _blend_corners(part: Part, blends: dict[int, Blend], tight: dict[int, float],
                    rp: float) -> list[Corner]:
     """Concave blends: corners of the faces across them (r < R'), or skipped."""
     concave = {n: b for n, b in blends.items() if b.concave}
