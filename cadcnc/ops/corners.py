@@ -129,7 +129,8 @@ def _edge_corners(part: Part, blends: dict[int, Blend], tight: dict[int, float],
 
 
 def _outer(blends: dict[int, Blend], small: set[int], n: int, seen: set[int]) -> set[int]:
-    """Faces reached across the rails of small blend n, walking through small blends."""
+    """Faces reached across the rails of blend n, walking through the blends in ``small``
+    (the blends of its own class: smaller than the ball, or not)."""
     seen.add(n)
     out: set[int] = set()
     for m, _ in blends[n].rails:
@@ -158,7 +159,8 @@ def _blend_corners(part: Part, blends: dict[int, Blend], tight: dict[int, float]
             out.append(_blend_record(b, tuple(sorted({m for m, _ in b.ends}))[:2], *reason))
             continue
         if n not in small:
-            rails = tuple(sorted({m for m, _ in b.rails}))[:2]
+            big = set(concave) - small
+            rails = tuple(sorted(_outer(concave, big, n, set())))[:2]
             rolled[n] = _pair(*(rails + (n,) * (2 - len(rails))))
             continue
         outer = _outer(concave, small, n, set())
