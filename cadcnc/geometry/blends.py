@@ -3,9 +3,9 @@
 A face is a *concave blend* of radius r when, at every sample of a grid over its
 parameter box, its largest principal curvature is concave, k_max ~ 1/r > 0 (curvature
 sign of docs/conventions.md: k > 0 bends towards the cutter), the spread of 1/k_max
-over the samples is within ``RADIUS_SPREAD`` of r, and at least two of its edges are
-tangent *rails*: edges running along the blend's spine (across the cross-section, whose
-direction is the k_max principal direction). Tangent edges along the cross-section are its
+over the samples is within ``RADIUS_SPREAD`` of r, and its tangent *rails* reach two
+faces or more: edges running along the blend's spine (across the cross-section, whose
+direction is the k_max principal direction; a hole's wall in two halves is no blend). Tangent edges along the cross-section are its
 *ends*. Convex rounds (k_min ~ -1/r) are found the same way so that their tangent rails
 are not mistaken for corners. Planes are never blends. Lengths mm, curvatures 1/mm.
 """
@@ -110,9 +110,10 @@ def find_blend(part: Part, n: int, kmax: np.ndarray, kmin: np.ndarray) -> Blend 
             except GeometryError:
                 continue
             (blend.rails if abs(tangent @ cross) < RAIL_COS else blend.ends).append((m, e))
-    # a concave blend needs two rails; a convex round one (its other side may be a
-    # concave edge, as a rounded hole mouth)
-    if len(blend.rails) < (2 if blend.concave else 1) and not blend.umbilic:
+    # a concave blend needs rails to two faces; a convex round one (its other side may be
+    # a concave edge, as a rounded hole mouth) to one
+    # (rails to one face only: half of a hole split in two, not a blend)
+    if len({m for m, _ in blend.rails}) < (2 if blend.concave else 1) and not blend.umbilic:
         return None
     return blend
 

@@ -161,11 +161,14 @@ def _blend_corners(part: Part, blends: dict[int, Blend], tight: dict[int, float]
         if n not in small:
             big = set(concave) - small
             rails = tuple(sorted(_outer(concave, big, n, set())))[:2]
-            rolled[n] = _pair(*(rails + (n,) * (2 - len(rails))))
+            if rails:  # none: a hole's wall in pieces, closed on itself (not a corner)
+                rolled[n] = _pair(*(rails + (n,) * (2 - len(rails))))
             continue
         outer = _outer(concave, small, n, set())
+        if not outer:
+            continue  # a hole's wall in pieces (its edges with a floor are edge corners)
         if len(outer) != 2:
-            out.append(_blend_record(b, tuple(sorted(outer))[:2] or (n, n), BLEND_RAILS,
+            out.append(_blend_record(b, tuple(sorted(outer))[:2], BLEND_RAILS,
                                      f"{radius} < R' with rails reaching faces "
                                      f"{sorted(outer)}: not two faces, not handled"))
             continue
