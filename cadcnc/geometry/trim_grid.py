@@ -46,6 +46,7 @@ from OCP.TopAbs import (TopAbs_FORWARD, TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
+from .trim_cells import mark, regions
 from ..trim import BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE
 
 _CONFUSION = 1e-7  # OCCT Precision::Confusion(), mm
@@ -66,6 +67,56 @@ def _fleche(seq: list, fu: float, fv: float) -> tuple[float, float]:
     dx, dy = (cx - ax) / n, (cy - ay) / n
     t = (bx - ax) * dx + (by - ay) * dy
     return max(fu, abs(ax + t * dx - bx)), max(fv, abs(ay + t * dy - by))
+
+
+def _distance(a: tuple, b: tuple) -> float:
+    """gp_Pnt::Distance's arithmetic (squares summed in x, y, z order)."""
+    d = 0.0
+    for x, y in zip(a, b):
+        d += (x - y) * (x - y)
+    return math.sqrt(d)
+
+
+def _keep_distinct(seq: list, pts: list, us: list, du: float, c3, last3d):
+    """Append to ``seq`` the samples FClass2d keeps: a point repeating the last kept one in
+    3-D is dropped unless the half-step point differs; returns the last kept 3-D point.
+    Vectorised when no two successive points are that close (then every point is kept)."""
+    p3 = [c3.Value(t).Coord() for t in us]
+    if not p3:
+        return last3d
+    a = np.array(p3 if last3d is None else [last3d] + p3)
+    d = a[1:] - a[:-1]
+    if len(d) == 0 or (d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2]).min() >= \
+            _CONFUSION * _CONFUSION * (1.0 + 1e-9):
+        seq += pts
+        return p3[-1]
+    for (x, y), t, q in zip(pts, us, p3):
+        real = True
+        if len(seq) > 1 and last3d is not None and _distance(q, last3d) < _CONFUSION:
+            real = _distance(q, c3.Value(t - du / 2.0).Coord()) >= _CONFUSION
+        if real:
+            seq.append((x, y))
+            last3d = q
+    return last3d
+
+
+def _fleches(seq: list, before: int, fu: float, fv: float) -> tuple[float, float]:
+    """``_fleche`` over every point appended after ``before`` (from the fifth one on) whose
+    triple's ends differ, as FClass2d checks after each sample; vectorised."""
+    if len(seq) <= before + 4:
+        return fu, fv
+    a = np.asarray(seq[before + 2:], dtype=float)
+    pa, pb, pc = a[:-2], a[1:-1], a[2:]
+    use = np.any(pa != pc, axis=1)
+    pa, pb, pc = pa[use], pb[use], pc[use]
+    n = np.hypot(pc[:, 0] - pa[:, 0], pc[:, 1] - pa[:, 1])
+    pa, pb, pc, n = pa[n > 0], pb[n > 0], pc[n > 0], n[n > 0]
+    if not len(n):
+        return fu, fv
+    d = (pc - pa) / n[:, None]
+    t = (pb[:, 0] - pa[:, 0]) * d[:, 0] + (pb[:, 1] - pa[:, 1]) * d[:, 1]
+    return (max(fu, float(np.abs(pa[:, 0] + t * d[:, 0] - pb[:, 0]).max())),
+            max(fv, float(np.abs(pa[:, 1] + t * d[:, 1] - pb[:, 1]).max())))
 
 
 def _is_degenerated(c3: BRepAdaptor_Curve, first: float, last: float) -> bool:
@@ -124,21 +175,20 @@ def _sample(wire, face, box: list, defl: float = 0.0) -> tuple[list, float, floa
         nbs = nbs * 4 if nbs > 2 else nbs
         du = (pl - pf) / (nbs - 1) * (1.0 if orient == TopAbs_FORWARD else -1.0)
         u = (pf if orient == TopAbs_FORWARD else pl) + (du if first_point == 2 else 0.0)
-        before = len(seq)
-        for _ in range(first_point, nbs + 1):
-            x, y = c2.Value(u).Coord()
-            box[:] = min(box[0], x), max(box[1], x), min(box[2], y), max(box[3], y)
-            real = True
-            if not degenerated:  # skip points that repeat the last one in 3-D
-                p3 = c3.Value(u)
-                if len(seq) > 1 and last3d is not None and p3.Distance(last3d) < _CONFUSION:
-                    real = p3.Distance(c3.Value(u - du / 2.0)) >= _CONFUSION
-                last3d = p3 if real else last3d
-            if real:
-                seq.append((x, y))
+        us = []
+        for _ in range(first_point, nbs + 1):  # the same running sum as FClass2d's
+            us.append(u)
             u += du
-            if len(seq) > before + 4 and seq[-3] != seq[-1]:
-                fu, fv = _fleche(seq, fu, fv)
+        pts = [c2.Value(t).Coord() for t in us]
+        if pts:
+            xs, ys = zip(*pts)
+            box[:] = min(box[0], *xs), max(box[1], *xs), min(box[2], *ys), max(box[3], *ys)
+        before = len(seq)
+        if degenerated:
+            seq += pts
+        else:
+            last3d = _keep_distinct(seq, pts, us, du, c3, last3d)
+        fu, fv = _fleches(seq, before, fu, fv)
         first_point = 2
     return seq, fu, fv, walked
 
@@ -236,26 +286,6 @@ def _layout(lo, hi, p, q, face_surface, max_cells: int, target: float) -> tuple[
         cell = [x * 1.25 for x in cell]
 
 
-def _mark(mask: np.ndarray, p, q, h, origin, size, eps) -> None:
-    """Set every cell of ``mask`` (nu, nw) that a segment's band (box-inflated) touches: the
-    inflated bounding boxes of pieces no longer than a cell, summed in a difference array."""
-    shape = np.array(mask.shape)
-    steps = np.maximum(np.ceil(np.max(np.abs(q - p) / size, axis=1)), 1).astype(np.int64)
-    seg = np.repeat(np.arange(len(p)), steps)
-    k = (np.arange(len(seg)) - np.repeat(np.cumsum(steps) - steps, steps))[:, None]
-    a = p[seg] + k / steps[seg, None] * (q[seg] - p[seg])
-    b = p[seg] + (k + 1) / steps[seg, None] * (q[seg] - p[seg])
-    i0 = np.floor((np.minimum(a, b) - h[seg] - eps - origin) / size)
-    i1 = np.floor((np.maximum(a, b) + h[seg] + eps - origin) / size)
-    keep = np.all((i1 >= 0) & (i0 < shape), axis=1)
-    i0 = np.clip(i0[keep], 0, shape - 1).astype(np.int64)
-    i1 = np.clip(i1[keep], 0, shape - 1).astype(np.int64) + 1
-    acc = np.zeros(shape + 1, dtype=np.int32)
-    for (r, c), sign in (((i0, i0), 1), ((i0, i1), -1), ((i1, i0), -1), ((i1, i1), 1)):
-        np.add.at(acc, (r[:, 0], c[:, 1]), sign)
-    mask |= acc.cumsum(0).cumsum(1)[:-1, :-1] > 0
-
-
 def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
     """(origin (2,), cell size (2,), free (nu, nw) bool, windows): the layout, and the cells
     that no band, nor its copies whole periods away, nor the wrap's seam touches."""
@@ -268,37 +298,16 @@ def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
     shifts = [[k * t for k in range(math.ceil((o - b) / t) - 1,
                                     math.floor((o + n * s - a) / t) + 2)] if t else [0.0]
               for a, b, o, s, n, (_, t, _) in zip(lo, hi, origin, size, shape, windows)]
-    mask = np.zeros(shape, dtype=bool)
-    for shift in product(*shifts):
-        _mark(mask, p + shift, q + shift, h, origin, size, eps)
+    mask = np.zeros(shape, dtype=np.uint8)
+    moved = np.array(list(product(*shifts)))[:, None, :]  # every copy in one pass
+    mark(mask, (p + moved).reshape(-1, 2), (q + moved).reshape(-1, 2),
+         np.tile(h, (len(moved), 1)), origin, size, eps)
     for k, (_, _, seam) in enumerate(windows):
         if seam is not None:  # a line across the grid
             a, b = origin - size, origin + (shape + 1) * size
             a[k] = b[k] = seam
-            _mark(mask, a[None], b[None], np.zeros((1, 2)), origin, size, eps)
-    return origin, size, ~mask, windows
-
-
-def _regions(free: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Runs of free cells along w, (row, start, stop), and each run's 4-connected region."""
-    d = np.diff(np.pad(free.astype(np.int8), ((0, 0), (1, 1))), axis=1)
-    (row, start), stop = np.nonzero(d == 1), np.nonzero(d == -1)[1]
-    parent = list(range(len(row)))
-
-    def root(x: int) -> int:
-        while parent[x] != x:
-            parent[x] = x = parent[parent[x]]
-        return x
-
-    first = np.searchsorted(row, np.arange(free.shape[0] + 1)).tolist()
-    s, e = start.tolist(), stop.tolist()
-    for r in range(free.shape[0] - 1):  # merge overlapping runs of neighbouring rows
-        a, b, a_end, b_end = first[r], first[r + 1], first[r + 1], first[r + 2]
-        while a < a_end and b < b_end:
-            if s[a] < e[b] and s[b] < e[a]:
-                parent[root(a)] = root(b)
-            a, b = (a + 1, b) if e[a] < e[b] else (a, b + 1)
-    return row, start, stop, np.array([root(x) for x in range(len(row))], dtype=np.int64)
+            mark(mask, a[None], b[None], np.zeros((1, 2)), origin, size, eps)
+    return origin, size, mask == 0, windows
 
 
 _STATE_CODE = {TopAbs_IN: CELL_INSIDE, TopAbs_OUT: CELL_OUTSIDE}
@@ -346,25 +355,19 @@ class TrimGrid:
 
     def _label_regions(self, free: np.ndarray, checks: int) -> None:
         """One exact call per 4-connected region of free cells (plus confirmations)."""
-        row, start, stop, region = _regions(free)
-        if not len(row):
+        region, picks = regions(np.ascontiguousarray(~free, dtype=np.uint8))
+        if not len(picks):
             return
-        order = np.argsort(region, kind="stable")
-        code = np.empty(len(row), dtype=np.int8)
-        groups = np.split(order, np.flatnonzero(np.diff(region[order])) + 1)
-        for runs in groups:
-            picks = [runs[0], runs[len(runs) // 2], runs[-1]][:max(1, checks)]
+        code = np.empty(len(picks), dtype=np.int8)
+        for r, cells in enumerate(picks.tolist()):
             states = {_STATE_CODE.get(self._fc.Perform(gp_Pnt2d(*self.face.wrap(
-                self.u0 + (row[r] + 0.5) * self.du,
-                self.w0 + ((start[r] + stop[r] - 1) // 2 + 0.5) * self.dw))), CELL_MIXED)
-                for r in picks}
-            code[runs] = label = states.pop() if len(states) == 1 else CELL_MIXED
+                self.u0 + (c // self.nw + 0.5) * self.du,
+                self.w0 + (c % self.nw + 0.5) * self.dw))), CELL_MIXED)
+                for c in cells[:max(1, checks)]}
+            code[r] = label = states.pop() if len(states) == 1 else CELL_MIXED
             self.stats["suspect"] += label == CELL_MIXED
-        self.stats.update(regions=len(groups), calls=len(groups) * len(picks))
-        lengths = stop - start
-        offset = np.repeat(np.cumsum(lengths) - lengths, lengths)
-        flat = np.arange(lengths.sum()) - offset + np.repeat(row * self.nw + start, lengths)
-        self.labels.flat[flat] = np.repeat(code, lengths)
+        self.stats.update(regions=len(picks), calls=len(picks) * min(max(1, checks), 3))
+        self.labels[region >= 0] = code[region[region >= 0]]
         self._flat = self.labels.tobytes()
 
     def to_window(self, u: float, w: float) -> tuple[float, float]:
