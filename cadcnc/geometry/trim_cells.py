@@ -88,3 +88,146 @@ def regions(mask: np.ndarray) -> tuple:
                 picks[r, 1] = c
             seen[r] += 1
     return region, picks
+
+
+@_jit
+def _touches(p0: float, p1: float, q0: float, q1: float, a0: float, a1: float,
+             b0: float, b1: float) -> bool:
+    """Whether segment (p0, p1) -> (q0, q1) meets the closed box [a0, b0] x [a1, b1]
+    (Liang-Barsky clipping)."""
+    t0, t1 = 0.0, 1.0
+    for d0, lo, hi in ((q0 - p0, a0 - p0, b0 - p0), (q1 - p1, a1 - p1, b1 - p1)):
+        if d0 == 0.0:
+            if lo > 0.0 or hi < 0.0:
+                return False
+        else:
+            ta, tb = lo / d0, hi / d0
+            if ta > tb:
+                ta, tb = tb, ta
+            t0, t1 = max(t0, ta), min(t1, tb)
+            if t0 > t1:
+                return False
+    return True
+
+
+@_jit
+def refine(mask: np.ndarray, labels: np.ndarray, p: np.ndarray, q: np.ndarray,
+           h: np.ndarray, origin: np.ndarray, size: np.ndarray, eps: np.ndarray,
+           budget: int, square: int) -> tuple:
+    """Sub-cells for the marked cells: (codes (nu, nw) int64, fine (m,) int64, unresolved).
+
+    Each marked cell gets Ru x Rw <= ``budget`` sub-cells shaped by the bands' variation in
+    it (a band along u or w, such as a seam, gets thin strips across it), at most ``square``
+    where neither shape is a strip; a sub-cell is marked if a segment's band (the
+    segment met by the sub-cell inflated by h + eps: FClass2d's ON test) touches it. Free
+    sub-cells connected inside the cell take the label of the free (labelled) cells beside
+    them, if those agree; else they stay CELL_MIXED (``unresolved`` counts them). ``codes``
+    is ``labels`` with 3 + offset on marked cells; ``fine[offset:]`` holds Ru, Rw and the
+    Ru x Rw labels (row-major).
+    """
+    nu, nw = mask.shape
+    var = np.zeros((nu, nw, 2))
+    for s in range(p.shape[0]):   # the bands' variation per cell (shape heuristic)
+        i0 = max(int(math.floor((min(p[s, 0], q[s, 0]) - h[s, 0] - origin[0]) / size[0])), 0)
+        i1 = min(int(math.floor((max(p[s, 0], q[s, 0]) + h[s, 0] - origin[0]) / size[0])), nu - 1)
+        j0 = max(int(math.floor((min(p[s, 1], q[s, 1]) - h[s, 1] - origin[1]) / size[1])), 0)
+        j1 = min(int(math.floor((max(p[s, 1], q[s, 1]) + h[s, 1] - origin[1]) / size[1])), nw - 1)
+        n = max((i1 - i0 + 1) * (j1 - j0 + 1), 1)
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                var[i, j, 0] += abs(q[s, 0] - p[s, 0]) / size[0] / n
+                var[i, j, 1] += abs(q[s, 1] - p[s, 1]) / size[1] / n
+    codes = labels.astype(np.int64)
+    shape = np.zeros((nu, nw, 2), np.int64)
+    total = 0
+    for i in range(nu):
+        for j in range(nw):
+            if mask[i, j]:
+                ratio = (var[i, j, 1] + 1e-3) / (var[i, j, 0] + 1e-3)
+                n = budget
+                ru = min(max(int(round(math.sqrt(n * ratio))), 1), n)
+                if 1 < ru < n:  # not a strip: a band across the cell, fewer sub-cells
+                    n = square
+                    ru = min(max(int(round(math.sqrt(n * ratio))), 1), n)
+                shape[i, j, 0], shape[i, j, 1] = ru, max(n // ru, 1)
+                codes[i, j] = 3 + total
+                total += 2 + shape[i, j, 0] * shape[i, j, 1]
+    fine = np.zeros(total, np.int64)
+    for i in range(nu):
+        for j in range(nw):
+            if mask[i, j]:
+                fine[codes[i, j] - 3] = shape[i, j, 0]
+                fine[codes[i, j] - 2] = shape[i, j, 1]
+    for s in range(p.shape[0]):   # mark sub-cells met by a band
+        i0 = max(int(math.floor((min(p[s, 0], q[s, 0]) - h[s, 0] - eps[0] - origin[0])
+                                / size[0])), 0)
+        i1 = min(int(math.floor((max(p[s, 0], q[s, 0]) + h[s, 0] + eps[0] - origin[0])
+                                / size[0])), nu - 1)
+        j0 = max(int(math.floor((min(p[s, 1], q[s, 1]) - h[s, 1] - eps[1] - origin[1])
+                                / size[1])), 0)
+        j1 = min(int(math.floor((max(p[s, 1], q[s, 1]) + h[s, 1] + eps[1] - origin[1])
+                                / size[1])), nw - 1)
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                if not mask[i, j]:
+                    continue
+                off, ru, rw = codes[i, j] - 1, shape[i, j, 0], shape[i, j, 1]
+                su, sw = size[0] / ru, size[1] / rw
+                cu, cw = origin[0] + i * size[0], origin[1] + j * size[1]
+                a0 = max(int(math.floor((min(p[s, 0], q[s, 0]) - h[s, 0] - cu) / su)) - 1, 0)
+                a1 = min(int(math.floor((max(p[s, 0], q[s, 0]) + h[s, 0] - cu) / su)) + 1, ru - 1)
+                b0 = max(int(math.floor((min(p[s, 1], q[s, 1]) - h[s, 1] - cw) / sw)) - 1, 0)
+                b1 = min(int(math.floor((max(p[s, 1], q[s, 1]) + h[s, 1] - cw) / sw)) + 1, rw - 1)
+                for a in range(a0, a1 + 1):
+                    for b in range(b0, b1 + 1):
+                        if fine[off + a * rw + b] == 0 and _touches(
+                                p[s, 0], p[s, 1], q[s, 0], q[s, 1],
+                                cu + a * su - h[s, 0] - eps[0], cw + b * sw - h[s, 1] - eps[1],
+                                cu + (a + 1) * su + h[s, 0] + eps[0],
+                                cw + (b + 1) * sw + h[s, 1] + eps[1]):
+                            fine[off + a * rw + b] = 1
+    unresolved = 0
+    stack = np.empty(budget, np.int64)
+    comp = np.empty(budget, np.int64)
+    for i in range(nu):   # free sub-cells: 4-connected components inside the cell
+        for j in range(nw):
+            if not mask[i, j]:
+                continue
+            off, ru, rw = codes[i, j] - 1, shape[i, j, 0], shape[i, j, 1]
+            for c in range(ru * rw):   # 0 free, 1 marked -> 2 + label, or 4 unresolved
+                if fine[off + c] != 0:
+                    continue
+                fine[off + c] = 5   # in the current component
+                top, k, label = 1, 0, -1
+                stack[0] = c
+                while top:
+                    top -= 1
+                    x = stack[top]
+                    comp[k] = x
+                    k += 1
+                    a, b = x // rw, x % rw
+                    for na, nb in ((a - 1, b), (a + 1, b), (a, b - 1), (a, b + 1)):
+                        if 0 <= na < ru and 0 <= nb < rw:
+                            y = off + na * rw + nb
+                            if fine[y] == 0:
+                                fine[y] = 5
+                                stack[top] = na * rw + nb
+                                top += 1
+                        else:   # the neighbouring cell
+                            ni = i + (na >= ru) - (na < 0)
+                            nj = j + (nb >= rw) - (nb < 0)
+                            if 0 <= ni < nu and 0 <= nj < nw and not mask[ni, nj]:
+                                other = labels[ni, nj]
+                                if other == 2:
+                                    label = -2
+                                elif label == -1:
+                                    label = other
+                                elif label != other:
+                                    label = -2
+                for m in range(k):
+                    fine[off + comp[m]] = 2 + label if label >= 0 else 4
+                unresolved += 0 if label >= 0 else k
+            for c in range(ru * rw):   # to CELL_* codes
+                v = fine[off + c]
+                fine[off + c] = v - 2 if v in (2, 3) else 2
+    return codes, fine, unresolved

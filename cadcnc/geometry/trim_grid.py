@@ -46,7 +46,7 @@ from OCP.TopAbs import (TopAbs_FORWARD, TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
-from .trim_cells import mark, regions
+from .trim_cells import mark, refine, regions
 from ..trim import BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE
 
 _CONFUSION = 1e-7  # OCCT Precision::Confusion(), mm
@@ -287,8 +287,9 @@ def _layout(lo, hi, p, q, face_surface, max_cells: int, target: float) -> tuple[
 
 
 def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
-    """(origin (2,), cell size (2,), free (nu, nw) bool, windows): the layout, and the cells
-    that no band, nor its copies whole periods away, nor the wrap's seam touches."""
+    """(origin (2,), cell size (2,), mask (nu, nw) uint8, windows, segments): the layout, and
+    the cells (mask 1) that a band, or its copies whole periods away, or the wrap's seam
+    touches; segments (p, q, h, eps) are those bands for ``trim_cells.refine``."""
     p, q, h = bands
     lo, hi = (np.minimum(p, q) - h).min(axis=0), (np.maximum(p, q) + h).max(axis=0)
     axes, windows = _layout(lo, hi, p, q, face_surface, max_cells, target)
@@ -298,16 +299,16 @@ def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
     shifts = [[k * t for k in range(math.ceil((o - b) / t) - 1,
                                     math.floor((o + n * s - a) / t) + 2)] if t else [0.0]
               for a, b, o, s, n, (_, t, _) in zip(lo, hi, origin, size, shape, windows)]
-    mask = np.zeros(shape, dtype=np.uint8)
     moved = np.array(list(product(*shifts)))[:, None, :]  # every copy in one pass
-    mark(mask, (p + moved).reshape(-1, 2), (q + moved).reshape(-1, 2),
-         np.tile(h, (len(moved), 1)), origin, size, eps)
+    segs = [(p + moved).reshape(-1, 2), (q + moved).reshape(-1, 2), np.tile(h, (len(moved), 1))]
     for k, (_, _, seam) in enumerate(windows):
         if seam is not None:  # a line across the grid
             a, b = origin - size, origin + (shape + 1) * size
             a[k] = b[k] = seam
-            mark(mask, a[None], b[None], np.zeros((1, 2)), origin, size, eps)
-    return origin, size, mask == 0, windows
+            segs = [np.vstack([x, y]) for x, y in zip(segs, (a[None], b[None], np.zeros((1, 2))))]
+    mask = np.zeros(shape, dtype=np.uint8)
+    mark(mask, *segs, origin, size, eps)
+    return origin, size, mask, windows, (*segs, eps)
 
 
 _STATE_CODE = {TopAbs_IN: CELL_INSIDE, TopAbs_OUT: CELL_OUTSIDE}
@@ -329,27 +330,33 @@ class TrimGrid:
         (self.u0, self.w0), (self.du, self.dw) = map(float, origin), map(float, size)
         self.window = tuple(float(x) for win in windows for x in win[:2])
         self.nu, self.nw = labels.shape
+        self.codes, self.fine = labels.astype(np.int64), np.zeros(0, np.int64)  # no sub-cells
         self._flat = labels.tobytes()  # C order: cell (i, j) at i * nw + j
 
     @classmethod
     def build(cls, face_surface, max_cells: int = 65536, target_share: float = 0.02,
-              checks: int = 3) -> "TrimGrid":
+              checks: int = 3, sub_cells: int = 256) -> "TrimGrid":
         """Label a grid for ``face_surface`` (a FaceSurface) by the module's rule, with
-        ``checks`` (1..3) exact calls per region (the first decides, the others confirm)."""
+        ``checks`` (1..3) exact calls per region (the first decides, the others confirm)
+        and up to ``sub_cells`` sub-cells per MIXED cell (1: none)."""
         t_start = time.perf_counter()
         tol_uv = classifier_tolerance(face_surface)
         fc = BRepTopAdaptor_FClass2d(face_surface.topods, tol_uv)
         bands = _bands(face_surface, tol_uv)
         stats = {"exact_only": bands is None, "regions": 0, "suspect": 0, "calls": 0}
         if bands is None or not len(bands[0]):  # exact only, or no wire (all IN): one cell
-            origin, size, free = (0.0, 0.0), (1.0, 1.0), np.full((1, 1), bands is not None)
-            windows = [(0.0, 0.0)] * 2
+            origin, size, windows = (0.0, 0.0), (1.0, 1.0), [(0.0, 0.0)] * 2
+            mask, segs = np.full((1, 1), bands is None, np.uint8), None
         else:
-            origin, size, free, windows = _free_cells(bands, face_surface, max_cells,
-                                                      target_share)
-        grid = cls(face_surface, np.full(free.shape, CELL_MIXED, np.int8), origin, size,
+            origin, size, mask, windows, segs = _free_cells(bands, face_surface, max_cells,
+                                                            target_share)
+        grid = cls(face_surface, np.full(mask.shape, CELL_MIXED, np.int8), origin, size,
                    windows, fc, stats)
-        grid._label_regions(free, checks)
+        grid._label_regions(mask == 0, checks)
+        if segs is not None and sub_cells > 1:
+            grid.codes, grid.fine, stats["unresolved"] = refine(
+                mask, grid.labels, *segs[:3], np.asarray(origin), np.asarray(size), segs[3],
+                sub_cells, min(sub_cells, 64))
         stats["build_s"] = time.perf_counter() - t_start
         return grid
 
@@ -381,7 +388,16 @@ class TrimGrid:
         if not (abs(x) < 1e15 and abs(y) < 1e15):
             return CELL_MIXED
         i = min(max(math.floor(x), 0), self.nu - 1)
-        return self._flat[i * self.nw + min(max(math.floor(y), 0), self.nw - 1)]
+        j = min(max(math.floor(y), 0), self.nw - 1)
+        code = self._flat[i * self.nw + j]
+        if code != CELL_MIXED or not self.fine.size:
+            return code
+        k = int(self.codes[i, j]) - 3  # trim_lookup.lookup_fine's sub-cell, from Python
+        if k < 0:
+            return code
+        ru, rw = int(self.fine[k]), int(self.fine[k + 1])
+        a, b = min(max(math.floor((x - i) * ru), 0), ru - 1), min(max(math.floor((y - j) * rw), 0), rw - 1)
+        return int(self.fine[k + 2 + a * rw + b])
 
     def classify(self, u: float, w: float) -> str:
         """inside / boundary / outside, exactly as ``FaceSurface.classify``."""
@@ -395,3 +411,8 @@ class TrimGrid:
     def kernel_args(self) -> tuple:
         """(labels, u0, w0, du, dw, nu, nw): the leading arguments of ``trim_lookup.lookup``."""
         return self.labels, self.u0, self.w0, self.du, self.dw, self.nu, self.nw
+
+    @property
+    def fine_args(self) -> tuple:
+        """(codes, fine, u0, w0, du, dw, nu, nw): those of ``trim_lookup.lookup_fine``."""
+        return self.codes, self.fine, self.u0, self.w0, self.du, self.dw, self.nu, self.nw

@@ -33,7 +33,7 @@ from . import trim_lookup
 from .trim_lookup import CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
-lookup = _jit(trim_lookup.lookup)
+lookup = _jit(trim_lookup.lookup_fine)
 wrap = _jit(trim_lookup.wrap)
 
 # statuses
@@ -92,8 +92,9 @@ def trim_cell(F: np.ndarray, I: np.ndarray, s: int, u: float, w: float) -> int:
     g = I[h + 13]
     nu = I[h + 14]
     nw = I[h + 15]
-    return lookup(I[g:g + nu * nw].reshape((nu, nw)), F[h], F[h + 1], F[h + 2], F[h + 3],
-                  nu, nw, wrap(u, F[h + 4], F[h + 5]), wrap(w, F[h + 6], F[h + 7]))
+    return lookup(I[g:g + nu * nw].reshape((nu, nw)), I[g + nu * nw:], F[h], F[h + 1],
+                  F[h + 2], F[h + 3], nu, nw, wrap(u, F[h + 4], F[h + 5]),
+                  wrap(w, F[h + 6], F[h + 7]))
 
 
 @_jit

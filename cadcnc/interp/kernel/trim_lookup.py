@@ -40,3 +40,24 @@ def lookup(grid: np.ndarray, u0: float, w0: float, du: float, dw: float, nu: int
     i = min(max(int(math.floor(x)), 0), nu - 1)
     j = min(max(int(math.floor(y)), 0), nw - 1)
     return int(grid[i, j])
+
+
+def lookup_fine(codes: np.ndarray, fine: np.ndarray, u0: float, w0: float, du: float,
+                dw: float, nu: int, nw: int, u: float, w: float) -> int:
+    """``lookup`` on a grid with sub-cells (``TrimGrid.fine_args``): ``codes`` (nu, nw) int64
+    holds CELL_* or, on a MIXED cell split in Ru x Rw sub-cells, 3 + k where ``fine[k]``,
+    ``fine[k + 1]`` are Ru, Rw and ``fine[k + 2:]`` the sub-cells' labels (row-major)."""
+    x = (u - u0) / du
+    y = (w - w0) / dw
+    if not (abs(x) < _FAR and abs(y) < _FAR):
+        return CELL_MIXED
+    i = min(max(int(math.floor(x)), 0), nu - 1)
+    j = min(max(int(math.floor(y)), 0), nw - 1)
+    code = int(codes[i, j])
+    if code < 3:
+        return code
+    k = code - 3
+    ru, rw = int(fine[k]), int(fine[k + 1])
+    a = min(max(int(math.floor((x - i) * ru)), 0), ru - 1)
+    b = min(max(int(math.floor((y - j) * rw)), 0), rw - 1)
+    return int(fine[k + 2 + a * rw + b])
