@@ -1,4 +1,5 @@
-"""The trim grid's cell work, compiled (numba): band marking and 4-connected free regions.
+"""The trim grid's cell work: the layout, and compiled (numba) band marking, 4-connected
+free regions and the MIXED cells' sub-cells.
 
 Used by ``trim_grid``: ``mark`` sets every cell a band touches, with the arithmetic of the
 vectorised rule it replaces (segments cut into pieces no longer than a cell, each piece's
@@ -14,6 +15,47 @@ import numba
 import numpy as np
 
 _jit = numba.njit(cache=True, nogil=True)
+
+
+def layout(lo, hi, p, q, face_surface, max_cells: int, target: float) -> tuple[list, list]:
+    """Per direction (origin, cell size, count) by trim_grid's resolution rule, and the window (start,
+    period, seam): periodic points are wrapped into [start, start + period) before lookup
+    (period 0: not periodic); ``seam`` is where FaceSurface.wrap jumps inside a window that
+    the grid does not span (lo, hi are widened to hold it), else None."""
+    windows = []
+    for k, (period, start) in enumerate(((face_surface.u_period, face_surface.u_range[0]),
+                                        (face_surface.w_period, face_surface.w_range[0]))):
+        window = 0.5 * (lo[k] + hi[k] - (period or 0.0))
+        seam = None if period is None else window + (start - window) % period
+        if period is None:
+            windows.append((0.0, 0.0, None))
+        elif max(hi[k], seam) - min(lo[k], seam) > 0.75 * period:
+            windows.append((start, period, None))  # the grid spans the wrap range
+        else:
+            lo[k], hi[k] = min(lo[k], seam), max(hi[k], seam)
+            windows.append((window, period, seam))
+    full = [w[1] if w[1] and w[2] is None else 0.0 for w in windows]
+    span = [hi[k] - lo[k] for k in range(2)]
+    domain = [full[k] or span[k] for k in range(2)]
+    var = [max(float(np.abs(q[:, k] - p[:, k]).sum()), 1e-9 * span[k]) for k in range(2)]
+    n = 4.0 * var[0] * var[1] * domain[0] * domain[1] / (target * span[0] * span[1]) ** 2
+    c = domain[0] * domain[1] / min(max(n, 256.0), float(max_cells))
+    # the best cell shape, but no direction finer than max_cells / 16 cells
+    cell = [max(math.sqrt(c * var[k] / var[1 - k]), 16.0 * domain[k] / max_cells)
+            for k in range(2)]
+    while True:
+        axes = []
+        for k in range(2):
+            if full[k]:  # exactly the wrap range [start, start + period)
+                count = max(1, math.ceil(full[k] / cell[k]))
+                axes.append((windows[k][0], full[k] / count, count))
+            else:  # the bands plus >= 1.1 clear cells each side
+                count = max(3, math.ceil(span[k] / cell[k]) + 3)
+                axes.append((lo[k] - 1.1 * span[k] / (count - 2.2), span[k] / (count - 2.2),
+                             count))
+        if axes[0][2] * axes[1][2] <= 2 * max_cells:  # counts round up; memory stays bounded
+            return axes, windows
+        cell = [x * 1.25 for x in cell]
 
 
 @_jit

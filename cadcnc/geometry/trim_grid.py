@@ -25,6 +25,13 @@ about 2 sqrt(Lu Lw C) / (Fu Fw); N makes that ``target_share`` (2 %), within [25
 bands cover over 3/4 of the period spans exactly the wrap range; any other spans the bands +
 1.1 clear cells each side (periodic ones inside a one-period window centred on them), so a
 point beyond the grid takes its nearest border cell's label.
+
+Sub-cells (``trim_cells.refine``): each MIXED cell is split in up to ``sub_cells`` (256)
+sub-cells, thin strips where its bands run along u or w (a periodic face's seam edge), else
+up to 8 x 8; a sub-cell is MIXED if a band segment meets it inflated by the half-widths
+(FClass2d's own ON test, + the 1e-12 round-off margin); free sub-cells connected inside the
+cell take the label of the free cells beside them (they agree, or the sub-cells stay MIXED:
+``stats["unresolved"]``). ``fine_args`` hands both levels to ``trim_lookup.lookup_fine``.
 """
 
 from __future__ import annotations
@@ -46,7 +53,7 @@ from OCP.TopAbs import (TopAbs_FORWARD, TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
-from .trim_cells import mark, refine, regions
+from .trim_cells import layout, mark, refine, regions
 from ..trim import BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE
 
 _CONFUSION = 1e-7  # OCCT Precision::Confusion(), mm
@@ -245,54 +252,13 @@ def _bands(face_surface, tol_uv: float) -> tuple[np.ndarray, ...] | None:
     return tuple(np.vstack(x) if x else np.zeros((0, 2)) for x in (p, q, h))
 
 
-def _layout(lo, hi, p, q, face_surface, max_cells: int, target: float) -> tuple[list, list]:
-    """Per direction (origin, cell size, count) by the module's rule, and the window (start,
-    period, seam): periodic points are wrapped into [start, start + period) before lookup
-    (period 0: not periodic); ``seam`` is where FaceSurface.wrap jumps inside a window that
-    the grid does not span (lo, hi are widened to hold it), else None."""
-    windows = []
-    for k, (period, start) in enumerate(((face_surface.u_period, face_surface.u_range[0]),
-                                        (face_surface.w_period, face_surface.w_range[0]))):
-        window = 0.5 * (lo[k] + hi[k] - (period or 0.0))
-        seam = None if period is None else window + (start - window) % period
-        if period is None:
-            windows.append((0.0, 0.0, None))
-        elif max(hi[k], seam) - min(lo[k], seam) > 0.75 * period:
-            windows.append((start, period, None))  # the grid spans the wrap range
-        else:
-            lo[k], hi[k] = min(lo[k], seam), max(hi[k], seam)
-            windows.append((window, period, seam))
-    full = [w[1] if w[1] and w[2] is None else 0.0 for w in windows]
-    span = [hi[k] - lo[k] for k in range(2)]
-    domain = [full[k] or span[k] for k in range(2)]
-    var = [max(float(np.abs(q[:, k] - p[:, k]).sum()), 1e-9 * span[k]) for k in range(2)]
-    n = 4.0 * var[0] * var[1] * domain[0] * domain[1] / (target * span[0] * span[1]) ** 2
-    c = domain[0] * domain[1] / min(max(n, 256.0), float(max_cells))
-    # the best cell shape, but no direction finer than max_cells / 16 cells
-    cell = [max(math.sqrt(c * var[k] / var[1 - k]), 16.0 * domain[k] / max_cells)
-            for k in range(2)]
-    while True:
-        axes = []
-        for k in range(2):
-            if full[k]:  # exactly the wrap range [start, start + period)
-                count = max(1, math.ceil(full[k] / cell[k]))
-                axes.append((windows[k][0], full[k] / count, count))
-            else:  # the bands plus >= 1.1 clear cells each side
-                count = max(3, math.ceil(span[k] / cell[k]) + 3)
-                axes.append((lo[k] - 1.1 * span[k] / (count - 2.2), span[k] / (count - 2.2),
-                             count))
-        if axes[0][2] * axes[1][2] <= 2 * max_cells:  # counts round up; memory stays bounded
-            return axes, windows
-        cell = [x * 1.25 for x in cell]
-
-
 def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
     """(origin (2,), cell size (2,), mask (nu, nw) uint8, windows, segments): the layout, and
     the cells (mask 1) that a band, or its copies whole periods away, or the wrap's seam
     touches; segments (p, q, h, eps) are those bands for ``trim_cells.refine``."""
     p, q, h = bands
     lo, hi = (np.minimum(p, q) - h).min(axis=0), (np.maximum(p, q) + h).max(axis=0)
-    axes, windows = _layout(lo, hi, p, q, face_surface, max_cells, target)
+    axes, windows = layout(lo, hi, p, q, face_surface, max_cells, target)
     origin, size = np.array([a[0] for a in axes]), np.array([a[1] for a in axes])
     shape = np.array([axes[0][2], axes[1][2]])
     eps = 1e-12 * (np.abs(origin) + shape * size) + 1e-300
