@@ -153,6 +153,45 @@ def _touches(p0: float, p1: float, q0: float, q1: float, a0: float, a1: float,
 
 
 @_jit
+def _merge(label: int, labels: np.ndarray, mask: np.ndarray, i: int, j: int) -> int:
+    """``label`` (-1 none yet, -2 conflicting) merged with free cell (i, j)'s, if any."""
+    nu, nw = mask.shape
+    if not (0 <= i < nu and 0 <= j < nw) or mask[i, j]:
+        return label
+    other = labels[i, j]
+    if other == 2 or label == -2 or (label >= 0 and label != other):
+        return -2
+    return other
+
+
+@_jit
+def _label_strips(fine: np.ndarray, off: int, n: int, across_u: bool, labels: np.ndarray,
+                  mask: np.ndarray, i: int, j: int) -> int:
+    """Label the runs of free strips of cell (i, j) (n strips across u if ``across_u``,
+    else across w) from the cells beside them; returns the sub-cells left unresolved."""
+    di, dj = (1, 0) if across_u else (0, 1)
+    common = _merge(_merge(-1, labels, mask, i + dj, j + di), labels, mask, i - dj, j - di)
+    unresolved, c = 0, 0
+    while c < n:
+        if fine[off + c] != 0:
+            c += 1
+            continue
+        e = c
+        while e + 1 < n and fine[off + e + 1] == 0:
+            e += 1
+        label = common
+        if c == 0:
+            label = _merge(label, labels, mask, i - di, j - dj)
+        if e == n - 1:
+            label = _merge(label, labels, mask, i + di, j + dj)
+        for k in range(c, e + 1):
+            fine[off + k] = 2 + label if label >= 0 else 4
+        unresolved += 0 if label >= 0 else e - c + 1
+        c = e + 1
+    return unresolved
+
+
+@_jit
 def refine(mask: np.ndarray, labels: np.ndarray, p: np.ndarray, q: np.ndarray,
            h: np.ndarray, origin: np.ndarray, size: np.ndarray, eps: np.ndarray,
            budget: int, square: int) -> tuple:
@@ -236,6 +275,8 @@ def refine(mask: np.ndarray, labels: np.ndarray, p: np.ndarray, q: np.ndarray,
             if not mask[i, j]:
                 continue
             off, ru, rw = codes[i, j] - 1, shape[i, j, 0], shape[i, j, 1]
+            if ru == 1 or rw == 1:   # strips: runs between marked ones
+                unresolved += _label_strips(fine, off, ru * rw, rw == 1, labels, mask, i, j)
             for c in range(ru * rw):   # 0 free, 1 marked -> 2 + label, or 4 unresolved
                 if fine[off + c] != 0:
                     continue
@@ -258,14 +299,7 @@ def refine(mask: np.ndarray, labels: np.ndarray, p: np.ndarray, q: np.ndarray,
                         else:   # the neighbouring cell
                             ni = i + (na >= ru) - (na < 0)
                             nj = j + (nb >= rw) - (nb < 0)
-                            if 0 <= ni < nu and 0 <= nj < nw and not mask[ni, nj]:
-                                other = labels[ni, nj]
-                                if other == 2:
-                                    label = -2
-                                elif label == -1:
-                                    label = other
-                                elif label != other:
-                                    label = -2
+                            label = _merge(label, labels, mask, ni, nj)
                 for m in range(k):
                     fine[off + comp[m]] = 2 + label if label >= 0 else 4
                 unresolved += 0 if label >= 0 else k
