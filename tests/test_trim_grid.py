@@ -20,7 +20,7 @@ import cadcnc
 from cadcnc.geometry import trim_grid
 from cadcnc.geometry.trim_grid import CELL_MIXED, TrimGrid, classifier_tolerance
 from cadcnc.interp.kernel import trim_lookup
-from cadcnc.interp.kernel.trim_lookup import lookup, lookup_fine, wrap
+from cadcnc.interp.kernel.trim_lookup import lookup, wrap
 
 FIXTURES = Path(__file__).resolve().parents[1] / "fixtures"
 STEPS = sorted(FIXTURES.glob("*.step"))
@@ -80,8 +80,7 @@ def test_grid_agrees_with_fclass2d_on_every_face(path):
         us, pu, ws, pw = grid.window
         for (u, w), (uw, ww) in zip(pts[:300].tolist(), windowed):
             assert (wrap(u, us, pu), wrap(w, ws, pw)) == (uw, ww)
-            assert lookup_fine(*grid.fine_args, uw, ww) == grid.cell(uw, ww)
-            assert lookup(*grid.kernel_args, uw, ww) in (CELL_MIXED, grid.cell(uw, ww))
+            assert lookup(*grid.kernel_args, uw, ww) == grid.cell(uw, ww)
     assert bad == [], f"{len(bad)} disagreements, first: {bad[:5]}"
     # the O(1) path answers almost everything (a regression to 'all MIXED' fails here)
     assert min(o1) > 0.85, o1
@@ -95,14 +94,25 @@ def test_wrap_moves_by_whole_periods():
 
 
 def test_lookup_clamps_and_defers_on_nonfinite():
-    grid = np.array([[0, 1], [2, 1]], dtype=np.int8)
-    args = (grid, 0.0, 0.0, 1.0, 1.0, 2, 2)
+    grid = np.array([[0, 1], [2, 1]], dtype=np.int64)
+    args = (grid, np.zeros(0, np.int64), 0.0, 0.0, 1.0, 1.0, 2, 2)
     assert lookup(*args, 0.5, 1.5) == 1
     assert lookup(*args, 1.5, 0.5) == 2
     assert lookup(*args, -5.0, -5.0) == 0  # beyond the grid: the nearest border cell
     assert lookup(*args, 99.0, 99.0) == 1
     for bad in (float("nan"), float("inf"), -float("inf")):
         assert lookup(*args, bad, 0.5) == trim_lookup.CELL_MIXED
+
+
+def test_lookup_reads_sub_cells():
+    """A MIXED cell split in 2 x 4 sub-cells (code 3 + offset of Ru, Rw, labels)."""
+    codes = np.array([[0, 3]], dtype=np.int64)
+    fine = np.array([2, 4, 0, 0, 1, 2, 1, 1, 1, 0], dtype=np.int64)
+    args = (codes, fine, 0.0, 0.0, 1.0, 1.0, 1, 2)
+    assert lookup(*args, 0.5, 0.5) == 0  # an unsplit cell
+    assert [lookup(*args, 0.25, 1.0 + b / 4 + 0.1) for b in range(4)] == [0, 0, 1, 2]
+    assert [lookup(*args, 0.75, 1.0 + b / 4 + 0.1) for b in range(4)] == [1, 1, 1, 0]
+    assert lookup(*args, 9.0, 9.0) == 0  # clamped into the last sub-cell
 
 
 @pytest.mark.parametrize("name", ["crossing_cylinders", "sphere_cylinder", "bspline_boss"])

@@ -31,7 +31,7 @@ sub-cells, thin strips where its bands run along u or w (a periodic face's seam 
 up to 8 x 8; a sub-cell is MIXED if a band segment meets it inflated by the half-widths
 (FClass2d's own ON test, + the 1e-12 round-off margin); free sub-cells connected inside the
 cell take the label of the free cells beside them (they agree, or the sub-cells stay MIXED:
-``stats["unresolved"]``). ``fine_args`` hands both levels to ``trim_lookup.lookup_fine``.
+``stats["unresolved"]``). ``kernel_args`` hands both levels to ``trim_lookup.lookup``.
 """
 
 from __future__ import annotations
@@ -358,7 +358,7 @@ class TrimGrid:
         code = self._flat[i * self.nw + j]
         if code != CELL_MIXED or not self.fine.size:
             return code
-        k = int(self.codes[i, j]) - 3  # trim_lookup.lookup_fine's sub-cell, from Python
+        k = int(self.codes[i, j]) - 3  # trim_lookup.lookup's sub-cell, from Python
         if k < 0:
             return code
         ru, rw = int(self.fine[k]), int(self.fine[k + 1])
@@ -375,10 +375,6 @@ class TrimGrid:
 
     @property
     def kernel_args(self) -> tuple:
-        """(labels, u0, w0, du, dw, nu, nw): the leading arguments of ``trim_lookup.lookup``."""
-        return self.labels, self.u0, self.w0, self.du, self.dw, self.nu, self.nw
-
-    @property
-    def fine_args(self) -> tuple:
-        """(codes, fine, u0, w0, du, dw, nu, nw): those of ``trim_lookup.lookup_fine``."""
+        """(codes, fine, u0, w0, du, dw, nu, nw): the leading arguments of
+        ``trim_lookup.lookup``."""
         return self.codes, self.fine, self.u0, self.w0, self.du, self.dw, self.nu, self.nw

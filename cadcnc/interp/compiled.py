@@ -63,7 +63,7 @@ def pack(surfaces, grids) -> tuple[np.ndarray, np.ndarray]:
         head[h + 3], head[h + 4] = ni, len(iarr)
         ints.append(np.asarray(iarr, dtype=np.int64))
         ni += len(iarr)
-        codes, fine, u0, w0, du, dw, nu, nw = grid.fine_args
+        codes, fine, u0, w0, du, dw, nu, nw = grid.kernel_args
         head[h + 13], head[h + 14], head[h + 15] = ni, nu, nw  # codes, then their sub-cells
         ints += [codes.astype(np.int64).ravel(), fine.astype(np.int64)]
         ni += nu * nw + len(fine)

@@ -33,7 +33,7 @@ from . import trim_lookup
 from .trim_lookup import CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
-lookup = _jit(trim_lookup.lookup_fine)
+lookup = _jit(trim_lookup.lookup)
 wrap = _jit(trim_lookup.wrap)
 
 # statuses
