@@ -28,7 +28,7 @@ point beyond the grid takes its nearest border cell's label.
 
 Sub-cells (``trim_cells.refine``): each MIXED cell is split in up to ``sub_cells`` (256)
 sub-cells, thin strips where its bands run along u or w (a periodic face's seam edge), else
-up to 8 x 8; a sub-cell is MIXED if a band segment meets it inflated by the half-widths
+up to 4 x 4; a sub-cell is MIXED if a band segment meets it inflated by the half-widths
 (FClass2d's own ON test, + the 1e-12 round-off margin); free sub-cells connected inside the
 cell take the label of the free cells beside them (they agree, or the sub-cells stay MIXED:
 ``stats["unresolved"]``). ``kernel_args`` hands both levels to ``trim_lookup.lookup``.
@@ -322,7 +322,7 @@ class TrimGrid:
         if segs is not None and sub_cells > 1:
             grid.codes, grid.fine, stats["unresolved"] = refine(
                 mask, grid.labels, *segs[:3], np.asarray(origin), np.asarray(size), segs[3],
-                sub_cells, min(sub_cells, 64))
+                sub_cells, min(sub_cells, 16))
         stats["build_s"] = time.perf_counter() - t_start
         return grid
 
