@@ -262,6 +262,11 @@ class CompiledStepper(Stepper):
                 self._margin = clearance
             if clearance < 0.0:
                 return COLLISION, detail
+            budget = getattr(self.guard, "budget", None)
+            if budget is not None:  # clear within this distance: the kernel commits alone
+                S = self.S
+                S[K.GUARD_Q:K.GUARD_Q + 3] = S[K.P_E:K.P_E + 3]
+                S[K.GUARD_B] = float(budget(tuple(S[K.P_E:K.P_E + 3].tolist())))
         return None
 
     # -- the landing's primitives (Stepper._land_on_limit drives them) ----------------------
