@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from OCP.TopAbs import TopAbs_IN
 from OCP.gp import gp_Pnt2d
 
@@ -149,6 +151,48 @@ class AnalyticFace:
         if fmin > r2:                          # wholly outside: the vertex or an end
             return self.point_distance((p[0], p[1], p[2] + s_min))
         return self.point_distance((p[0], p[1], p[2] + (0.0 if f0 >= f1 else length)))
+
+
+    def segment_lower_bound(self, p, length: float) -> float | None:
+        """A lower bound (mm) of the distance from the segment p .. p + length z to a
+        torus face: the distance to the whole torus, min over s of |g(s) - r| with g the
+        distance to the tube's core circle; None for other kinds or near the axis.
+
+        g^2 = q - 2 R rho + R^2 (q: squared distance to the centre, rho: to the axis,
+        both quadratics in s under the square); its critical points solve
+        (s + b)^2 rho^2(s) = R^2 (A s + B)^2, a quartic, so g's range over [0, length]
+        is the range of its values at the quartic's real roots and at both ends.
+        """
+        if self.kind != "torus":
+            return None
+        w0 = _sub(p, self.o)
+        w0 = _axpy(-_dot(w0, self.z), self.z, w0)            # radial part at s = 0
+        e = _axpy(-self.z[2], self.z, (0.0, 0.0, 1.0))       # radial part of +z
+        qa, qb, qc = _dot(e, e), _dot(w0, e), _dot(w0, w0)   # rho^2 = qa s^2 + 2 qb s + qc
+        s_v = min(max(-qb / qa, 0.0), length) if qa > EPS else 0.0
+        if qa * s_v * s_v + 2.0 * qb * s_v + qc < (EPS * self.r_major) ** 2 + 1e-18:
+            return None                                     # the segment meets the axis
+        b = p[2] - self.o[2]                                 # q' / 2 = s + b
+        quartic = np.polymul([1.0, 2.0 * b, b * b], [qa, 2.0 * qb, qc])
+        quartic[2:] -= self.r_major ** 2 * np.array([qa * qa, 2.0 * qa * qb, qb * qb])
+        cands = [0.0, length]
+        for root in np.roots(quartic) if np.any(quartic) else ():
+            if abs(root.imag) <= 1e-6 * (1.0 + abs(root.real)):
+                s = float(root.real)
+                for _ in range(2):   # polish on the quartic (np.roots is ~1e-12 relative)
+                    d = np.polyval(np.polyder(quartic), s)
+                    s = s - float(np.polyval(quartic, s)) / d if d else s
+                if 0.0 <= s <= length:
+                    cands.append(s)
+        gs = []
+        for s in cands:
+            rho = math.sqrt(max(qa * s * s + 2.0 * qb * s + qc, 0.0))
+            ax = _dot(_sub((p[0], p[1], p[2] + s), self.o), self.z)
+            gs.append(math.hypot(rho - self.r_major, ax))
+        lo, hi = min(gs), max(gs)
+        if lo <= self.r <= hi:
+            return 0.0
+        return lo - self.r if lo > self.r else self.r - hi
 
 
 def _xyz(v) -> tuple[float, float, float]:

@@ -151,9 +151,11 @@ class ClearanceGuard:
         if own and below:
             m = self.tol
         elif own:
-            d_seg, d_p = self._segment_distance(k, p)[0], self._point_distance(k, p)
-            # an unknown distance fails closed (-inf is a hit, never an inf margin)
-            m = d_seg - (d_p - self.tol) if math.isfinite(d_seg + d_p) else -math.inf
+            m = self._own_bound(k, p)
+            if m is None or m < 0.0:
+                d_seg, d_p = self._segment_distance(k, p)[0], self._point_distance(k, p)
+                # an unknown distance fails closed (-inf is a hit, never an inf margin)
+                m = d_seg - (d_p - self.tol) if math.isfinite(d_seg + d_p) else -math.inf
         else:
             d, own_edge = (self._point_distance(k, p), False) if below or \
                 self.shank == 0.0 else self._segment_distance(k, p)
@@ -192,6 +194,17 @@ class ClearanceGuard:
                   and self._own_shapes.Contains(ext.SupportOnShape2(n))
                   for n in range(1, ext.NbSolution() + 1))
         return ext.Value(), own
+
+    def _own_bound(self, k: int, p) -> float | None:
+        """A lower bound of own face k's margin in closed form (a torus: the segment's
+        distance to the whole torus, the ball's to the face), or None."""
+        a = self._analytic[k - 1]
+        lb = a.segment_lower_bound(p, self.shank)
+        d_p = a.point_distance(p) if lb is not None else None
+        if d_p is None:
+            return None
+        self.closed_calls += 1
+        return lb - (d_p - self.tol)
 
     def _free_edges(self, k: int):
         """A compound of face k's edges that face i and j do not share, or None."""
