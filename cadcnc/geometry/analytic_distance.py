@@ -161,7 +161,8 @@ class AnalyticFace:
         g^2 = q - 2 R rho + R^2 (q: squared distance to the centre, rho: to the axis,
         both quadratics in s under the square); its critical points solve
         (s + b)^2 rho^2(s) = R^2 (A s + B)^2, a quartic, so g's range over [0, length]
-        is the range of its values at the quartic's real roots and at both ends.
+        is the range of its values at the quartic's real roots and at both ends (numpy's
+        companion-matrix roots, polished by Newton).
         """
         if self.kind != "torus":
             return None
@@ -173,17 +174,22 @@ class AnalyticFace:
         if qa * s_v * s_v + 2.0 * qb * s_v + qc < (EPS * self.r_major) ** 2 + 1e-18:
             return None                                     # the segment meets the axis
         b = p[2] - self.o[2]                                 # q' / 2 = s + b
-        quartic = np.polymul([1.0, 2.0 * b, b * b], [qa, 2.0 * qb, qc])
+        quartic = np.convolve([1.0, 2.0 * b, b * b], [qa, 2.0 * qb, qc])   # 5 coefficients
         quartic[2:] -= self.r_major ** 2 * np.array([qa * qa, 2.0 * qa * qb, qb * qb])
         cands = [0.0, length]
+        deriv = np.polyder(quartic)
+        # every root's real part is a candidate: g's value at an extra point stays within
+        # g's true range, and a near-double real root may come out slightly complex
         for root in np.roots(quartic) if np.any(quartic) else ():
-            if abs(root.imag) <= 1e-6 * (1.0 + abs(root.real)):
-                s = float(root.real)
-                for _ in range(2):   # polish on the quartic (np.roots is ~1e-12 relative)
-                    d = np.polyval(np.polyder(quartic), s)
-                    s = s - float(np.polyval(quartic, s)) / d if d else s
-                if 0.0 <= s <= length:
-                    cands.append(s)
+            s = float(root.real)
+            for _ in range(2):   # polish on the quartic, only where it improves
+                d = float(np.polyval(deriv, s))
+                t = s - float(np.polyval(quartic, s)) / d if d else s
+                if not abs(np.polyval(quartic, t)) < abs(np.polyval(quartic, s)):
+                    break
+                s = t
+            if 0.0 <= s <= length:
+                cands.append(s)
         gs = []
         for s in cands:
             rho = math.sqrt(max(qa * s * s + 2.0 * qb * s + qc, 0.0))

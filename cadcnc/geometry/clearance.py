@@ -97,6 +97,8 @@ class ClearanceGuard:
         """
         self.calls += 1
         p = (float(p[0]), float(p[1]), float(p[2]))
+        if not math.isfinite(p[0] + p[1] + p[2]):
+            return -math.inf, "ball centre is not a finite point"   # fail closed
         moved = math.inf if self._broad_at is None else _dist(p, self._broad_at)
         if moved > self.reach:
             self._broad_phase(p)
