@@ -118,8 +118,8 @@ def test_an_unknown_distance_fails_closed():
     p = (15.0, 15.0 - 3.0 * math.tan(lean) - 3.0 / math.cos(lean), 13.0)
     g = guard("undercut")
     g._point_distance = lambda face, q: -math.inf
-    g._segment_distance = lambda face, q: (1.0, False)
+    g._segment_distance = lambda face, q, *length: (1.0, False)
     assert g._exact(wall, p)[0] == -math.inf
-    g._segment_distance = lambda face, q: (-math.inf, False)
+    g._segment_distance = lambda face, q, *length: (-math.inf, False)
     third = next(k for k in range(1, len(part_of("undercut")) + 1) if k not in (floor, wall))
     assert g._exact(third, p)[0] == -math.inf

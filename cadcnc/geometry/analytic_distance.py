@@ -68,15 +68,16 @@ class AnalyticFace:
         return f._classifier.Perform(self._uv) == TopAbs_IN
 
     # -- point -------------------------------------------------------------------------
-    def point_distance(self, p) -> float | None:
-        """Distance (mm) from p to the face, or None where no closed form applies."""
+    def point_distance(self, p, trimmed: bool = True) -> float | None:
+        """Distance (mm) from p to the face, or None where no closed form applies;
+        ``trimmed=False``: to the whole surface (a lower bound of the face's)."""
         if self.kind is None:
             return None
         foot_d = self._surface_foot(p)
         if foot_d is None:
             return None
         foot, d = foot_d
-        return d if self._inside(foot) else None
+        return d if not trimmed or self._inside(foot) else None
 
     def _surface_foot(self, p):
         """(nearest point of the untrimmed surface, distance) or None when not unique."""
@@ -106,14 +107,17 @@ class AnalyticFace:
         return _axpy(self.r / n, t, c), abs(n - self.r)
 
     # -- vertical segment ----------------------------------------------------------------
-    def segment_distance(self, p, length: float) -> float | None:
-        """Distance (mm) from the segment p .. p + length z (global z) to the face, or None.
+    def segment_distance(self, p, length: float, trimmed: bool = True) -> float | None:
+        """Distance (mm) from the segment p .. p + length z (global z) to the face, or None
+        (``trimmed=False``: to the whole surface, a lower bound; a torus's too).
 
         Plane, cylinder and sphere: along the segment the signed plane height is linear
         and the squared distance to the axis or centre is a convex quadratic in s, so the
         nearest segment point is an end, the quadratic's vertex, or a crossing of the
         surface (distance 0); the foot of that point decides.
         """
+        if self.kind == "torus" and not trimmed:
+            return self.segment_lower_bound(p, length)
         if self.kind not in ("plane", "cylinder", "sphere"):
             return None
         if self.kind == "plane":
@@ -122,9 +126,9 @@ class AnalyticFace:
             if h0 * h1 <= 0.0 and h0 != h1:
                 s = -h0 / self.z[2]
                 q = (p[0], p[1], p[2] + s)
-                return 0.0 if self._inside(q) else None
+                return 0.0 if not trimmed or self._inside(q) else None
             s = 0.0 if abs(h0) < abs(h1) else length
-            return self.point_distance((p[0], p[1], p[2] + s))
+            return self.point_distance((p[0], p[1], p[2] + s), trimmed)
         # squared distance to the axis (cylinder) or centre (sphere): A s^2 + 2 B s + C
         w0 = _sub(p, self.o)
         if self.kind == "cylinder":
@@ -143,14 +147,14 @@ class AnalyticFace:
             if qa <= EPS or disc < 0.0:
                 return None
             for s in ((-qb - math.sqrt(disc)) / qa, (-qb + math.sqrt(disc)) / qa):
-                if 0.0 <= s <= length and self._inside((p[0], p[1], p[2] + s)):
+                if 0.0 <= s <= length and (not trimmed or self._inside((p[0], p[1], p[2] + s))):
                     return 0.0
             return None
         # a tie (several nearest segment points) is fine: any global minimiser whose foot
         # is inside the face gives the face's distance
         if fmin > r2:                          # wholly outside: the vertex or an end
-            return self.point_distance((p[0], p[1], p[2] + s_min))
-        return self.point_distance((p[0], p[1], p[2] + (0.0 if f0 >= f1 else length)))
+            return self.point_distance((p[0], p[1], p[2] + s_min), trimmed)
+        return self.point_distance((p[0], p[1], p[2] + (0.0 if f0 >= f1 else length)), trimmed)
 
 
     def segment_lower_bound(self, p, length: float) -> float | None:

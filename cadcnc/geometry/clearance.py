@@ -159,8 +159,7 @@ class ClearanceGuard:
                 # an unknown distance fails closed (-inf is a hit, never an inf margin)
                 m = d_seg - (d_p - self.tol) if math.isfinite(d_seg + d_p) else -math.inf
         else:
-            d, own_edge = (self._point_distance(k, p), False) if below or \
-                self.shank == 0.0 else self._segment_distance(k, p)
+            d, own_edge = self._segment_distance(k, p, 0.0 if below else self.shank)
             m = d - self.threshold
             if own_edge:
                 m = max(m, 0.0)
@@ -170,11 +169,18 @@ class ClearanceGuard:
         return m, "ball" if below or self._point_distance(k, p) < self.threshold \
             else "shank"
 
-    def _segment_distance(self, k: int, p) -> tuple[float, bool]:
-        """(distance mm from the segment p .. p + L z to face k, whether every nearest
-        point of the face lies on an edge or vertex of face i or j): in closed form for an
-        analytic face whose foot is inside it (then not on an edge), else OCCT's."""
-        d = self._analytic[k - 1].segment_distance(p, self.shank)
+    def _segment_distance(self, k: int, p, length: float | None = None) -> tuple[float, bool]:
+        """(distance mm from the segment p .. p + length z (default L) to face k, whether
+        every nearest point of the face lies on an edge or vertex of face i or j): in
+        closed form for an analytic face whose foot is inside it (then not on an edge);
+        for a third face whose distance to its whole surface already clears R' - tol, that
+        distance (a lower bound: the margin stays >= 0); else OCCT's."""
+        length = self.shank if length is None else length
+        a = self._analytic[k - 1]
+        d = a.segment_distance(p, length)
+        if d is None and k not in self.pair:
+            d = a.segment_distance(p, length, trimmed=False)
+            d = d if d is not None and d >= self.threshold else None
         if d is not None:
             self.closed_calls += 1
             return d, False
@@ -188,7 +194,8 @@ class ClearanceGuard:
             if face is None:
                 return math.inf, False
         a = gp_Pnt(*p)
-        shape = BRepBuilderAPI_MakeEdge(a, gp_Pnt(p[0], p[1], p[2] + self.shank)).Edge()
+        shape = BRepBuilderAPI_MakeEdge(a, gp_Pnt(p[0], p[1], p[2] + length)).Edge() \
+            if length > 0.0 else BRepBuilderAPI_MakeVertex(a).Vertex()
         ext = BRepExtrema_DistShapeShape(shape, face)
         if not ext.IsDone() or ext.NbSolution() == 0:
             return -math.inf, False  # fail closed: an unknown distance is a hit
