@@ -160,7 +160,8 @@ def verify(args) -> int:
         where = f"{lab}: " if len(reports) > 1 else ""
         if not math.isfinite(r.max_gouge_mm):
             say_error(f"cadcnc: verify: {where}the gouge depth could not be measured")
-        else:
-            say_error(f"cadcnc: verify: {where}gouge {r.max_gouge_mm:.4g} mm deep exceeds "
-                      f"the tolerance {tol.gouge:g} mm (see max over-cut and whole-part hits)")
+            continue
+        failed = [c for c in r.criteria(tol.gouge) if not c.ok]
+        say_error(f"cadcnc: verify: {where}failed " + "; ".join(
+            f"{c.name} {c.value:.4g} (limit {c.limit:g})" for c in failed))
     return code

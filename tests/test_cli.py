@@ -308,7 +308,7 @@ def test_verify_saved_path_and_gate(boss_outputs):
     assert "over-cut" in ok.stdout
     strict = cadcnc_cli("verify", d / "p.json", "--gouge-tolerance", "1e-9", "--quiet")
     assert strict.returncode == 5
-    assert strict.stderr.startswith("cadcnc: verify: gouge") and "1e-09 mm" in strict.stderr
+    assert strict.stderr.startswith("cadcnc: verify: failed gouge") and "limit 1e-09" in strict.stderr
 
 
 def test_verify_needs_the_job_parameters():
@@ -346,7 +346,7 @@ def test_path_refuses_a_pair_with_no_feasible_position(tmp_path):
 def test_verify_old_tolerance_spelling_still_gates(boss_outputs):
     d, _ = boss_outputs
     strict = cadcnc_cli("verify", d / "p.json", "--tolerance", "1e-9", "--quiet")
-    assert strict.returncode == 5 and "1e-09 mm" in strict.stderr
+    assert strict.returncode == 5 and "limit 1e-09" in strict.stderr
 
 
 def test_safe_z_is_an_alias_of_clearance(boss_outputs, tmp_path):

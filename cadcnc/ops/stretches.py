@@ -197,8 +197,13 @@ def _project(surface, point) -> tuple[float, float]:
 
 
 def edge_stretches(feas: Feasibility, shared_edge, edge: int,
-                   spacing: float = SPACING) -> EdgeStretches:
-    """Every stretch along one shared concave edge (see the module's method)."""
+                   spacing: float = SPACING, extend: tuple[bool, bool] = (True, True)
+                   ) -> EdgeStretches:
+    """Every stretch along one shared concave edge (see the module's method).
+
+    ``extend``: whether to search past the edge's start and end; not where another
+    concave edge of the same pair continues it (that edge's own search covers it, and two
+    cuts would overlap)."""
     curve = EdgeCurve(shared_edge)
     ext = 0.0 if curve.closed else max(feas.offsets) + 1.0
     n = max(MIN_SAMPLES, int(math.ceil(curve.length / spacing)) + 1)
@@ -207,8 +212,9 @@ def edge_stretches(feas: Feasibility, shared_edge, edge: int,
         grid = grid[:-1]
     step = grid[1] - grid[0]
     k_ext = int(math.ceil(ext / step)) if ext > 0 else 0
-    grid = np.concatenate([-step * np.arange(k_ext, 0, -1), grid,
-                           curve.length + step * np.arange(1, k_ext + 1)])
+    k_lo, k_hi = (k_ext if go else 0 for go in extend)
+    grid = np.concatenate([-step * np.arange(k_lo, 0, -1), grid,
+                           curve.length + step * np.arange(1, k_hi + 1)])
     out = EdgeStretches(edge, curve.length)
     samples: list[Sample] = []
     for s in grid:   # each seeded from the last solved sample: stays on one branch
@@ -334,4 +340,16 @@ def pair_stretches(s1, s2, job: Job, guard: ClearanceGuard | None = None,
     if guard is None:
         guard = guard_for(part, (s1.number, s2.number), job)
     feas = Feasibility(s1, s2, job, guard)
-    return [edge_stretches(feas, e, k, spacing) for k, e in enumerate(edges)]
+    return [edge_stretches(feas, e, k, spacing, (not _continued(e.start, e, edges),
+                                                 not _continued(e.end, e, edges)))
+            for k, e in enumerate(edges)]
+
+
+JOIN = 1e-6  # mm: edge ends closer than this are one vertex
+
+
+def _continued(point, edge, edges) -> bool:
+    """Whether another of the pair's concave edges starts or ends at ``point``."""
+    p = np.asarray(point, dtype=float)
+    return any(min(np.linalg.norm(p - np.asarray(o.start)), np.linalg.norm(
+        p - np.asarray(o.end))) <= JOIN for o in edges if o is not edge and not o.closed)

@@ -128,6 +128,17 @@ def check_reference(surface_a, surface_b, points: np.ndarray, *, span: str,
     local = np.concatenate([np.arange(len(s[1])) for s in sampled])
     near = nearest(points, allpts)
     piece_of = owner[near]
+    # a piece met only by the path's first or last point is met where pieces join (a path
+    # starting or ending where two pieces meet): those points belong to the piece the path
+    # runs along
+    at_end = np.minimum(np.linalg.norm(points - points[0], axis=1),
+                        np.linalg.norm(points - points[-1], axis=1)) <= cover_radius
+    lone = [k for k in set(piece_of.tolist()) if at_end[piece_of == k].all()]
+    if lone and len(set(piece_of.tolist())) > len(lone):
+        keep = ~np.isin(owner, lone)
+        moved = np.isin(piece_of, lone)
+        near[moved] = np.flatnonzero(keep)[nearest(points[moved], allpts[keep])]
+        piece_of = owner[near]
     # the branch: the pieces the path runs along, in the order the path meets them
     order = sorted(set(piece_of.tolist()), key=lambda k: int(np.argmax(piece_of == k)))
     rep.branch_curves = order
