@@ -83,6 +83,7 @@ def judge(args, tp, part, what: str, gopts: dict | None = None) -> tuple[bool, i
     if write:
         moves = None if gopts is None else written_moves(tp, **gopts)
         gate = gouge_gate(tp, part, tp.job.tolerances, moves=moves,
+                          blend_mm=0.0 if gopts is None else gopts["blend"],
                           progress=stage_progress(args, f"{what}: gouge check", after_s=1.0))
         if not gate.ok:
             write, code = args.allow_gouge, GOUGE_REFUSED

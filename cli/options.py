@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 
 from cadcnc.errors import InputError
-from cadcnc.io.gcode import SAFE_MARGIN
+from cadcnc.io.gcode import SAFE_MARGIN, blend_for
 from cadcnc.job import Job, PairPath, Tool, check_number
 from cadcnc.tolerances import DEFAULT, Tolerances
 from cadcnc.units import parse_duration, parse_feed, parse_length, parse_point
@@ -65,7 +65,8 @@ def gcode_options(args, clearance_z: float | None, parts) -> dict:
     if clearance_z is None:
         clearance_z = max(part.top for part in parts) + SAFE_MARGIN
     spindle = None if args.spindle is None else check_number("--spindle", args.spindle, "rpm")
-    return dict(tolerance=tol, tool_tip=args.tool_tip, safe_z=clearance_z, spindle=spindle)
+    return dict(tolerance=tol, tool_tip=args.tool_tip, safe_z=clearance_z, spindle=spindle,
+                blend=blend_for(tolerances(args).gouge))
 
 
 def program_gcode_options(args) -> dict:
@@ -76,4 +77,5 @@ def program_gcode_options(args) -> dict:
     spindle = None if args.spindle is None else check_number("--spindle", args.spindle, "rpm")
     plunge = getattr(args, "plunge_feed", None)
     plunge = None if plunge is None else parse_feed(plunge, "plunge feed")
-    return dict(tolerance=tol, tool_tip=args.tool_tip, spindle=spindle, plunge_feed=plunge)
+    return dict(tolerance=tol, tool_tip=args.tool_tip, spindle=spindle, plunge_feed=plunge,
+                blend=blend_for(tolerances(args).gouge))

@@ -70,6 +70,7 @@ def judge_program(args, program, part, what: str, gopts: dict | None) -> tuple[b
         return write, code
     moves = None if gopts is None else program_written_moves(program, **gopts)
     gate = gate_program(program, part, program.job.tolerances, moves=moves,
+                        blend_mm=0.0 if gopts is None else gopts["blend"],
                         progress=stage_progress(args, f"{what}: gouge check", after_s=1.0))
     if gate.ok:
         return write, code

@@ -69,7 +69,7 @@ def test_program_structure(paths):
     text = to_ngc(paths["boss"], spindle=12000)
     lines = text.splitlines()
     assert lines[0] == "%" and lines[-1] == "%" and lines[-2] == "M2"
-    assert "G17 G21 G40 G90 G94" in lines and "G64 P0.001" in lines
+    assert "G17 G21 G40 G90 G94" in lines and "G64 P0.0001" in lines
     assert "F1500" in lines and "S12000 M3" in lines and "M5" in lines
     n = len(paths["boss"][0])
     assert sum(line.startswith("G1 ") for line in lines) == n  # one G1 per kept point

@@ -1,8 +1,8 @@
 """RS274/NGC (LinuxCNC dialect, plain enough for most 3-axis controls) from toolpaths.
 
 Conventions (docs/cli.md "G-code"): mm (G21), absolute (G90), XY plane (G17), feed per
-minute (G94), path blending ``G64 P<tolerance>``; the part's +Z is the spindle axis and the
-path is reached from above: rapid to a safe Z, rapid over the first point, rapid down to
+minute (G94), path blending ``G64 P<blend>`` (a tenth of the gouge limit, counted by the gate);
+the part's +Z is the spindle axis and the path is reached from above: rapid to a safe Z, rapid over the first point, rapid down to
 ``clearance`` above it, feed down onto it, one ``G1`` per kept point, rapid back up to the
 safe Z, ``M2``. The programmed point is the ball centre, or with ``tool_tip=True`` the tip
 of the ball (Z - R, R the cutter radius without allowance).
@@ -25,9 +25,28 @@ import numpy as np
 
 from ..errors import InputError
 from ..job import check_number
+from ..tolerances import DEFAULT as _DEFAULT_TOLERANCES
+
+DEFAULT_GOUGE = _DEFAULT_TOLERANCES.gouge  # mm: the default gouge limit
 from .atomic import write_text
 
 DEFAULT_TOLERANCE = 0.001  # mm
+BLEND_SHARE = 0.1
+"""G64 P (how far the machine may leave the programmed polyline when blending moves) is
+this share of the gouge limit; the gouge gate counts it: every written move must keep the
+ball within the limit less P of the part."""
+
+
+def blend_for(gouge_mm: float) -> float:
+    """The G64 P blending tolerance (mm) for a gouge limit (mm)."""
+    return BLEND_SHARE * gouge_mm
+
+
+def blend_word(blend: float) -> str:
+    """``G64 P<blend>`` with enough decimals to print ``blend`` (mm) exactly to 1e-7."""
+    if not (math.isfinite(blend) and blend > 0):
+        raise InputError(f"G64 P blending tolerance must be > 0 mm, got {blend!r}")
+    return f"G64 P{_num(blend, 7)}"
 CLEARANCE = 2.0  # mm above the first point where the rapid approach ends
 SAFE_MARGIN = 10.0  # mm above the highest point (part or path) for rapids
 
@@ -100,7 +119,7 @@ def programmed_points(path, tool_tip: bool = False) -> np.ndarray:
 
 def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
            safe_z: float | None = None, clearance: float = CLEARANCE,
-           spindle: float | None = None, title: str = "") -> str:
+           spindle: float | None = None, blend: float | None = None, title: str = "") -> str:
     """One RS274/NGC program machining ``paths`` (Toolpath objects) in order.
 
     ``tolerance`` (mm): drop points (see module doc); None keeps every point. ``safe_z``
@@ -140,7 +159,7 @@ def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
         _comment(f"tolerance {tol:g} mm ({'points dropped' if tolerance else 'every point kept'}"
                  f"); {digits} decimals"),
         "G17 G21 G40 G90 G94",
-        f"G64 P{_num(tol, digits)}",
+        blend_word(blend_for(DEFAULT_GOUGE) if blend is None else blend),
         f"G0 Z{n(safe_z)}",
     ]
     if spindle:

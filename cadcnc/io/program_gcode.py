@@ -20,12 +20,15 @@ import numpy as np
 from ..errors import InputError
 from ..job import check_number
 from ..program.program import Program
-from .gcode import _WORD, DEFAULT_TOLERANCE, _comment, _num, digits_for, simplify
+from .gcode import (
+    _WORD, DEFAULT_GOUGE, DEFAULT_TOLERANCE, _comment, _num, blend_for, blend_word, digits_for,
+    simplify,
+)
 
 
 def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: bool = False,
                 spindle: float | None = None, plunge_feed: float | None = None,
-                title: str = "") -> str:
+                blend: float | None = None, title: str = "") -> str:
     """One RS274/NGC program for ``program`` (see the module doc); InputError on a point
     or word that cannot be written."""
     if not program.segments:
@@ -57,7 +60,7 @@ def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: b
                  f"); {digits} decimals; feed {_num(feed, 3)}, plunge {_num(plunge, 3)} "
                  "mm/min"),
         "G17 G21 G40 G90 G94",
-        f"G64 P{_num(tol, digits)}",
+        blend_word(blend_for(DEFAULT_GOUGE) if blend is None else blend),
         f"G0 Z{n(first[2] - dz)}",
     ]
     if spindle:

@@ -318,3 +318,19 @@ def test_the_cli_gates_the_program_it_writes(tmp_path):
     assert oracle.max() > LIMIT   # the refusal is real
     assert cadcnc_cli(*args, "-o", tmp_path / "s.json").returncode == 0
     assert cadcnc_cli(*args[:-2], "-o", ngc).returncode == 0   # every point kept: passes
+
+
+def test_the_blending_tolerance_is_written_and_counted(tmp_path):
+    """G64 P is a tenth of the gouge limit, written in the program and counted by the CLI's
+    gate: a move must keep the ball within the limit less P."""
+    from conftest import FIXTURES
+    from test_cli import cadcnc_cli
+
+    boss = FIXTURES / "bspline_boss.step"
+    job = ("--faces", "4", "5", "--radius", "3", "--feed", "1500", "--period", "4ms")
+    ok = cadcnc_cli("path", boss, *job, "-o", tmp_path / "a.ngc", "--quiet")
+    assert ok.returncode == 0 and "G64 P0.0001\n" in (tmp_path / "a.ngc").read_text()
+    tight = cadcnc_cli("path", boss, *job, "--gouge-tolerance", "1e-6", "-o",
+                       tmp_path / "b.ngc", "--quiet", check=5)
+    assert tight.returncode == 5 and "less the blending tolerance 1e-07 mm" in tight.stderr
+    assert not (tmp_path / "b.ngc").exists()
