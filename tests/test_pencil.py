@@ -70,3 +70,39 @@ def test_every_move_clears_the_part(name):
 def test_side_is_checked():
     with pytest.raises(cadcnc.InputError, match="side"):
         pencil(load_fixture("pocket"), radius=3.0, side="up")
+
+
+def test_cadquery_example_runs_as_script_and_under_cq_editor(capsys):
+    """docs/examples/pencil_example.py: a Workplane in, wires out through the cut points."""
+    import runpy
+
+    from conftest import ROOT
+
+    example = str(ROOT / "docs" / "examples" / "pencil_example.py")
+    shown = {}
+    ns = runpy.run_path(example, init_globals={
+        "show_object": lambda obj, name="", options=None: shown.__setitem__(name, obj)})
+    prog = ns["program"]
+    assert set(shown) == {"part", "cuts", "links"} and prog.complete and len(prog.cuts) >= 4
+    wires = cadcnc.to_cq(prog, links=False)
+    assert len(wires) == len(prog.cuts)
+    for w, cut in zip(wires, prog.cuts):
+        ends = np.array([w.startPoint().toTuple(), w.endPoint().toTuple()])
+        np.testing.assert_allclose(ends, cut.points[[0, -1]], atol=1e-3)
+        assert w.Length() == pytest.approx(cut.length, abs=1e-3)
+    assert len(shown["links"].Wires()) == len(cadcnc.to_cq(prog, cuts=False))
+    runpy.run_path(example, run_name="__main__")  # as a plain script: prints the summary
+    assert "pencil R 2:" in capsys.readouterr().out
+
+
+def test_pencil_takes_a_cadquery_shape():
+    import cadquery as cq
+
+    step = cq.Workplane("XY").box(20, 10, 10).faces(">Z").workplane().center(5, 0).rect(
+        10, 10).cutBlind(-4)  # a step: one concave edge, 10 mm long
+    part_prog = cadcnc.pencil(cadcnc.Part.from_cadquery(step.val()), radius=2.0)
+    shape_prog = cadcnc.pencil(step.val(), radius=2.0)
+    work_prog = cadcnc.pencil(step, radius=2.0)
+    assert len(part_prog.cuts) == 1 and part_prog.cut_length == pytest.approx(10, abs=0.1)
+    for other in (shape_prog, work_prog):
+        np.testing.assert_array_equal(other.cuts[0].points, part_prog.cuts[0].points)

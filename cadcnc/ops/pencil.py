@@ -23,6 +23,7 @@ from dataclasses import replace
 
 from ..errors import CadcncError, InputError
 from ..geometry.clearance import guard_for
+from ..geometry.part import Part
 from ..job import Job, PairPath, Tool
 from ..program.linking import linked, order_cuts
 from ..program.program import CutSegment, Program, Skipped
@@ -42,8 +43,9 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
            period: float = DEFAULT_PERIOD, faces=None, clearance: float | None = None,
            shank_length: float | None = None, side: str = CLIMB,
            tol: Tolerances = DEFAULT, progress=None) -> Program:
-    """The pencil program of ``part`` (a :class:`~cadcnc.geometry.part.Part`) for a ball of
-    radius ``radius`` (mm) with ``allowance`` (mm): see the module doc.
+    """The pencil program of ``part`` (a :class:`~cadcnc.geometry.part.Part`, or a CadQuery
+    Workplane or Shape, read with :meth:`Part.from_cadquery`) for a ball of radius
+    ``radius`` (mm) with ``allowance`` (mm): see the module doc.
 
     ``faces``: face numbers to restrict the corners to (both faces of a corner must be
     among them); ``clearance``: ball-centre Z of the links (default the part's top + 10
@@ -52,6 +54,8 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
     """
     if side not in (CLIMB, CONVENTIONAL):
         raise InputError(f"side must be {CLIMB!r} or {CONVENTIONAL!r}, got {side!r}")
+    if not isinstance(part, Part):
+        part = Part.from_cadquery(part, tol)
     tool = Tool(radius, allowance, shank_length)
     job = Job(tool, feed, period, PairPath(edge=None), source=part.source,
               clearance=clearance, tolerances=tol)
