@@ -31,7 +31,7 @@ from ..tolerances import DEFAULT, Tolerances
 from .corners import BLEND, EDGE, find_corners
 from .pair_program import CLIMB, CONVENTIONAL, _run, safe_height, stretch_cuts
 from .pair_path import plan_path
-from .stretches import pair_stretches
+from .stretches import Feasibility, edge_stretches, pair_stretches
 
 CHAIN_GAP = 1e-3
 """mm: a cut starting this near another's end continues it (no lift)."""
@@ -77,6 +77,14 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
                 new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
                 cuts += new
                 skipped += why
+            elif corner.kind == BLEND and len(corner.rails) == 1:
+                # the ball's stretches anchored on planes normal to the blend's rail on a
+                found = [edge_stretches(Feasibility(s1, s2, cjob, guard), corner.rails[0], 0)]
+                new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
+                cuts += new
+                skipped += [replace(w, detail=f"blend corner over face(s) "
+                                    f"{', '.join(map(str, corner.blend_faces))}: {w.detail}")
+                            for w in why]
             elif corner.kind == BLEND:
                 cut = _blend_cut(s1, s2, cjob, corner, guard)
                 if len(cut.points) < 2:
