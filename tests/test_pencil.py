@@ -83,7 +83,9 @@ def test_cadquery_example_runs_as_script_and_under_cq_editor(capsys):
     ns = runpy.run_path(example, init_globals={
         "show_object": lambda obj, name="", options=None: shown.__setitem__(name, obj)})
     prog = ns["program"]
-    assert set(shown) == {"part", "cuts", "links"} and prog.complete and len(prog.cuts) >= 4
+    assert set(shown) == {"part", "cuts", "links"} and prog.complete
+    # the round pocket r 8 (ball centres on r 6, once around) and the step, 30 mm across
+    assert sorted(c.length for c in prog.cuts) == pytest.approx([30.0, 12 * np.pi], abs=0.01)
     wires = cadcnc.to_cq(prog, links=False)
     assert len(wires) == len(prog.cuts)
     for w, cut in zip(wires, prog.cuts):

@@ -1,8 +1,7 @@
 """Pencil milling inside a CadQuery script: runs under CQ-editor and as a plain script.
 
-A block with a rectangular pocket whose vertical corners are rounded (r 4 mm, larger
-than the ball, so the ball rolls on them): a 2 mm ball cleans the pocket's floor-to-wall
-corners. ``cadcnc.pencil`` takes the Workplane itself; ``cadcnc.to_cq`` turns the
+A block with a round pocket (r 8 mm, 5 deep) and a step along one side: a 2 mm ball
+cleans the pocket's floor-to-wall corner (one closed loop) and the step's corner. ``cadcnc.pencil`` takes the Workplane itself; ``cadcnc.to_cq`` turns the
 program into wires for ``show_object``. Run: ``python docs/examples/pencil_example.py``.
 """
 
@@ -11,8 +10,8 @@ import cadquery as cq
 import cadcnc
 
 block = (cq.Workplane("XY").box(40, 30, 12)
-         .faces(">Z").workplane().rect(24, 16).cutBlind(-5)
-         .edges("|Z and (not <X) and (not >X) and (not <Y) and (not >Y)").fillet(4))
+         .faces(">Z").workplane().center(-5, 0).circle(8).cutBlind(-5)
+         .faces(">Z").workplane().center(22, 0).rect(6, 40).cutBlind(-4))
 
 program = cadcnc.pencil(block, radius=2.0)
 totals = program.totals()
