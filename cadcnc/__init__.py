@@ -31,6 +31,8 @@ _LAZY = {
     "Toolpath": "program.toolpath",
     "VerificationReport": "verification", "verify": "verification",
     "gouge_gate": "verification",
+    "pencil": "ops.pencil", "Program": "program.program",
+    "to_cq": "io.program_cq", "to_cq_compound": "io.program_cq",
 }
 
 __all__ = [

@@ -44,7 +44,7 @@ def demo_program(step: Path, job: Job) -> str:
 
 
 FILES = ("path.json", "path.csv", "path.ngc", "demo.apt", "verification.txt",
-         "verification.json", "path.png")
+         "verification.json", "path.png", "pencil.json", "pencil.png")
 
 
 def demo(args) -> int:
@@ -75,6 +75,16 @@ def demo(args) -> int:
     contents[out / "verification.json"] = json.dumps(d, indent=1) + "\n"
     contents[out / "path.png"] = picture_bytes(tp, part, "path.png",
                                                title=f"demo: faces {i} and {j} of {step.name}")
+    from cadcnc.io.program_json import program_json
+    from cadcnc.io.program_plot import program_picture_bytes
+    from cadcnc.ops.pencil import pencil
+
+    pen = pencil(part, radius=job.tool.radius)  # every corner of the part, linked
+    say(f"pencil R {job.tool.radius:g}: {len(pen.cuts)} cuts, {pen.cut_length:.1f} mm cut, "
+        f"{pen.link_length:.1f} mm of links, {len(pen.skipped)} corners skipped")
+    contents[out / "pencil.json"] = program_json(pen)
+    contents[out / "pencil.png"] = program_picture_bytes(pen, part, "pencil.png",
+                                                         f"demo: pencil of {step.name}")
     outputs.write(contents)
     say(f"wrote {out}/: " + ", ".join(sorted(FILES)))
     return 0 if report.ok() else 5

@@ -255,7 +255,12 @@ def demo_run(tmp_path_factory):
 def test_demo_writes_everything(demo_run, boss_api):
     out, run = demo_run
     names = {p.name for p in out.iterdir()}
-    assert {"path.json", "path.csv", "path.ngc", "path.png", "demo.apt"} <= names
+    assert {"path.json", "path.csv", "path.ngc", "path.png", "demo.apt", "pencil.json",
+            "pencil.png"} <= names
+    from cadcnc.io.program_json import read_program
+
+    pen = read_program(out / "pencil.json")
+    assert len(pen.cuts) == 1 and pen.complete and "pencil R 3: 1 cuts" in run.stdout
     assert f"wrote {out}/" in run.stdout
     np.testing.assert_array_equal(read_json(out / "path.json").points, boss_api.points)
     assert (out / "path.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -70,3 +70,64 @@ def test_every_move_clears_the_part(name):
 def test_side_is_checked():
     with pytest.raises(cadcnc.InputError, match="side"):
         pencil(load_fixture("pocket"), radius=3.0, side="up")
+
+
+def test_cadquery_example_runs_as_script_and_under_cq_editor(capsys):
+    """docs/examples/pencil_example.py: a Workplane in, wires out through the cut points."""
+    import runpy
+
+    from conftest import ROOT
+
+    example = str(ROOT / "docs" / "examples" / "pencil_example.py")
+    shown = {}
+    ns = runpy.run_path(example, init_globals={
+        "show_object": lambda obj, name="", options=None: shown.__setitem__(name, obj)})
+    prog = ns["program"]
+    assert set(shown) == {"part", "cuts", "links"} and prog.complete
+    # the round pocket r 8 (ball centres on r 6, once around) and the step, 30 mm across
+    assert sorted(c.length for c in prog.cuts) == pytest.approx([30.0, 12 * np.pi], abs=0.01)
+    wires = cadcnc.to_cq(prog, links=False)
+    assert len(wires) == len(prog.cuts)
+    for w, cut in zip(wires, prog.cuts):
+        ends = np.array([w.startPoint().toTuple(), w.endPoint().toTuple()])
+        np.testing.assert_allclose(ends, cut.points[[0, -1]], atol=1e-3)
+        assert w.Length() == pytest.approx(cut.length, abs=1e-3)
+    assert len(shown["links"].Wires()) == len(cadcnc.to_cq(prog, cuts=False))
+    runpy.run_path(example, run_name="__main__")  # as a plain script: prints the summary
+    assert "pencil R 2:" in capsys.readouterr().out
+
+
+def test_pencil_takes_a_cadquery_shape():
+    import cadquery as cq
+
+    step = cq.Workplane("XY").box(20, 10, 10).faces(">Z").workplane().center(5, 0).rect(
+        10, 10).cutBlind(-4)  # a step: one concave edge, 10 mm long
+    part_prog = cadcnc.pencil(cadcnc.Part.from_cadquery(step.val()), radius=2.0)
+    shape_prog = cadcnc.pencil(step.val(), radius=2.0)
+    work_prog = cadcnc.pencil(step, radius=2.0)
+    assert len(part_prog.cuts) == 1 and part_prog.cut_length == pytest.approx(10, abs=0.1)
+    for other in (shape_prog, work_prog):
+        np.testing.assert_array_equal(other.cuts[0].points, part_prog.cuts[0].points)
+
+
+def test_blend_corners_are_cut_by_stretches_between_their_limits():
+    """fillet_pocket (fixtures/build_pencil_fixtures.py: pocket x -25..25, y -18..18,
+    floor z 18, floor fillet r 1.5, vertical fillets r 2 at x = 25 and r 5 at x = -25), R'
+    3: across the floor fillet the ball sits R' from wall and floor (z 21, 3 mm inside the
+    wall); each wall's corner runs from where the r 5 fillet begins (x -20) to where the
+    ball touches the x = 25 wall (x 22), the x = 25 wall's between the y = +-18 walls
+    (y +-15); across the r 2 vertical fillets the ball runs from the floor (z 21) to the
+    top (z 30). Before stretches, the floor blends next to the r 2 fillets were skipped
+    (their first seed blocked by the next wall)."""
+    _, prog = program_of("fillet_pocket")
+    ends = {tuple(sorted(c.path.faces)): c.points[[0, -1]] for c in prog.cuts}
+    want = {(10, 23): [(-20, -15, 21), (22, -15, 21)], (14, 23): [(-20, 15, 21), (22, 15, 21)],
+            (12, 23): [(22, -15, 21), (22, 15, 21)], (10, 12): [(22, -15, 21), (22, -15, 30)],
+            (12, 14): [(22, 15, 21), (22, 15, 30)], (8, 23): [(-22, -13, 21), (-22, 13, 21)]}
+    for pair, pts in want.items():
+        got = ends[pair]
+        if np.linalg.norm(got[0] - pts[0]) > np.linalg.norm(got[0] - pts[1]):
+            got = got[::-1]  # the side rule may run it either way
+        np.testing.assert_allclose(got, np.array(pts, float), atol=1e-3, err_msg=str(pair))
+    assert not any(s.faces in ((10, 23), (12, 23)) for s in prog.skipped)
+    assert prog.complete

@@ -18,7 +18,7 @@ whose rails reach other than two faces (``blend_rails``), faces left out by ``fa
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -43,7 +43,8 @@ class Corner:
 
     ``seeds``: tuple of (3,) ball centres (mm) at the blend's ends (one for a closed blend,
     none for an edge corner); ``radius``: the blend's largest radius (mm); ``length``: the
-    edge's or the rail's length (mm); ``skip`` None for a corner to cut.
+    edge's or the rail's length (mm); ``skip`` None for a corner to cut; ``rails``: a
+    blend corner's rail edges on face a (SharedEdge), where its stretches are anchored.
     """
 
     kind: str
@@ -56,6 +57,7 @@ class Corner:
     closed: bool = False
     skip: str | None = None
     detail: str = ""
+    rails: tuple = field(default=(), repr=False, compare=False)
 
     @property
     def cut(self) -> bool:
@@ -248,7 +250,7 @@ def _group_corner(part: Part, blends: dict[int, Blend], group: list[int],
     rails_b = [e for n in group for m, e in blends[n].rails if m == b]
     r = max(blends[n].r_max for n in group)
     corner = Corner(BLEND, pair, blend_faces=tuple(group), radius=r,
-                    length=float(sum(e.length for e in rails_a)))
+                    length=float(sum(e.length for e in rails_a)), rails=tuple(rails_a))
     ends_a = _free_ends(rails_a)
     closed = not ends_a
     if closed:

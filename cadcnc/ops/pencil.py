@@ -23,6 +23,7 @@ from dataclasses import replace
 
 from ..errors import CadcncError, InputError
 from ..geometry.clearance import guard_for
+from ..geometry.part import Part
 from ..job import Job, PairPath, Tool
 from ..program.linking import linked, order_cuts
 from ..program.program import CutSegment, Program, Skipped
@@ -30,7 +31,7 @@ from ..tolerances import DEFAULT, Tolerances
 from .corners import BLEND, EDGE, find_corners
 from .pair_program import CLIMB, CONVENTIONAL, _run, safe_height, stretch_cuts
 from .pair_path import plan_path
-from .stretches import pair_stretches
+from .stretches import Feasibility, edge_stretches, pair_stretches
 
 CHAIN_GAP = 1e-3
 """mm: a cut starting this near another's end continues it (no lift)."""
@@ -42,8 +43,9 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
            period: float = DEFAULT_PERIOD, faces=None, clearance: float | None = None,
            shank_length: float | None = None, side: str = CLIMB,
            tol: Tolerances = DEFAULT, progress=None) -> Program:
-    """The pencil program of ``part`` (a :class:`~cadcnc.geometry.part.Part`) for a ball of
-    radius ``radius`` (mm) with ``allowance`` (mm): see the module doc.
+    """The pencil program of ``part`` (a :class:`~cadcnc.geometry.part.Part`, or a CadQuery
+    Workplane or Shape, read with :meth:`Part.from_cadquery`) for a ball of radius
+    ``radius`` (mm) with ``allowance`` (mm): see the module doc.
 
     ``faces``: face numbers to restrict the corners to (both faces of a corner must be
     among them); ``clearance``: ball-centre Z of the links (default the part's top + 10
@@ -52,6 +54,8 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
     """
     if side not in (CLIMB, CONVENTIONAL):
         raise InputError(f"side must be {CLIMB!r} or {CONVENTIONAL!r}, got {side!r}")
+    if not isinstance(part, Part):
+        part = Part.from_cadquery(part, tol)
     tool = Tool(radius, allowance, shank_length)
     job = Job(tool, feed, period, PairPath(edge=None), source=part.source,
               clearance=clearance, tolerances=tol)
@@ -73,6 +77,14 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
                 new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
                 cuts += new
                 skipped += why
+            elif corner.kind == BLEND and len(corner.rails) == 1:
+                # the ball's stretches anchored on planes normal to the blend's rail on a
+                found = [edge_stretches(Feasibility(s1, s2, cjob, guard), corner.rails[0], 0)]
+                new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
+                cuts += new
+                skipped += [replace(w, detail=f"blend corner over face(s) "
+                                    f"{', '.join(map(str, corner.blend_faces))}: {w.detail}")
+                            for w in why]
             elif corner.kind == BLEND:
                 cut = _blend_cut(s1, s2, cjob, corner, guard)
                 if len(cut.points) < 2:

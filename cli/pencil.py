@@ -1,0 +1,180 @@
+"""``cadcnc pencil``: every inner corner of a part in one program, gated, written all at once.
+
+Options are defined here (registered by :mod:`cadcnc.cli.app` with :func:`add_parser`).
+Exit codes like ``path``: 0 for a complete program that passed the gouge gate (every cut,
+then every move of the whole program, links included, as written), 5 a gouge, 6 partial
+(a cut stopped short), with ``--allow-gouge`` / ``--allow-partial`` to write anyway.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import time
+from pathlib import Path
+
+from cadcnc.errors import InputError  # light: OCCT is imported in pencil_command
+from cadcnc.units import parse_duration, parse_feed, parse_length
+
+from .feedback import say_error, stage_progress
+
+GOUGE_REFUSED = 5
+PARTIAL = 6
+SUFFIXES = (".json", ".ngc", ".csv", ".png", ".glb")
+DEFAULT_FEED = "1500"  # mm/min; equal to cadcnc.ops.pencil.DEFAULT_FEED (a test checks)
+DEFAULT_PERIOD = "4ms"  # equal to cadcnc.ops.pencil.DEFAULT_PERIOD (a test checks)
+
+
+def add_parser(add, job_flip, gouge, gcode) -> None:
+    """Register ``pencil`` with ``add(name, help, description)`` and the shared option
+    groups of :mod:`cadcnc.cli.app` (flip-material, gouge gate, G-code)."""
+    p = add("pencil", "clean every inner corner of a part in one program",
+            "Find every concave corner of the part a ball of radius R' = R + C can clean "
+            "(shared concave edges, blends smaller than the ball), cut every feasible "
+            "stretch, chain and link them, gate the whole program and write it: .json "
+            "(program), .ngc, .csv (a row per cut point), .png or .glb (picture).")
+    p.add_argument("step", metavar="PART.step", help="the part (STEP file, mm)")
+    p.add_argument("--radius", required=True, metavar="R", help="ball radius, mm")
+    p.add_argument("--allowance", default="0", metavar="C",
+                   help="stock allowance left on every face, mm (default 0)")
+    p.add_argument("--feed", default=DEFAULT_FEED, metavar="F",
+                   help=f"feed, mm/min (default {DEFAULT_FEED})")
+    p.add_argument("--period", default=DEFAULT_PERIOD, metavar="T",
+                   help=f"interpolation period with its unit (default {DEFAULT_PERIOD}: "
+                        "a 0.1 mm step at 1500 mm/min)")
+    p.add_argument("--faces", nargs="+", type=int, metavar="N",
+                   help="only corners whose two faces are among these (default: all)")
+    p.add_argument("--side", choices=("climb", "conventional"), default="climb",
+                   help="direction along the corners (default climb: material on the "
+                        "right of the travel, clockwise spindle)")
+    p.add_argument("--plunge-feed", metavar="F",
+                   help="feed of the plunges in the links, mm/min (default: --feed)")
+    p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
+                   help="output: .json, .ngc, .csv, .png or .glb; repeat for several")
+    job_flip(p)
+    gouge(p)
+    gcode(p)
+
+
+def program_csv(program) -> str:
+    """One row per cut point: segment number (1-based among all segments), faces, x y z."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["segment", "face_i", "face_j", "x_mm", "y_mm", "z_mm"])
+    for k, seg in enumerate(program.segments, 1):
+        if seg.kind != "cut":
+            continue
+        i, j = seg.path.faces
+        for p in seg.points:
+            w.writerow([k, i, j, f"{p[0]:.6f}", f"{p[1]:.6f}", f"{p[2]:.6f}"])
+    return buf.getvalue()
+
+
+def pencil_command(args) -> int:
+    import cadcnc
+    from cadcnc.io.output_set import OutputSet
+    from cadcnc.io.program_gcode import program_ngc
+    from cadcnc.io.program_json import program_json
+    from cadcnc.io.program_plot import program_picture_bytes
+    from cadcnc.ops.pencil import pencil
+
+    from .options import clearance, tolerances
+
+    outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])
+    radius = parse_length(args.radius, "radius", allow_zero=False)
+    allowance = parse_length(args.allowance, "allowance")
+    feed, period = parse_feed(args.feed), parse_duration(args.period)
+    plunge = None if args.plunge_feed is None else parse_feed(args.plunge_feed, "plunge feed")
+    tol = tolerances(args)
+    t0 = time.monotonic()
+    part = cadcnc.load_step(args.step, flip_material=args.flip_material)
+    for n in args.faces or ():
+        part.face(n)  # face numbers checked before anything is computed
+    report = None if args.quiet else (
+        lambda done, total, what: say_error(f"cadcnc: pencil: corner {done}/{total} ({what})"))
+    program = pencil(part, radius=radius, allowance=allowance, feed=feed, period=period,
+                     faces=None if args.faces is None else set(args.faces),
+                     clearance=clearance(args), side=args.side, tol=tol, progress=report)
+    t_cut = time.monotonic() - t0
+    if not program.cuts:
+        raise InputError(f"{args.step}: no corner to cut with a {radius:g} mm ball "
+                         f"({_skipped_line(program) or 'no concave corner found'})")
+    title = f"pencil R {radius:g} of {Path(args.step).name}"
+    gopts = dict(tolerance=None if args.tolerance is None
+                 else parse_length(args.tolerance, "tolerance", False),
+                 tool_tip=args.tool_tip, spindle=args.spindle, plunge_feed=plunge)
+    ngc = program_ngc(program, title=title, **gopts)
+    write, code = _judge(args, program, part, ngc)
+    if not args.quiet:
+        print(_summary(program, args.step, time.monotonic() - t0, t_cut))
+    if not write:
+        return code
+    contents = {}
+    for out in args.output:
+        suffix = Path(out).suffix.lower()
+        contents[out] = (program_json(program) if suffix == ".json" else ngc
+                         if suffix == ".ngc" else program_csv(program) if suffix == ".csv"
+                         else program_picture_bytes(program, part, out, title))
+    outputs.write(contents)
+    if not args.quiet:
+        print(f"  wrote      {', '.join(args.output)}")
+    return code
+
+
+def _judge(args, program, part, ngc: str) -> tuple[bool, int]:
+    """(write?, exit code): partial -> 6, any cut or the program's written moves (links
+    included, rounding and dropped points as in the G-code) gouging -> 5."""
+    from cadcnc.io.gcode import programmed_moves
+    from cadcnc.verification import gouge_gate
+
+    write, code = True, 0
+    if not program.complete:
+        write, code = args.allow_partial, PARTIAL
+        say_error("cadcnc: pencil: partial: " + "; ".join(program.partial_reasons or [
+            "a stretch stopped short"]) + ("" if write else
+                                           "; nothing written (--allow-partial writes it)"))
+    if not write:
+        return write, code
+    dz = program.job.tool.radius if args.tool_tip else 0.0
+    moves = programmed_moves(ngc, dz)
+    cuts = program.cuts
+    for k, cut in enumerate(cuts):
+        gate = gouge_gate(cut.path, part, program.job.tolerances,
+                          moves=moves if k == len(cuts) - 1 else None,
+                          progress=stage_progress(args, f"pencil: gouge check {k + 1}/"
+                                                        f"{len(cuts)}", after_s=2.0))
+        if not gate.ok:
+            write, code = args.allow_gouge, GOUGE_REFUSED
+            i, j = cut.path.faces
+            say_error(f"cadcnc: pencil: cut {k + 1} (faces {i} {j}"
+                      f"{', with every move of the program' if k == len(cuts) - 1 else ''}"
+                      f"): {gate.message}" + ("; written anyway (--allow-gouge)" if write
+                                               else ". --allow-gouge writes it"))
+            break
+    return write, code
+
+
+def _skipped_line(program) -> str:
+    counts: dict[str, int] = {}
+    for s in program.skipped:
+        counts[s.reason] = counts.get(s.reason, 0) + 1
+    return ", ".join(f"{n} {r}" for r, n in sorted(counts.items()))
+
+
+def _summary(program, step: str, seconds: float, t_cut: float) -> str:
+    job = program.job
+    segs = program.segments
+    chains = sum(1 for a, b in zip(segs, segs[1:])  # a lift (rapid) before a cut
+                 if a.kind == "link" and a.rapid.any() and b.kind == "cut")
+    t = program.totals()
+    return "\n".join([
+        f"{Path(step).name}: pencil, ball R {job.tool.radius:g} mm + allowance "
+        f"{job.tool.allowance:g} mm, feed {job.feed:g} mm/min, period "
+        f"{job.period * 1000:g} ms (step {job.feed / 60 * job.period:.3g} mm)",
+        f"  corners    {len(program.cuts)} cuts in {chains} chains; skipped "
+        f"{len(program.skipped)}" + (f" ({_skipped_line(program)})" if program.skipped else ""),
+        f"  lengths    cut {t['cut_length_mm']:.1f} mm, links {t['link_length_mm']:.1f} mm; "
+        f"time at feed {t['time_at_feed_s']:.1f} s",
+        f"  status     {'complete' if program.complete else 'partial'}; computed in "
+        f"{t_cut:.1f} s, gated and written in {seconds - t_cut:.1f} s",
+    ])

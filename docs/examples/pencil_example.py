@@ -1,0 +1,31 @@
+"""Pencil milling inside a CadQuery script: runs under CQ-editor and as a plain script.
+
+A block with a round pocket (r 8 mm, 5 deep) and a step along one side: a 2 mm ball
+cleans the pocket's floor-to-wall corner (one closed loop) and the step's corner. ``cadcnc.pencil`` takes the Workplane itself; ``cadcnc.to_cq`` turns the
+program into wires for ``show_object``. Run: ``python docs/examples/pencil_example.py``.
+"""
+
+import cadquery as cq
+
+import cadcnc
+
+block = (cq.Workplane("XY").box(40, 30, 12)
+         .faces(">Z").workplane().center(-5, 0).circle(8).cutBlind(-5)
+         .faces(">Z").workplane().center(22, 0).rect(6, 40).cutBlind(-4))
+
+program = cadcnc.pencil(block, radius=2.0)
+totals = program.totals()
+summary = (f"pencil R 2: {totals['cuts']} cuts, {totals['cut_length_mm']:.1f} mm cut, "
+           f"{totals['link_length_mm']:.1f} mm of links, {totals['time_at_feed_s']:.1f} s "
+           f"at feed; {len(program.skipped)} corners skipped")
+
+if "show_object" in globals():  # CQ-editor
+    show_object(block, name="part", options={"alpha": 0.6})  # noqa: F821
+    show_object(cadcnc.to_cq_compound(program, links=False), name="cuts",  # noqa: F821
+                options={"color": "red"})
+    show_object(cadcnc.to_cq_compound(program, cuts=False), name="links",  # noqa: F821
+                options={"color": "blue"})
+else:
+    print(summary)
+    for s in program.skipped:
+        print(f"  skipped faces {s.faces}: {s.reason}")
