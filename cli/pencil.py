@@ -16,10 +16,8 @@ from pathlib import Path
 from cadcnc.errors import InputError  # light: OCCT is imported in pencil_command
 from cadcnc.units import parse_duration, parse_feed, parse_length
 
-from .feedback import say_error, stage_progress
+from .feedback import say_error
 
-GOUGE_REFUSED = 5
-PARTIAL = 6
 SUFFIXES = (".json", ".ngc", ".csv", ".png", ".glb")
 DEFAULT_FEED = "1500"  # mm/min; equal to cadcnc.ops.pencil.DEFAULT_FEED (a test checks)
 DEFAULT_PERIOD = "4ms"  # equal to cadcnc.ops.pencil.DEFAULT_PERIOD (a test checks)
@@ -78,13 +76,13 @@ def pencil_command(args) -> int:
     from cadcnc.io.program_plot import program_picture_bytes
     from cadcnc.ops.pencil import pencil
 
-    from .options import clearance, tolerances
+    from .options import clearance, program_gcode_options, tolerances
+    from .program_commands import judge_program
 
     outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])
     radius = parse_length(args.radius, "radius", allow_zero=False)
     allowance = parse_length(args.allowance, "allowance")
     feed, period = parse_feed(args.feed), parse_duration(args.period)
-    plunge = None if args.plunge_feed is None else parse_feed(args.plunge_feed, "plunge feed")
     tol = tolerances(args)
     t0 = time.monotonic()
     part = cadcnc.load_step(args.step, flip_material=args.flip_material)
@@ -100,11 +98,9 @@ def pencil_command(args) -> int:
         raise InputError(f"{args.step}: no corner to cut with a {radius:g} mm ball "
                          f"({_skipped_line(program) or 'no concave corner found'})")
     title = f"pencil R {radius:g} of {Path(args.step).name}"
-    gopts = dict(tolerance=None if args.tolerance is None
-                 else parse_length(args.tolerance, "tolerance", False),
-                 tool_tip=args.tool_tip, spindle=args.spindle, plunge_feed=plunge)
+    gopts = program_gcode_options(args)
     ngc = program_ngc(program, title=title, **gopts)
-    write, code = _judge(args, program, part, ngc)
+    write, code = judge_program(args, program, part, "pencil", gopts)
     if not args.quiet:
         print(_summary(program, args.step, time.monotonic() - t0, t_cut))
     if not write:
@@ -119,39 +115,6 @@ def pencil_command(args) -> int:
     if not args.quiet:
         print(f"  wrote      {', '.join(args.output)}")
     return code
-
-
-def _judge(args, program, part, ngc: str) -> tuple[bool, int]:
-    """(write?, exit code): partial -> 6, any cut or the program's written moves (links
-    included, rounding and dropped points as in the G-code) gouging -> 5."""
-    from cadcnc.io.gcode import programmed_moves
-    from cadcnc.verification import gouge_gate
-
-    write, code = True, 0
-    if not program.complete:
-        write, code = args.allow_partial, PARTIAL
-        say_error("cadcnc: pencil: partial: " + "; ".join(program.partial_reasons or [
-            "a stretch stopped short"]) + ("" if write else
-                                           "; nothing written (--allow-partial writes it)"))
-    if not write:
-        return write, code
-    dz = program.job.tool.radius if args.tool_tip else 0.0
-    moves = programmed_moves(ngc, dz)
-    cuts = program.cuts
-    for k, cut in enumerate(cuts):
-        gate = gouge_gate(cut.path, part, program.job.tolerances,
-                          moves=moves if k == len(cuts) - 1 else None,
-                          progress=stage_progress(args, f"pencil: gouge check {k + 1}/"
-                                                        f"{len(cuts)}", after_s=2.0))
-        if not gate.ok:
-            write, code = args.allow_gouge, GOUGE_REFUSED
-            i, j = cut.path.faces
-            say_error(f"cadcnc: pencil: cut {k + 1} (faces {i} {j}"
-                      f"{', with every move of the program' if k == len(cuts) - 1 else ''}"
-                      f"): {gate.message}" + ("; written anyway (--allow-gouge)" if write
-                                               else ". --allow-gouge writes it"))
-            break
-    return write, code
 
 
 def _skipped_line(program) -> str:
