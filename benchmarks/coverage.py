@@ -95,20 +95,30 @@ def run_pair(task: dict) -> dict:
                     feasible.append(v["p"])
             rec["edges"].append({"edge": e.index, "length_mm": round(e.length, 4),
                                  "verdicts": dict(counts)})
-        runs = [run_path(step, faces, radius, task["feed"], task["period"], task["timeout"])]
-        if runs[0]["version"] in (None, 1):  # version 1 writes one edge per run
+        via = task.get("via", "cli")
+        runs = [run_path(step, faces, radius, task["feed"], task["period"], task["timeout"],
+                         via=via)]
+        if via == "cli" and runs[0]["version"] in (None, 1):  # v1: one edge per run
             for k in range(2, len(edges) + 1):
                 runs.append(run_path(step, faces, radius, task["feed"], task["period"],
                                      task["timeout"], edge=k))
         polylines = [line for r in runs for line in r["polylines"]]
-        for name, pts in (("covered", feasible), ("covered_ball", ball)):
-            if pts and polylines:
-                d = distance_to_polylines(np.asarray(pts), polylines)
+        refused = polylines + [line for r in runs for line in r["refused_polylines"]]
+        for name, pts, lines in (("covered", feasible, polylines),
+                                 ("covered_ball", ball, polylines),
+                                 ("covered_ungated", feasible, refused)):
+            if pts and lines:
+                d = distance_to_polylines(np.asarray(pts), lines)
                 rec[name] = int(np.count_nonzero(d <= COVERED))
+        if feasible:  # a few feasible positions left uncovered, for follow-up
+            d = (distance_to_polylines(np.asarray(feasible), polylines) if polylines
+                 else np.full(len(feasible), np.inf))
+            rec["uncovered"] = [[round(float(x), 6) for x in feasible[k]]
+                                for k in np.flatnonzero(d > COVERED)[::7][:6]]
         rec["feasible"], rec["feasible_ball"] = len(feasible), len(ball)
         if polylines:
             rec["path_check"] = judge_path(o, faces, polylines, offset, task["check_points"])
-        rec["runs"] = [{k: v for k, v in r.items() if k != "polylines"}
+        rec["runs"] = [{k: v for k, v in r.items() if k not in ("polylines", "refused_polylines")}
                        | {"points": sum(len(x) for x in r["polylines"])} for r in runs]
     except Exception as exc:  # noqa: BLE001 - the judge's own failure is reported per pair
         rec["error"] = f"{type(exc).__name__}: {exc}"
@@ -142,7 +152,7 @@ def tasks_for(args) -> tuple[list[dict], list[dict]]:
               + (f" ({problem})" if problem else ""), file=sys.stderr, flush=True)
         for radius in args.radius:
             for faces in spread(pairs, args.max_pairs):
-                tasks.append({"step": str(f), "name": f.name, "faces": faces,
+                tasks.append({"step": str(f), "name": f.name, "faces": faces, "via": args.via,
                               "radius": radius, "feed": args.feed, "period": args.period,
                               "timeout": args.timeout, "max_samples": args.max_samples,
                               "check_points": args.check_points})
@@ -212,6 +222,9 @@ def main(argv=None) -> int:
     ap.add_argument("--check-points", type=int, default=100,
                     help="written points judged per cut polyline at most (silent-bad)")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--via", choices=("cli", "api"), default="cli",
+                    help="cli: `cadcnc path`; api: the program pipeline (program_for_job, "
+                    "gate per cut) through benchmarks/coverage_run_pair.py")
     ap.add_argument("--json", help="write per-pair records here")
     ap.add_argument("--table", metavar="JSON", help="print the table of an earlier --json "
                     "file instead of running (refusals re-read with today's reasons)")
