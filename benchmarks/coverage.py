@@ -58,8 +58,13 @@ def pairs_of(step: str) -> tuple[list[tuple[int, int]], str | None]:
 
 
 def judge_path(o: Oracle, faces, polylines, offset: float, cap: int) -> dict:
-    """Silent-bad check of written cut points (at most ``cap`` evenly spread per polyline)."""
+    """Silent-bad check of written cut points (at most ``cap`` evenly spread per polyline).
+
+    ``shank_mm``: how far the shank (p to p + 10 R' z) comes nearer than R' to the part
+    at the worst checked point, with its face; reported beside silent-bad (the shank
+    rule is the spec's, the gouge gate does not check it)."""
     worst_face, worst_gouge, checked = 0.0, 0.0, 0
+    worst_shank, shank_face = 0.0, 0
     for line in polylines:
         idx = np.unique(np.linspace(0, len(line) - 1, min(cap, len(line))).round().astype(int))
         for p in line[idx]:
@@ -69,7 +74,11 @@ def judge_path(o: Oracle, faces, polylines, offset: float, cap: int) -> dict:
             dist, _ = o.clearance(p, offset)
             if math.isfinite(dist):
                 worst_gouge = max(worst_gouge, offset - dist)
+            dist, face = o.shank_clearance(p, 10.0 * offset, offset)
+            if math.isfinite(dist) and offset - dist > worst_shank:
+                worst_shank, shank_face = offset - dist, face
     return {"checked": checked, "off_face_mm": worst_face, "gouge_mm": worst_gouge,
+            "shank_mm": worst_shank, "shank_face": shank_face,
             "bad": worst_face > TOL or worst_gouge > TOL}
 
 
