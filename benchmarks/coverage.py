@@ -24,6 +24,7 @@ import json
 import math
 import multiprocessing
 import os
+import re
 import sys
 import time
 from pathlib import Path
@@ -168,6 +169,28 @@ def tasks_for(args) -> tuple[list[dict], list[dict]]:
     return tasks, notes
 
 
+EDGE_REASONS = re.compile(r"edge \d+: no feasible ball position: ([^(;]+)")
+
+
+def program_notes(records: list[dict], radius: float) -> list[str]:
+    """Version 2 runs: edges refused or skipped by the stretch finder, by its reason;
+    cuts the gate refused, and the feasible positions they would have covered."""
+    edges, gated = collections.Counter(), 0
+    for r in records:
+        for run in r.get("runs", []):
+            text = " ".join([run.get("message", "")] + run.get("skipped", []))
+            edges.update(m.strip() for m in EDGE_REASONS.findall(text))
+            edges.update("cut stopped short" for k in run.get("skipped", [])
+                         if "stopped short" in k)
+            gated += len(run.get("gate_refused", []))
+    if not edges and not gated:
+        return []
+    extra = sum(r.get("covered_ungated", 0) - r["covered"] for r in records)
+    return [f"R {radius}: edges without a cut, by the stretch finder's reason: "
+            + ", ".join(f"{k} {v}" for k, v in edges.most_common())
+            + f"; cuts refused by the gate {gated} (they would have covered {extra} more)"]
+
+
 def table(records: list[dict], notes: list[dict]) -> str:
     """The per-part and total figures as a Markdown table, then refusals by reason."""
     rows = ["| part | R mm | pairs | covered / feasible | % | ball only: covered / feasible "
@@ -197,6 +220,8 @@ def table(records: list[dict], notes: list[dict]) -> str:
     for radius, counts in sorted(reasons.items()):
         rows.append(f"R {radius}: runs not written, by reason: "
                     + ", ".join(f"{k} {v}" for k, v in counts.most_common()))
+    for radius in sorted({r["radius"] for r in records}):
+        rows.extend(program_notes([r for r in records if r["radius"] == radius], radius))
     for n in notes:
         if n["problem"] or not n["pairs"]:
             rows.append(f"{n['part']}: no pair judged ({n['problem'] or 'no concave edge'}); "

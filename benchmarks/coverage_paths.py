@@ -117,7 +117,7 @@ def run_path(step: str, faces: tuple[int, int], radius: float, feed: float, peri
                              for k in data.get("gate_refused", [])]
         elif outcome == "written":
             outcome = "exit 0 without a file"
-    message = " ".join(stderr.strip().splitlines()[-1:])[:300]
+    message = " ".join(stderr.strip().splitlines()[-1:])[:2000]
     return {"edge": edge, "code": code, "outcome": outcome, "message": message,
             "seconds": round(seconds, 2), "version": version, "polylines": polylines,
             "refused_polylines": refused_lines, "skipped": skipped, "gate_refused": gated}
