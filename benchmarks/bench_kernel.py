@@ -173,6 +173,31 @@ def memory(plan, job, cycles: int, streamed: int) -> tuple[float, float, int]:
     return per_cycle, growth, st.cycles
 
 
+def undisturbed(us: np.ndarray) -> tuple[np.ndarray, int]:
+    """The step times without the process's descheduling: each step over 1 ms (another
+    process ran) and the step after it (cold caches) dropped; (times, count dropped)."""
+    bad = np.flatnonzero(us > 1000.0)
+    drop = np.union1d(bad, bad + 1)
+    drop = drop[drop < len(us)]
+    return np.delete(us, drop), len(drop)
+
+
+def exact_calls(st, n: int) -> tuple[np.ndarray, int]:
+    """step_times(st, n) and how many exact trim classifications (FClass2d) it made."""
+    from cadcnc.geometry.trim_grid import TrimGrid
+    calls, classify = [0], TrimGrid.classify
+
+    def counted(grid, u, w):
+        calls[0] += 1
+        return classify(grid, u, w)
+
+    TrimGrid.classify = counted
+    try:
+        return step_times(st, n), calls[0]
+    finally:
+        TrimGrid.classify = classify
+
+
 def pct(us: np.ndarray) -> str:
     p50, p99, p999 = np.percentile(us, [50, 99, 99.9])
     return (f"p50 {p50:6.2f}  p99 {p99:6.2f}  p99.9 {p999:6.2f}  max {us.max():8.2f}  "
@@ -189,7 +214,7 @@ def main() -> None:
         stepper(plan, job).run()                                   # warm-up (JIT load)
         d2 = bare_d2(plan)
         ref = step_times(stepper(plan, job, compiled=False), 2000)
-        fast = step_times(stepper(plan, job, end=False), args.steps)
+        fast, exact = exact_calls(stepper(plan, job, end=False), args.steps)
         per_cycle = loop_per_cycle(plan, job, 200_000)
         path_us, grid_us, points = whole_path(part, i, j)
         ss = int_ss(plan)
@@ -203,7 +228,9 @@ def main() -> None:
         print(f"  whole path ({points} points)  : {path_us / 1000:8.2f} ms (trim grids "
               f"{grid_us / 1000:.2f} ms), GeomAPI_IntSS {ss / 1000:8.2f} ms: "
               f"{ss / path_us:.1f}x faster")
-        print(f"  latency, {len(fast)} steps, GC off: {pct(fast)}")
+        print(f"  latency, {len(fast)} steps, GC off: {pct(fast)}; {exact} exact trim calls")
+        calm, dropped = undisturbed(fast)
+        print(f"  the same without descheduling ({dropped} steps dropped): {pct(calm)}")
         if name == CASES[0][0]:
             per, growth, n = memory(plan, job, 100_000, args.streamed)
             print(f"  memory: record on {per:.0f} B/cycle (traced, doubling chunks incl.); "

@@ -61,10 +61,10 @@ def kernel_loop():
     one, into = numba.njit(lookup), numba.njit(wrap)
 
     @numba.njit
-    def run(grid, u0, w0, du, dw, nu, nw, window, us, ws, out):
+    def run(grid, fine, u0, w0, du, dw, nu, nw, window, us, ws, out):
         for k in range(us.shape[0]):
             u, w = into(us[k], window[0], window[1]), into(ws[k], window[2], window[3])
-            out[k] = one(grid, u0, w0, du, dw, nu, nw, u, w)
+            out[k] = one(grid, fine, u0, w0, du, dw, nu, nw, u, w)
 
     return run
 
@@ -99,7 +99,7 @@ def measure(face: FaceSurface, n: int, max_cells: int, rng, run) -> dict:
         t_kernel = (time.perf_counter() - t0) / n
         assert np.array_equal(out, codes), "kernel lookup and TrimGrid.cell disagree"
     return {"face": face.number, "kind": face.kind, "cells": grid.labels.size,
-            "build": grid.stats["build_s"], "bytes": 2 * grid.labels.nbytes,  # + bytes copy
+            "build": grid.stats["build_s"], "bytes": grid.labels.nbytes * 2 + grid.codes.nbytes + grid.fine.nbytes,
             "o1": float(np.mean(codes != CELL_MIXED)), "t_face": t_face, "t_grid": t_grid,
             "t_perform": t_perform, "t_kernel": t_kernel,
             "disagree": sum(a != b for a, b in zip(exact, fast)),

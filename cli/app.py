@@ -44,8 +44,11 @@ def _job_options(p, required: bool) -> None:
                    help="start point near the intersection, mm (default: the shared "
                         "concave edge's start)")
     p.add_argument("--end", metavar="X,Y,Z", help="end point, mm (needs --start)")
-    p.add_argument("--edge", type=int, default=1, metavar="K",
-                   help="which shared concave edge when the faces share several (1, 2, ...)")
+    p.add_argument("--edge", type=int, default=None, metavar="K",
+                   help="only shared concave edge K (1, 2, ...; default: every edge)")
+    p.add_argument("--stretch", type=int, default=None, metavar="N",
+                   help="only feasible stretch N (1, 2, ... along the edge; default: every "
+                        "stretch)")
     _flip_option(p)
 
 
@@ -105,16 +108,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="machine-readable output")
     _flip_option(p)
 
-    p = add("path", "compute a path and write it (.json, .csv, .ngc)",
-            "Compute the ball-end path along the intersection of faces I and J and write it; "
-            "the format follows each output's suffix.")
+    p = add("path", "compute a program and write it (.json, .csv, .ngc, .png, .glb)",
+            "Compute the program of faces I and J: every feasible stretch of their shared "
+            "concave edges cut by the ball, linked by retract, rapid and plunge; gate it "
+            "against the whole part and write it; the format follows each output's suffix. "
+            "Exit 0 complete and verified, 3 no feasible stretch, 5 gouge, 6 partial.")
     p.add_argument("step", metavar="PART.step", help="the part (STEP file, mm)")
     _job_options(p, required=True)
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
-                   help="output file: .json (everything), .csv (a row per cycle) or .ngc "
-                        "(G-code); repeat for several")
+                   help="output file: .json (the program, version 2), .csv (a row per "
+                        "cycle of every cut), .ngc (G-code), .png or .glb (a picture); "
+                        "repeat for several")
     _gouge_options(p)
     _gcode_options(p)
+    p.add_argument("--plunge-feed", metavar="F",
+                   help="feed of the links' plunge moves, mm/min (default: the feed)")
 
     p = add("run", "execute an APT-like part program (PATH = P/[...])",
             "Execute an APT-like part program (grammar: docs/cli.md). Prints a summary per "
@@ -136,7 +144,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="output folder (default: ./cadcnc-demo)")
 
     p = add("plot", "picture of a saved path (.png) or a 3-D scene (.glb)")
-    p.add_argument("path_json", metavar="PATH.json", help="a path written by `cadcnc path`")
+    p.add_argument("path_json", metavar="PATH.json",
+                   help="a program written by `cadcnc path` (or a version 1 path)")
     p.add_argument("--part", metavar="PART.step",
                    help="the part (default: the STEP file recorded in the path)")
     p.add_argument("-o", "--output", required=True, metavar="OUT",

@@ -15,18 +15,15 @@ import cadcnc
 from cadcnc import apt
 from cadcnc.errors import InputError
 from cadcnc.geometry.report import concave_edges, faces_report
-from cadcnc.io import read_json
-from cadcnc.io.plot import PICTURE_SUFFIXES, picture_bytes
 from cadcnc.io.output_set import OutputSet, check_destination
 from cadcnc.io.gcode import written_moves
 from cadcnc.io.outputs import SUFFIXES, render
 from cadcnc.io.summary import summary
-from cadcnc.ops.pair_path import path_for_job
-from cadcnc.verification import gouge_gate, verify as run_verify
+from cadcnc.verification import gouge_gate
 
-from . import demo as demo_command
+from . import demo as demo_command, program_commands
 from .feedback import progress, say_error, stage_progress
-from .options import clearance, gcode_options, job_from_args, tolerances, wants_gcode
+from .options import clearance, gcode_options, tolerances
 
 GOUGE_REFUSED = 5  # exit code: the whole-part check found a gouge deeper than the limit
 PARTIAL = 6  # exit code: the path stopped before its intended end
@@ -68,27 +65,7 @@ def _angles(rng) -> str:
     return f"{lo:.1f}" if abs(hi - lo) < 0.05 else f"{lo:.1f}..{hi:.1f}"
 
 
-# -- path ------------------------------------------------------------------------------------
-def path(args) -> int:
-    outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])
-    job = job_from_args(args, args.step)
-    part = cadcnc.load_step(args.step, flip_material=job.flip_material)
-    for n in job.operation.faces:  # face numbers checked before anything is computed
-        part.face(n)
-    gopts = gcode_options(args, job.clearance, [part]) if wants_gcode(args.output) else {}
-    i, j = job.operation.faces
-    tp = path_for_job(part, job, progress=progress(args, f"faces {i} {j}"))
-    write, code = judge(args, tp, part, "path", gopts or None)
-    if not write:
-        return code
-    title = f"faces {i} {j} of {Path(args.step).name}"
-    outputs.write({out: render([tp], out, title=title, **gopts) for out in args.output})
-    if not args.quiet:
-        print(summary(tp, args.step))
-        print(f"  wrote      {', '.join(args.output)}")
-    return code
-
-
+# -- path (programs: cli/program_commands.py) ------------------------------------------
 def judge(args, tp, part, what: str, gopts: dict | None = None) -> tuple[bool, int]:
     """(write it?, exit code) for a computed path: the exit code is 0 only for a complete
     path that passed the whole-part gouge gate. With G-code options ``gopts`` (a program is
@@ -210,57 +187,6 @@ def _stream(args, checked, source: str) -> int:
     return status
 
 
-# -- plot ------------------------------------------------------------------------------------
-def load_saved(path_json: str, part_file: str | None):
-    """(toolpath, part) of a saved path JSON; the part from ``part_file`` or the record."""
-    tp = read_json(path_json)
-    if part_file is None:
-        part_file = tp.job.source
-        if not part_file:
-            raise InputError(f"{path_json}: records no part file; give --part PART.step")
-        if not Path(part_file).is_absolute() and not Path(part_file).exists():
-            near = Path(path_json).parent / part_file
-            part_file = str(near) if near.exists() else part_file
-    return tp, cadcnc.load_step(part_file, flip_material=tp.job.flip_material)
-
-
-def plot(args) -> int:
-    outputs = OutputSet([args.output], PICTURE_SUFFIXES, inputs=[args.path_json, args.part])
-    tp, part = load_saved(args.path_json, args.part)
-    for n in tp.faces:
-        if n is not None:
-            part.face(n)
-    outputs.write({args.output: picture_bytes(tp, part, args.output)})
-    if not args.quiet:
-        print(f"wrote {args.output}")
-    return 0
-
-
-# -- verify ----------------------------------------------------------------------------------
-def verify(args) -> int:
-    tol = tolerances(args)
-    if args.input.lower().endswith(".json"):
-        tp, part = load_saved(args.input, args.part)
-    else:
-        if args.part is not None:
-            raise InputError("--part is for a saved PATH.json; a STEP input is the part")
-        job = job_from_args(args, args.input)
-        part = cadcnc.load_step(args.input, flip_material=job.flip_material)
-        tp = path_for_job(part, job, progress=progress(args, "verify"))
-    report = run_verify(tp, part, tol=tol, progress=stage_progress(args, "verify"))
-    if args.json:
-        print(json.dumps(report.to_dict(), indent=1))
-    else:
-        print(report.format_table(tol.gouge))
-    if report.ok(tol.gouge):
-        return 0
-    if not math.isfinite(report.max_gouge_mm):
-        say_error("cadcnc: verify: the gouge depth could not be measured")
-        return GOUGE_REFUSED
-    say_error(f"cadcnc: verify: gouge {report.max_gouge_mm:.4g} mm deep exceeds the "
-              f"tolerance {tol.gouge:g} mm (see max over-cut and whole-part hits)")
-    return GOUGE_REFUSED
-
-
-COMMANDS = {"faces": faces, "path": path, "run": run, "demo": demo_command.demo,
-            "plot": plot, "verify": verify}
+COMMANDS = {"faces": faces, "path": program_commands.path, "run": run,
+            "demo": demo_command.demo, "plot": program_commands.plot,
+            "verify": program_commands.verify}

@@ -26,13 +26,16 @@ def job_from_args(args, source: str) -> Job:
     missing = [f"--{n}" for n in JOB_OPTIONS if getattr(args, n) is None]
     if missing:
         raise InputError(f"computing a path needs {', '.join(missing)}")
-    if args.edge < 1:
+    if args.edge is not None and args.edge < 1:
         raise InputError(f"--edge numbers the shared concave edges from 1, got {args.edge}")
+    stretch = getattr(args, "stretch", None)
+    if stretch is not None and stretch < 1:
+        raise InputError(f"--stretch numbers the stretches of an edge from 1, got {stretch}")
     tool = Tool(parse_length(args.radius, "radius"), parse_length(args.allowance, "allowance"))
     op = PairPath(faces=tuple(args.faces),
                   start=None if args.start is None else parse_point(args.start, "start"),
                   end=None if args.end is None else parse_point(args.end, "end"),
-                  edge=args.edge - 1)
+                  edge=None if args.edge is None else args.edge - 1, stretch=stretch)
     return Job(tool, parse_feed(args.feed), parse_duration(args.period), op, source=source,
                clearance=clearance(args), tolerances=tolerances(args),
                flip_material=getattr(args, "flip_material", False))
@@ -63,3 +66,14 @@ def gcode_options(args, clearance_z: float | None, parts) -> dict:
         clearance_z = max(part.top for part in parts) + SAFE_MARGIN
     spindle = None if args.spindle is None else check_number("--spindle", args.spindle, "rpm")
     return dict(tolerance=tol, tool_tip=args.tool_tip, safe_z=clearance_z, spindle=spindle)
+
+
+def program_gcode_options(args) -> dict:
+    """Keyword arguments of :func:`cadcnc.io.program_gcode.program_ngc`: chord tolerance,
+    tool tip, spindle, plunge feed (default the feed). The links' height is the job's
+    clearance (``--clearance``), else the part's top plus the safe margin."""
+    tol = None if args.tolerance is None else parse_length(args.tolerance, "tolerance", False)
+    spindle = None if args.spindle is None else check_number("--spindle", args.spindle, "rpm")
+    plunge = getattr(args, "plunge_feed", None)
+    plunge = None if plunge is None else parse_feed(plunge, "plunge feed")
+    return dict(tolerance=tol, tool_tip=args.tool_tip, spindle=spindle, plunge_feed=plunge)

@@ -118,8 +118,35 @@ def test_an_unknown_distance_fails_closed():
     p = (15.0, 15.0 - 3.0 * math.tan(lean) - 3.0 / math.cos(lean), 13.0)
     g = guard("undercut")
     g._point_distance = lambda face, q: -math.inf
-    g._segment_distance = lambda face, q: (1.0, False)
+    g._segment_distance = lambda face, q, *length: (1.0, False)
     assert g._exact(wall, p)[0] == -math.inf
-    g._segment_distance = lambda face, q: (-math.inf, False)
+    g._segment_distance = lambda face, q, *length: (-math.inf, False)
     third = next(k for k in range(1, len(part_of("undercut")) + 1) if k not in (floor, wall))
     assert g._exact(third, p)[0] == -math.inf
+
+
+def occt_only(g: ClearanceGuard) -> ClearanceGuard:
+    """The same guard with every closed form switched off (OCCT answers everything)."""
+    for a in g._analytic:
+        a.kind = None
+    return g
+
+
+@pytest.mark.parametrize("name", ["pocket", "shelf", "undercut"])
+def test_closed_forms_keep_occt_verdicts_and_hit_values(name):
+    """Along a line through the fixture's corner (into its end walls, under its shelf),
+    the guard with closed forms gives OCCT's verdict at every point, the same margin
+    (1e-9 mm) wherever it is a hit, and needs fewer OCCT distances."""
+    fast, slow = guard(name), occt_only(guard(name))
+    p0 = SIDECAR[name]["stretches"][0]["start"]["p"] if SIDECAR[name]["stretches"] else None
+    y, z = (p0[1], p0[2]) if p0 else (8.0, 11.0)
+    hits = 0
+    for k in range(81):
+        p = (-2.0 + 0.5 * k, y, z)
+        (m1, d1), (m2, d2) = fast.margin(p), slow.margin(p)
+        assert (m1 < 0.0) == (m2 < 0.0), (p, m1, d1, m2, d2)
+        if m2 < 0.0:
+            hits += 1
+            assert m1 == pytest.approx(m2, abs=1e-9) and d1 == d2, (p, d1, d2)
+    assert hits, "the line never met a face: the test would be empty"
+    assert fast.exact_calls < slow.exact_calls

@@ -106,10 +106,10 @@ def boss_api():
 def test_path_summary(boss_outputs, boss_api):
     _, run = boss_outputs
     out = run.stdout
-    assert f"points     {len(boss_api)}" in out
-    assert f"length     {boss_api.length:.4f} mm" in out
-    assert f"time       {boss_api.duration:.4f} s" in out
-    assert "stop       closed" in out and "eq. 16" in out and "wrote" in out
+    assert (f"cut 1: faces 4 5, edge 1, stretch 1: {boss_api.length:.4f} mm, "
+            f"{len(boss_api)} points, {boss_api.duration:.4f} s") in out
+    assert "stop closed" in out and "eq. 16" in out and "wrote" in out
+    assert "result     complete" in out
     assert run.stderr == ""
 
 
@@ -282,7 +282,8 @@ def test_plot(boss_outputs, tmp_path, suffix, magic):
         import trimesh
 
         scene = trimesh.load(out)
-        assert {"path", "contact1", "contact2", "face4", "face5"} <= set(scene.geometry)
+        # the program: approach link, the cut, retract; the part's faces
+        assert {"link1", "cut2", "link3", "face4", "face5"} <= set(scene.geometry)
 
 
 def test_plot_bad_suffix(boss_outputs, tmp_path):
@@ -292,7 +293,8 @@ def test_plot_bad_suffix(boss_outputs, tmp_path):
 
 
 def test_verify_computed_path_json():
-    run = cadcnc_cli("verify", SADDLE, "--faces", "1", "2", *JOB, "--json", check=0)
+    """A program of one cut: the report keeps the version 1 keys."""
+    run = cadcnc_cli("verify", BOSS, "--faces", "4", "5", *JOB, "--json", check=0)
     data = json.loads(run.stdout)
     for key in ("max_overcut_mm", "max_undercut_mm", "hausdorff_mm", "coverage",
                 "whole_part_hits"):
@@ -326,17 +328,19 @@ def test_docs_examples_run(example, tmp_path):
         assert len(rs274(tmp_path, out.read_text())) > 400
 
 
-def test_path_refuses_a_path_that_gouges_a_third_face(tmp_path):
-    """A 3 mm ball in the 4 mm slot cuts the opposite wall: refused, nothing written."""
+def test_path_refuses_a_pair_with_no_feasible_position(tmp_path):
+    """A 3 mm ball in the 4 mm slot would cut the opposite wall everywhere: the pair is
+    refused up front (exit 2, like every pair that cannot be machined), with the reason
+    per edge: the third face in the way; nothing written, --allow-gouge changes nothing."""
     out = tmp_path / "slot.json"
     args = ["path", FIXTURES / "narrow_slot.step", "--faces", "3", "4", *JOB, "-o", out]
-    run = cadcnc_cli(*args)
-    assert run.returncode == 5, run.stderr
-    assert "refused" in run.stderr and "face 5 by 2 mm" in run.stderr
-    assert not out.exists()
-    run = cadcnc_cli(*args, "--allow-gouge", "--quiet")
-    assert run.returncode == 5 and out.exists()  # written, and the exit code still says so
-    assert "written anyway" in run.stderr
+    for extra in ([], ["--allow-gouge", "--allow-partial"]):
+        run = cadcnc_cli(*args, *extra)
+        assert run.returncode == 2 and run.stderr.startswith("cadcnc: error: ")
+        assert len(run.stderr.strip().splitlines()) == 1
+        assert "no feasible ball position" in run.stderr and "edge 1:" in run.stderr and "third face" in run.stderr
+        assert "face 6 (2 mm too near)" in run.stderr
+        assert not out.exists()
 
 
 def test_verify_old_tolerance_spelling_still_gates(boss_outputs):

@@ -27,7 +27,7 @@ def test_path_end_to_end(tmp_path):
     run = cadcnc("path", FIXTURES / "bspline_boss.step", "--faces", "4", "5", "--radius", "3",
                  "--feed", "1500", "--period", "4ms", "-o", out)
     assert run.returncode == 0, run.stderr
-    assert "points     697" in run.stdout and out.read_bytes().startswith(b"{")
+    assert ", 697 points," in run.stdout and "result     complete" in run.stdout and out.read_bytes().startswith(b"{")
 
 
 def test_error_is_one_line_with_exit_code(tmp_path):

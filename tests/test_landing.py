@@ -158,3 +158,32 @@ def test_a_start_already_in_collision_takes_no_step(compiled):
     st = stepper("pocket", 10, 17, Plane((1.0, 0.0, 0.0), -30.0, 3.0), compiled=compiled)
     assert st.step() is None
     assert st.stop_reason == COLLISION and "no step possible" in st.stop_detail
+
+
+class CountingPlane(Plane):
+    """``Plane`` counting its margin calls; with ``budget``: its clearance (a distance)."""
+
+    def __init__(self, *args, budget=False):
+        super().__init__(*args)
+        self.calls = 0
+        if budget:
+            self.budget = lambda p: self.c - self.gap - float(self.a @ p)
+
+    def margin(self, p):
+        self.calls += 1
+        return super().margin(p)
+
+
+def test_a_guard_budget_spares_its_calls_and_keeps_the_path():
+    plain = CountingPlane((1.0, 0.0, 0.0), 5.0123456789, 3.0)
+    budgeted = CountingPlane((1.0, 0.0, 0.0), 5.0123456789, 3.0, budget=True)
+    a = stepper("pocket", 10, 17, plain).run()
+    b = stepper("pocket", 10, 17, budgeted).run()
+    assert type(b) is not Stepper  # the compiled stepper
+    assert b.stop_reason == COLLISION and b.stop_detail == a.stop_detail
+    assert np.array_equal(a.record.points, b.record.points)  # the same commits
+    assert b.record.points[-1][0] == pytest.approx(5.0123456789 - 3.0, abs=1e-9)
+    assert plain.calls >= a.cycles
+    # asked again only when a step leaves the clear ball: about log(distance / f) times
+    # while approaching, plus the landing's trials
+    assert budgeted.calls < 0.2 * plain.calls, (budgeted.calls, plain.calls)

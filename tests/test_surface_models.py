@@ -231,7 +231,7 @@ def test_cli_path_on_loose_faces_is_verified_on_the_same_material_side(tmp_path)
     code, _, err = cli("path", loose, "--faces", 4, 5, *job, "-o", out, "-q")
     assert code == 0, err
     saved = json.loads(out.read_text())
-    assert saved["inputs"]["flip_material"] is False
+    assert saved["job"]["flip_material"] is False
     assert cli("verify", out, "-q")[0] == 0
     # flipped, the boss corner is convex: no path along it
     code, _, err = cli("path", loose, "--faces", 4, 5, *job, "-o", tmp_path / "f.json",

@@ -94,11 +94,45 @@ def test_wrap_moves_by_whole_periods():
 
 
 def test_lookup_clamps_and_defers_on_nonfinite():
-    grid = np.array([[0, 1], [2, 1]], dtype=np.int8)
-    args = (grid, 0.0, 0.0, 1.0, 1.0, 2, 2)
+    grid = np.array([[0, 1], [2, 1]], dtype=np.int64)
+    args = (grid, np.zeros(0, np.int64), 0.0, 0.0, 1.0, 1.0, 2, 2)
     assert lookup(*args, 0.5, 1.5) == 1
     assert lookup(*args, 1.5, 0.5) == 2
     assert lookup(*args, -5.0, -5.0) == 0  # beyond the grid: the nearest border cell
     assert lookup(*args, 99.0, 99.0) == 1
     for bad in (float("nan"), float("inf"), -float("inf")):
         assert lookup(*args, bad, 0.5) == trim_lookup.CELL_MIXED
+
+
+def test_lookup_reads_sub_cells():
+    """A MIXED cell split in 2 x 4 sub-cells (code 3 + offset of Ru, Rw, labels)."""
+    codes = np.array([[0, 3]], dtype=np.int64)
+    fine = np.array([2, 4, 0, 0, 1, 2, 1, 1, 1, 0], dtype=np.int64)
+    args = (codes, fine, 0.0, 0.0, 1.0, 1.0, 1, 2)
+    assert lookup(*args, 0.5, 0.5) == 0  # an unsplit cell
+    assert [lookup(*args, 0.25, 1.0 + b / 4 + 0.1) for b in range(4)] == [0, 0, 1, 2]
+    assert [lookup(*args, 0.75, 1.0 + b / 4 + 0.1) for b in range(4)] == [1, 1, 1, 0]
+    assert lookup(*args, 9.0, 9.0) == 0  # clamped into the last sub-cell
+
+
+@pytest.mark.parametrize("name", ["crossing_cylinders", "sphere_cylinder", "bspline_boss"])
+def test_sub_cells_answer_most_points_of_mixed_cells(name):
+    """Points drawn in the MIXED cells (seams and trim bands) are mostly answered by the
+    sub-cells, and every answer equals FClass2d's (the sub-cells' labels are exact too)."""
+    part, rng = cadcnc.load_step(FIXTURES / f"{name}.step"), np.random.default_rng(3)
+    for face in part.faces[:2]:
+        grid = TrimGrid.build(face)
+        coarse = TrimGrid.build(face, sub_cells=1)
+        assert coarse.fine.size == 0 and np.array_equal(coarse.labels, grid.labels)
+        cells = np.argwhere(grid.labels == CELL_MIXED)
+        pick = cells[rng.integers(0, len(cells), 2000)] + rng.uniform(0, 1, (2000, 2))
+        pts = np.column_stack([grid.u0 + pick[:, 0] * grid.du, grid.w0 + pick[:, 1] * grid.dw])
+        answered = 0
+        for u, w in pts.tolist():
+            code = grid.cell(u, w)
+            assert coarse.cell(u, w) == CELL_MIXED
+            if code != CELL_MIXED:
+                answered += 1
+                expected = face.classify(*face.wrap(u, w))
+                assert trim_grid._CODE_STATE[code] == expected, (face.number, u, w)
+        assert answered > 0.8 * len(pts), (face.number, answered, grid.stats)

@@ -36,11 +36,14 @@ import math
 import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_IsInFace
+from OCP.BRep import BRep_Builder
+from OCP.TopoDS import TopoDS_Compound
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_VERTEX
 from OCP.TopExp import TopExp
 from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.gp import gp_Pnt
 
+from .analytic_distance import AnalyticFace
 from .part import optimal_box
 
 TIE = 1e-9  # mm: margins this close are the same contact
@@ -67,6 +70,7 @@ class ClearanceGuard:
         self.reach = max(self.offset, 1.0) if reach is None else float(reach)
         n = len(part)
         self._faces = [part.face(k) for k in range(1, n + 1)]
+        self._analytic = [AnalyticFace(f) for f in self._faces]   # closed forms, or kind None
         boxes = [optimal_box(f.topods, use_triangulation=False) for f in self._faces]
         self._lo = np.array([b[0] for b in boxes]) - BOX_SLACK     # (n, 3)
         self._hi = np.array([b[1] for b in boxes]) + BOX_SLACK     # (n, 3)
@@ -75,11 +79,13 @@ class ClearanceGuard:
             for kind in (TopAbs_EDGE, TopAbs_VERTEX):
                 TopExp.MapShapes_s(self._faces[k - 1].topods, kind, self._own_shapes)
         self._own_rule = {k: _needs_own_rule(self._faces[k - 1]) for k in self.pair}
+        self._edges: dict = {}              # face -> compound of its free edges (planes)
         self._broad_at: tuple[float, float, float] | None = None
         self._near: list[int] = []          # face numbers within reach at _broad_at
         self._bound: dict[int, tuple] = {}  # face -> (p0, lower bound of the margin at p0, slope)
         self.calls = 0
-        self.exact_calls = 0
+        self.exact_calls = 0     # OCCT distances
+        self.closed_calls = 0    # closed-form distances
         self.broad_calls = 0
 
     # -- the guard ------------------------------------------------------------------------
@@ -91,6 +97,8 @@ class ClearanceGuard:
         """
         self.calls += 1
         p = (float(p[0]), float(p[1]), float(p[2]))
+        if not math.isfinite(p[0] + p[1] + p[2]):
+            return -math.inf, "ball centre is not a finite point"   # fail closed
         moved = math.inf if self._broad_at is None else _dist(p, self._broad_at)
         if moved > self.reach:
             self._broad_phase(p)
@@ -140,33 +148,54 @@ class ClearanceGuard:
         where the pair's own face is (a wall's top edge beside a shank tangent to the
         wall): that contact belongs to the own face's rule, and counts as clear.
         """
-        face = self._faces[k - 1].topods
         below = self._hi[k - 1][2] - BOX_SLACK <= p[2]
         own = k in self.pair
         if own and below:
             m = self.tol
         elif own:
-            d_seg, d_p = self._segment_distance(face, p)[0], self._point_distance(face, p)
-            # an unknown distance fails closed (-inf is a hit, never an inf margin)
-            m = d_seg - (d_p - self.tol) if math.isfinite(d_seg + d_p) else -math.inf
+            m = self._own_bound(k, p)
+            if m is None or m < 0.0:
+                d_seg, d_p = self._segment_distance(k, p)[0], self._point_distance(k, p)
+                # an unknown distance fails closed (-inf is a hit, never an inf margin)
+                m = d_seg - (d_p - self.tol) if math.isfinite(d_seg + d_p) else -math.inf
         else:
-            d, own_edge = (self._point_distance(face, p), False) if below or \
-                self.shank == 0.0 else self._segment_distance(face, p)
+            d, own_edge = self._segment_distance(k, p, 0.0 if below else self.shank)
             m = d - self.threshold
             if own_edge:
                 m = max(m, 0.0)
         self._bound[k] = (p, m, 2.0 if own else 1.0)
         if own or m >= 0.0:
             return m, "shank" if own else "tool"
-        return m, "ball" if below or self._point_distance(face, p) < self.threshold \
+        return m, "ball" if below or self._point_distance(k, p) < self.threshold \
             else "shank"
 
-    def _segment_distance(self, face, p) -> tuple[float, bool]:
-        """(distance mm from the segment p .. p + L z to the face, whether every nearest
-        point of the face lies on an edge or vertex of face i or j)."""
+    def _segment_distance(self, k: int, p, length: float | None = None) -> tuple[float, bool]:
+        """(distance mm from the segment p .. p + length z (default L) to face k, whether
+        every nearest point of the face lies on an edge or vertex of face i or j): in
+        closed form for an analytic face whose foot is inside it (then not on an edge);
+        for a third face whose distance to its whole surface already clears R' - tol, that
+        distance (a lower bound: the margin stays >= 0); else OCCT's."""
+        length = self.shank if length is None else length
+        a = self._analytic[k - 1]
+        d = a.segment_distance(p, length)
+        if d is None and k not in self.pair:
+            d = a.segment_distance(p, length, trimmed=False)
+            d = d if d is not None and d >= self.threshold else None
+        if d is not None:
+            self.closed_calls += 1
+            return d, False
         self.exact_calls += 1
+        face = self._faces[k - 1].topods
+        if self._analytic[k - 1].kind == "plane" and k not in self.pair:
+            # the distance to a segment is convex on the plane: with the foot outside the
+            # face the nearest point is on the face's boundary; a contact on an edge of
+            # face i or j counts as clear (the own face's rule), so only the others count
+            face = self._free_edges(k)
+            if face is None:
+                return math.inf, False
         a = gp_Pnt(*p)
-        shape = BRepBuilderAPI_MakeEdge(a, gp_Pnt(p[0], p[1], p[2] + self.shank)).Edge()
+        shape = BRepBuilderAPI_MakeEdge(a, gp_Pnt(p[0], p[1], p[2] + length)).Edge() \
+            if length > 0.0 else BRepBuilderAPI_MakeVertex(a).Vertex()
         ext = BRepExtrema_DistShapeShape(shape, face)
         if not ext.IsDone() or ext.NbSolution() == 0:
             return -math.inf, False  # fail closed: an unknown distance is a hit
@@ -175,8 +204,39 @@ class ClearanceGuard:
                   for n in range(1, ext.NbSolution() + 1))
         return ext.Value(), own
 
-    def _point_distance(self, face, p) -> float:
+    def _own_bound(self, k: int, p) -> float | None:
+        """A lower bound of own face k's margin in closed form (a torus: the segment's
+        distance to the whole torus, the ball's to the face), or None."""
+        a = self._analytic[k - 1]
+        lb = a.segment_lower_bound(p, self.shank)
+        d_p = a.point_distance(p) if lb is not None else None
+        if d_p is None:
+            return None
+        self.closed_calls += 1
+        return lb - (d_p - self.tol)
+
+    def _free_edges(self, k: int):
+        """A compound of face k's edges that face i and j do not share, or None."""
+        if k not in self._edges:
+            edges = TopTools_IndexedMapOfShape()
+            TopExp.MapShapes_s(self._faces[k - 1].topods, TopAbs_EDGE, edges)
+            comp, builder, n = TopoDS_Compound(), BRep_Builder(), 0
+            builder.MakeCompound(comp)
+            for e in range(1, edges.Extent() + 1):
+                if not self._own_shapes.Contains(edges.FindKey(e)):
+                    builder.Add(comp, edges.FindKey(e))
+                    n += 1
+            self._edges[k] = comp if n else None
+        return self._edges[k]
+
+    def _point_distance(self, k: int, p) -> float:
+        """Distance (mm) from p to face k: closed form where it applies, else OCCT's."""
+        d = self._analytic[k - 1].point_distance(p)
+        if d is not None:
+            self.closed_calls += 1
+            return d
         self.exact_calls += 1
+        face = self._faces[k - 1].topods
         ext = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(), face)
         return ext.Value() if ext.IsDone() and ext.NbSolution() else -math.inf
 
@@ -184,7 +244,8 @@ class ClearanceGuard:
 def _needs_own_rule(face) -> bool:
     """False where a shank above the ball can never come nearer to this face than the
     ball's own contact: a plane whose outward normal has n_z >= 0, or a cylinder whose
-    axis is vertical (both in closed form)."""
+    axis is vertical, or a surface of extrusion along Z (all three in closed form: the
+    horizontal distance from any point of the vertical segment is the ball's)."""
     surf = face._adaptor
     if face.kind == "plane":
         u, w = np.mean(face.u_range), np.mean(face.w_range)
@@ -192,6 +253,8 @@ def _needs_own_rule(face) -> bool:
     if face.kind == "cylinder":
         axis = surf.Cylinder().Axis().Direction()
         return abs(abs(axis.Z()) - 1.0) > 1e-12
+    if face.kind == "extrusion":
+        return abs(abs(surf.Direction().Z()) - 1.0) > 1e-12
     return True
 
 

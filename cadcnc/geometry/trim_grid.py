@@ -25,6 +25,13 @@ about 2 sqrt(Lu Lw C) / (Fu Fw); N makes that ``target_share`` (2 %), within [25
 bands cover over 3/4 of the period spans exactly the wrap range; any other spans the bands +
 1.1 clear cells each side (periodic ones inside a one-period window centred on them), so a
 point beyond the grid takes its nearest border cell's label.
+
+Sub-cells (``trim_cells.refine``): each MIXED cell is split in up to ``sub_cells`` (256)
+sub-cells, thin strips where its bands run along u or w (a periodic face's seam edge), else
+up to 4 x 4; a sub-cell is MIXED if a band segment meets it inflated by the half-widths
+(FClass2d's own ON test, + the 1e-12 round-off margin); free sub-cells connected inside the
+cell take the label of the free cells beside them (they agree, or the sub-cells stay MIXED:
+``stats["unresolved"]``). ``kernel_args`` hands both levels to ``trim_lookup.lookup``.
 """
 
 from __future__ import annotations
@@ -46,6 +53,7 @@ from OCP.TopAbs import (TopAbs_FORWARD, TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
+from .trim_cells import layout, mark, refine, regions
 from ..trim import BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE
 
 _CONFUSION = 1e-7  # OCCT Precision::Confusion(), mm
@@ -66,6 +74,56 @@ def _fleche(seq: list, fu: float, fv: float) -> tuple[float, float]:
     dx, dy = (cx - ax) / n, (cy - ay) / n
     t = (bx - ax) * dx + (by - ay) * dy
     return max(fu, abs(ax + t * dx - bx)), max(fv, abs(ay + t * dy - by))
+
+
+def _distance(a: tuple, b: tuple) -> float:
+    """gp_Pnt::Distance's arithmetic (squares summed in x, y, z order)."""
+    d = 0.0
+    for x, y in zip(a, b):
+        d += (x - y) * (x - y)
+    return math.sqrt(d)
+
+
+def _keep_distinct(seq: list, pts: list, us: list, du: float, c3, last3d):
+    """Append to ``seq`` the samples FClass2d keeps: a point repeating the last kept one in
+    3-D is dropped unless the half-step point differs; returns the last kept 3-D point.
+    Vectorised when no two successive points are that close (then every point is kept)."""
+    p3 = [c3.Value(t).Coord() for t in us]
+    if not p3:
+        return last3d
+    a = np.array(p3 if last3d is None else [last3d] + p3)
+    d = a[1:] - a[:-1]
+    if len(d) == 0 or (d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2]).min() >= \
+            _CONFUSION * _CONFUSION * (1.0 + 1e-9):
+        seq += pts
+        return p3[-1]
+    for (x, y), t, q in zip(pts, us, p3):
+        real = True
+        if len(seq) > 1 and last3d is not None and _distance(q, last3d) < _CONFUSION:
+            real = _distance(q, c3.Value(t - du / 2.0).Coord()) >= _CONFUSION
+        if real:
+            seq.append((x, y))
+            last3d = q
+    return last3d
+
+
+def _fleches(seq: list, before: int, fu: float, fv: float) -> tuple[float, float]:
+    """``_fleche`` over every point appended after ``before`` (from the fifth one on) whose
+    triple's ends differ, as FClass2d checks after each sample; vectorised."""
+    if len(seq) <= before + 4:
+        return fu, fv
+    a = np.asarray(seq[before + 2:], dtype=float)
+    pa, pb, pc = a[:-2], a[1:-1], a[2:]
+    use = np.any(pa != pc, axis=1)
+    pa, pb, pc = pa[use], pb[use], pc[use]
+    n = np.hypot(pc[:, 0] - pa[:, 0], pc[:, 1] - pa[:, 1])
+    pa, pb, pc, n = pa[n > 0], pb[n > 0], pc[n > 0], n[n > 0]
+    if not len(n):
+        return fu, fv
+    d = (pc - pa) / n[:, None]
+    t = (pb[:, 0] - pa[:, 0]) * d[:, 0] + (pb[:, 1] - pa[:, 1]) * d[:, 1]
+    return (max(fu, float(np.abs(pa[:, 0] + t * d[:, 0] - pb[:, 0]).max())),
+            max(fv, float(np.abs(pa[:, 1] + t * d[:, 1] - pb[:, 1]).max())))
 
 
 def _is_degenerated(c3: BRepAdaptor_Curve, first: float, last: float) -> bool:
@@ -124,21 +182,20 @@ def _sample(wire, face, box: list, defl: float = 0.0) -> tuple[list, float, floa
         nbs = nbs * 4 if nbs > 2 else nbs
         du = (pl - pf) / (nbs - 1) * (1.0 if orient == TopAbs_FORWARD else -1.0)
         u = (pf if orient == TopAbs_FORWARD else pl) + (du if first_point == 2 else 0.0)
-        before = len(seq)
-        for _ in range(first_point, nbs + 1):
-            x, y = c2.Value(u).Coord()
-            box[:] = min(box[0], x), max(box[1], x), min(box[2], y), max(box[3], y)
-            real = True
-            if not degenerated:  # skip points that repeat the last one in 3-D
-                p3 = c3.Value(u)
-                if len(seq) > 1 and last3d is not None and p3.Distance(last3d) < _CONFUSION:
-                    real = p3.Distance(c3.Value(u - du / 2.0)) >= _CONFUSION
-                last3d = p3 if real else last3d
-            if real:
-                seq.append((x, y))
+        us = []
+        for _ in range(first_point, nbs + 1):  # the same running sum as FClass2d's
+            us.append(u)
             u += du
-            if len(seq) > before + 4 and seq[-3] != seq[-1]:
-                fu, fv = _fleche(seq, fu, fv)
+        pts = [c2.Value(t).Coord() for t in us]
+        if pts:
+            xs, ys = zip(*pts)
+            box[:] = min(box[0], *xs), max(box[1], *xs), min(box[2], *ys), max(box[3], *ys)
+        before = len(seq)
+        if degenerated:
+            seq += pts
+        else:
+            last3d = _keep_distinct(seq, pts, us, du, c3, last3d)
+        fu, fv = _fleches(seq, before, fu, fv)
         first_point = 2
     return seq, fu, fv, walked
 
@@ -195,110 +252,29 @@ def _bands(face_surface, tol_uv: float) -> tuple[np.ndarray, ...] | None:
     return tuple(np.vstack(x) if x else np.zeros((0, 2)) for x in (p, q, h))
 
 
-def _layout(lo, hi, p, q, face_surface, max_cells: int, target: float) -> tuple[list, list]:
-    """Per direction (origin, cell size, count) by the module's rule, and the window (start,
-    period, seam): periodic points are wrapped into [start, start + period) before lookup
-    (period 0: not periodic); ``seam`` is where FaceSurface.wrap jumps inside a window that
-    the grid does not span (lo, hi are widened to hold it), else None."""
-    windows = []
-    for k, (period, start) in enumerate(((face_surface.u_period, face_surface.u_range[0]),
-                                        (face_surface.w_period, face_surface.w_range[0]))):
-        window = 0.5 * (lo[k] + hi[k] - (period or 0.0))
-        seam = None if period is None else window + (start - window) % period
-        if period is None:
-            windows.append((0.0, 0.0, None))
-        elif max(hi[k], seam) - min(lo[k], seam) > 0.75 * period:
-            windows.append((start, period, None))  # the grid spans the wrap range
-        else:
-            lo[k], hi[k] = min(lo[k], seam), max(hi[k], seam)
-            windows.append((window, period, seam))
-    full = [w[1] if w[1] and w[2] is None else 0.0 for w in windows]
-    span = [hi[k] - lo[k] for k in range(2)]
-    domain = [full[k] or span[k] for k in range(2)]
-    var = [max(float(np.abs(q[:, k] - p[:, k]).sum()), 1e-9 * span[k]) for k in range(2)]
-    n = 4.0 * var[0] * var[1] * domain[0] * domain[1] / (target * span[0] * span[1]) ** 2
-    c = domain[0] * domain[1] / min(max(n, 256.0), float(max_cells))
-    # the best cell shape, but no direction finer than max_cells / 16 cells
-    cell = [max(math.sqrt(c * var[k] / var[1 - k]), 16.0 * domain[k] / max_cells)
-            for k in range(2)]
-    while True:
-        axes = []
-        for k in range(2):
-            if full[k]:  # exactly the wrap range [start, start + period)
-                count = max(1, math.ceil(full[k] / cell[k]))
-                axes.append((windows[k][0], full[k] / count, count))
-            else:  # the bands plus >= 1.1 clear cells each side
-                count = max(3, math.ceil(span[k] / cell[k]) + 3)
-                axes.append((lo[k] - 1.1 * span[k] / (count - 2.2), span[k] / (count - 2.2),
-                             count))
-        if axes[0][2] * axes[1][2] <= 2 * max_cells:  # counts round up; memory stays bounded
-            return axes, windows
-        cell = [x * 1.25 for x in cell]
-
-
-def _mark(mask: np.ndarray, p, q, h, origin, size, eps) -> None:
-    """Set every cell of ``mask`` (nu, nw) that a segment's band (box-inflated) touches: the
-    inflated bounding boxes of pieces no longer than a cell, summed in a difference array."""
-    shape = np.array(mask.shape)
-    steps = np.maximum(np.ceil(np.max(np.abs(q - p) / size, axis=1)), 1).astype(np.int64)
-    seg = np.repeat(np.arange(len(p)), steps)
-    k = (np.arange(len(seg)) - np.repeat(np.cumsum(steps) - steps, steps))[:, None]
-    a = p[seg] + k / steps[seg, None] * (q[seg] - p[seg])
-    b = p[seg] + (k + 1) / steps[seg, None] * (q[seg] - p[seg])
-    i0 = np.floor((np.minimum(a, b) - h[seg] - eps - origin) / size)
-    i1 = np.floor((np.maximum(a, b) + h[seg] + eps - origin) / size)
-    keep = np.all((i1 >= 0) & (i0 < shape), axis=1)
-    i0 = np.clip(i0[keep], 0, shape - 1).astype(np.int64)
-    i1 = np.clip(i1[keep], 0, shape - 1).astype(np.int64) + 1
-    acc = np.zeros(shape + 1, dtype=np.int32)
-    for (r, c), sign in (((i0, i0), 1), ((i0, i1), -1), ((i1, i0), -1), ((i1, i1), 1)):
-        np.add.at(acc, (r[:, 0], c[:, 1]), sign)
-    mask |= acc.cumsum(0).cumsum(1)[:-1, :-1] > 0
-
-
 def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
-    """(origin (2,), cell size (2,), free (nu, nw) bool, windows): the layout, and the cells
-    that no band, nor its copies whole periods away, nor the wrap's seam touches."""
+    """(origin (2,), cell size (2,), mask (nu, nw) uint8, windows, segments): the layout, and
+    the cells (mask 1) that a band, or its copies whole periods away, or the wrap's seam
+    touches; segments (p, q, h, eps) are those bands for ``trim_cells.refine``."""
     p, q, h = bands
     lo, hi = (np.minimum(p, q) - h).min(axis=0), (np.maximum(p, q) + h).max(axis=0)
-    axes, windows = _layout(lo, hi, p, q, face_surface, max_cells, target)
+    axes, windows = layout(lo, hi, p, q, face_surface, max_cells, target)
     origin, size = np.array([a[0] for a in axes]), np.array([a[1] for a in axes])
     shape = np.array([axes[0][2], axes[1][2]])
     eps = 1e-12 * (np.abs(origin) + shape * size) + 1e-300
     shifts = [[k * t for k in range(math.ceil((o - b) / t) - 1,
                                     math.floor((o + n * s - a) / t) + 2)] if t else [0.0]
               for a, b, o, s, n, (_, t, _) in zip(lo, hi, origin, size, shape, windows)]
-    mask = np.zeros(shape, dtype=bool)
-    for shift in product(*shifts):
-        _mark(mask, p + shift, q + shift, h, origin, size, eps)
+    moved = np.array(list(product(*shifts)))[:, None, :]  # every copy in one pass
+    segs = [(p + moved).reshape(-1, 2), (q + moved).reshape(-1, 2), np.tile(h, (len(moved), 1))]
     for k, (_, _, seam) in enumerate(windows):
         if seam is not None:  # a line across the grid
             a, b = origin - size, origin + (shape + 1) * size
             a[k] = b[k] = seam
-            _mark(mask, a[None], b[None], np.zeros((1, 2)), origin, size, eps)
-    return origin, size, ~mask, windows
-
-
-def _regions(free: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Runs of free cells along w, (row, start, stop), and each run's 4-connected region."""
-    d = np.diff(np.pad(free.astype(np.int8), ((0, 0), (1, 1))), axis=1)
-    (row, start), stop = np.nonzero(d == 1), np.nonzero(d == -1)[1]
-    parent = list(range(len(row)))
-
-    def root(x: int) -> int:
-        while parent[x] != x:
-            parent[x] = x = parent[parent[x]]
-        return x
-
-    first = np.searchsorted(row, np.arange(free.shape[0] + 1)).tolist()
-    s, e = start.tolist(), stop.tolist()
-    for r in range(free.shape[0] - 1):  # merge overlapping runs of neighbouring rows
-        a, b, a_end, b_end = first[r], first[r + 1], first[r + 1], first[r + 2]
-        while a < a_end and b < b_end:
-            if s[a] < e[b] and s[b] < e[a]:
-                parent[root(a)] = root(b)
-            a, b = (a + 1, b) if e[a] < e[b] else (a, b + 1)
-    return row, start, stop, np.array([root(x) for x in range(len(row))], dtype=np.int64)
+            segs = [np.vstack([x, y]) for x, y in zip(segs, (a[None], b[None], np.zeros((1, 2))))]
+    mask = np.zeros(shape, dtype=np.uint8)
+    mark(mask, *segs, origin, size, eps)
+    return origin, size, mask, windows, (*segs, eps)
 
 
 _STATE_CODE = {TopAbs_IN: CELL_INSIDE, TopAbs_OUT: CELL_OUTSIDE}
@@ -320,51 +296,51 @@ class TrimGrid:
         (self.u0, self.w0), (self.du, self.dw) = map(float, origin), map(float, size)
         self.window = tuple(float(x) for win in windows for x in win[:2])
         self.nu, self.nw = labels.shape
+        self.codes, self.fine = labels.astype(np.int64), np.zeros(0, np.int64)  # no sub-cells
         self._flat = labels.tobytes()  # C order: cell (i, j) at i * nw + j
 
     @classmethod
     def build(cls, face_surface, max_cells: int = 65536, target_share: float = 0.02,
-              checks: int = 3) -> "TrimGrid":
+              checks: int = 3, sub_cells: int = 256) -> "TrimGrid":
         """Label a grid for ``face_surface`` (a FaceSurface) by the module's rule, with
-        ``checks`` (1..3) exact calls per region (the first decides, the others confirm)."""
+        ``checks`` (1..3) exact calls per region (the first decides, the others confirm)
+        and up to ``sub_cells`` sub-cells per MIXED cell (1: none)."""
         t_start = time.perf_counter()
         tol_uv = classifier_tolerance(face_surface)
         fc = BRepTopAdaptor_FClass2d(face_surface.topods, tol_uv)
         bands = _bands(face_surface, tol_uv)
         stats = {"exact_only": bands is None, "regions": 0, "suspect": 0, "calls": 0}
         if bands is None or not len(bands[0]):  # exact only, or no wire (all IN): one cell
-            origin, size, free = (0.0, 0.0), (1.0, 1.0), np.full((1, 1), bands is not None)
-            windows = [(0.0, 0.0)] * 2
+            origin, size, windows = (0.0, 0.0), (1.0, 1.0), [(0.0, 0.0)] * 2
+            mask, segs = np.full((1, 1), bands is None, np.uint8), None
         else:
-            origin, size, free, windows = _free_cells(bands, face_surface, max_cells,
-                                                      target_share)
-        grid = cls(face_surface, np.full(free.shape, CELL_MIXED, np.int8), origin, size,
+            origin, size, mask, windows, segs = _free_cells(bands, face_surface, max_cells,
+                                                            target_share)
+        grid = cls(face_surface, np.full(mask.shape, CELL_MIXED, np.int8), origin, size,
                    windows, fc, stats)
-        grid._label_regions(free, checks)
+        grid._label_regions(mask == 0, checks)
+        if segs is not None and sub_cells > 1:
+            grid.codes, grid.fine, stats["unresolved"] = refine(
+                mask, grid.labels, *segs[:3], np.asarray(origin), np.asarray(size), segs[3],
+                sub_cells, min(sub_cells, 16))
         stats["build_s"] = time.perf_counter() - t_start
         return grid
 
     def _label_regions(self, free: np.ndarray, checks: int) -> None:
         """One exact call per 4-connected region of free cells (plus confirmations)."""
-        row, start, stop, region = _regions(free)
-        if not len(row):
+        region, picks = regions(np.ascontiguousarray(~free, dtype=np.uint8))
+        if not len(picks):
             return
-        order = np.argsort(region, kind="stable")
-        code = np.empty(len(row), dtype=np.int8)
-        groups = np.split(order, np.flatnonzero(np.diff(region[order])) + 1)
-        for runs in groups:
-            picks = [runs[0], runs[len(runs) // 2], runs[-1]][:max(1, checks)]
+        code = np.empty(len(picks), dtype=np.int8)
+        for r, cells in enumerate(picks.tolist()):
             states = {_STATE_CODE.get(self._fc.Perform(gp_Pnt2d(*self.face.wrap(
-                self.u0 + (row[r] + 0.5) * self.du,
-                self.w0 + ((start[r] + stop[r] - 1) // 2 + 0.5) * self.dw))), CELL_MIXED)
-                for r in picks}
-            code[runs] = label = states.pop() if len(states) == 1 else CELL_MIXED
+                self.u0 + (c // self.nw + 0.5) * self.du,
+                self.w0 + (c % self.nw + 0.5) * self.dw))), CELL_MIXED)
+                for c in cells[:max(1, checks)]}
+            code[r] = label = states.pop() if len(states) == 1 else CELL_MIXED
             self.stats["suspect"] += label == CELL_MIXED
-        self.stats.update(regions=len(groups), calls=len(groups) * len(picks))
-        lengths = stop - start
-        offset = np.repeat(np.cumsum(lengths) - lengths, lengths)
-        flat = np.arange(lengths.sum()) - offset + np.repeat(row * self.nw + start, lengths)
-        self.labels.flat[flat] = np.repeat(code, lengths)
+        self.stats.update(regions=len(picks), calls=len(picks) * min(max(1, checks), 3))
+        self.labels[region >= 0] = code[region[region >= 0]]
         self._flat = self.labels.tobytes()
 
     def to_window(self, u: float, w: float) -> tuple[float, float]:
@@ -378,7 +354,16 @@ class TrimGrid:
         if not (abs(x) < 1e15 and abs(y) < 1e15):
             return CELL_MIXED
         i = min(max(math.floor(x), 0), self.nu - 1)
-        return self._flat[i * self.nw + min(max(math.floor(y), 0), self.nw - 1)]
+        j = min(max(math.floor(y), 0), self.nw - 1)
+        code = self._flat[i * self.nw + j]
+        if code != CELL_MIXED or not self.fine.size:
+            return code
+        k = int(self.codes[i, j]) - 3  # trim_lookup.lookup's sub-cell, from Python
+        if k < 0:
+            return code
+        ru, rw = int(self.fine[k]), int(self.fine[k + 1])
+        a, b = min(max(math.floor((x - i) * ru), 0), ru - 1), min(max(math.floor((y - j) * rw), 0), rw - 1)
+        return int(self.fine[k + 2 + a * rw + b])
 
     def classify(self, u: float, w: float) -> str:
         """inside / boundary / outside, exactly as ``FaceSurface.classify``."""
@@ -390,5 +375,6 @@ class TrimGrid:
 
     @property
     def kernel_args(self) -> tuple:
-        """(labels, u0, w0, du, dw, nu, nw): the leading arguments of ``trim_lookup.lookup``."""
-        return self.labels, self.u0, self.w0, self.du, self.dw, self.nu, self.nw
+        """(codes, fine, u0, w0, du, dw, nu, nw): the leading arguments of
+        ``trim_lookup.lookup``."""
+        return self.codes, self.fine, self.u0, self.w0, self.du, self.dw, self.nu, self.nw

@@ -63,10 +63,10 @@ def pack(surfaces, grids) -> tuple[np.ndarray, np.ndarray]:
         head[h + 3], head[h + 4] = ni, len(iarr)
         ints.append(np.asarray(iarr, dtype=np.int64))
         ni += len(iarr)
-        labels, u0, w0, du, dw, nu, nw = grid.kernel_args
-        head[h + 13], head[h + 14], head[h + 15] = ni, nu, nw
-        ints.append(labels.astype(np.int64).ravel())
-        ni += nu * nw
+        codes, fine, u0, w0, du, dw, nu, nw = grid.kernel_args
+        head[h + 13], head[h + 14], head[h + 15] = ni, nu, nw  # codes, then their sub-cells
+        ints += [codes.astype(np.int64).ravel(), fine.astype(np.int64)]
+        ni += nu * nw + len(fine)
         (umin, _), (wmin, _) = surface.u_range, surface.w_range
         floats[0][h:h + 13] = (u0, w0, du, dw, *grid.window, umin, surface.u_period or 0.0,
                                wmin, surface.w_period or 0.0, surface.normal_sign)
@@ -262,6 +262,11 @@ class CompiledStepper(Stepper):
                 self._margin = clearance
             if clearance < 0.0:
                 return COLLISION, detail
+            budget = getattr(self.guard, "budget", None)
+            if budget is not None:  # clear within this distance: the kernel commits alone
+                S = self.S
+                S[K.GUARD_Q:K.GUARD_Q + 3] = S[K.P_E:K.P_E + 3]
+                S[K.GUARD_B] = float(budget(tuple(S[K.P_E:K.P_E + 3].tolist())))
         return None
 
     # -- the landing's primitives (Stepper._land_on_limit drives them) ----------------------

@@ -5,17 +5,22 @@ points dropped by Douglas-Peucker within ``tolerance`` on cuts, fewest decimals 
 rounding within a tenth of it). Each segment's moves are written as they are: a cut's
 points as ``G1`` at the job's feed, a link's moves as ``G0`` (rapid) or ``G1`` at the
 plunge feed. The program starts with a rapid to the first segment's height and ends with
-``M2``. With ``tool_tip`` the programmed point is the ball's tip (centre Z - R).
+``M2``. With ``tool_tip`` the programmed point is the ball's tip (centre Z - R). Each
+segment starts with a comment ``(segment k: cut, ...)`` or ``(segment k: link)``, k its
+1-based index in ``program.segments`` (as the CSV's ``segment`` column).
 """
 
 from __future__ import annotations
+
+import math
+import re
 
 import numpy as np
 
 from ..errors import InputError
 from ..job import check_number
 from ..program.program import Program
-from .gcode import DEFAULT_TOLERANCE, _comment, _num, digits_for, simplify
+from .gcode import _WORD, DEFAULT_TOLERANCE, _comment, _num, digits_for, simplify
 
 
 def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: bool = False,
@@ -64,14 +69,14 @@ def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: b
             path = seg.path
             keep = simplify(seg.points, tolerance) if tolerance else np.arange(len(seg.points))
             lines.append(_comment(
-                f"cut {k}: faces {path.faces[0]} {path.faces[1]}, {len(keep)} of "
+                f"segment {k}: cut, faces {path.faces[0]} {path.faces[1]}, {len(keep)} of "
                 f"{len(seg.points)} points, stop: {path.stop_reason}"))
             if current != feed:
                 lines.append(f"F{_num(feed, 3)}")
                 current = feed
             lines += [f"G1 {xyz(p)}" for p in seg.points[keep[1:]]]
             continue
-        lines.append(_comment(f"link {k}"))
+        lines.append(_comment(f"segment {k}: link"))
         for p, rapid in zip(seg.points[1:], seg.rapid):
             if rapid:
                 lines.append(f"G0 {xyz(p)}")
@@ -84,3 +89,34 @@ def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: b
         lines.append("M5")
     lines += ["M2", "%"]
     return "\n".join(lines) + "\n"
+
+
+_SEGMENT = re.compile(r"^\(segment \d+: (cut|link)")
+
+
+def segment_moves(text: str, tool_tip_offset: float = 0.0) -> list[np.ndarray]:
+    """Per segment of a program written by :func:`program_ngc`, the (M_k, 3) ball-centre
+    positions the machine visits, as written (points dropped, rounded, the tool-tip offset
+    ``tool_tip_offset`` added back to Z), each starting at the position the segment starts
+    from. Every move of the program is in exactly one list."""
+    pos = [math.nan, math.nan, math.nan]
+    out: list[list] = []
+    for line in text.splitlines():
+        if _SEGMENT.match(line):
+            out.append([] if any(math.isnan(v) for v in pos) else [tuple(pos)])
+            continue
+        if not line.startswith(("G0 ", "G1 ")):
+            continue
+        for axis, value in _WORD.findall(line):
+            pos["XYZ".index(axis)] = float(value)
+        if out and not any(math.isnan(v) for v in pos):
+            out[-1].append(tuple(pos))
+    return [np.array(m, dtype=float).reshape(-1, 3) + (0.0, 0.0, tool_tip_offset)
+            for m in out]
+
+
+def program_written_moves(program: Program, **options) -> list[np.ndarray]:
+    """Per segment of ``program``, the positions :func:`program_ngc` with ``options``
+    commands (see :func:`segment_moves`): what the whole-program gouge gate checks."""
+    text = program_ngc(program, **options)
+    return segment_moves(text, program.job.tool.radius if options.get("tool_tip") else 0.0)

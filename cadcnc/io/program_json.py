@@ -73,10 +73,8 @@ def _segment(d: dict, k: int):
             raise InputError(f"segment {k} (link) has a non-finite point")
         return LinkSegment(pts, d.get("rapid", [True] * (len(pts) - 1)))
     if kind == "cut":
-        body = {key: v for key, v in d.items()
-                if key not in ("kind", "edge", "stretch", "at_limit")}
         try:
-            path = v1.toolpath_from_dict({**body, "format": v1.FORMAT, "version": v1.VERSION})
+            path = v1.toolpath_from_dict(v1.cut_as_toolpath_dict(d))
         except InputError as e:
             raise InputError(f"segment {k} (cut): {e}") from None
         return CutSegment(path, d.get("edge"), d.get("stretch"), bool(d.get("at_limit")))

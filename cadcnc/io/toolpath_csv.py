@@ -55,15 +55,17 @@ def write_csv(path: Toolpath, out) -> None:
 
 
 def read_csv(file) -> dict[str, np.ndarray]:
-    """{column: (N,) float array} from a file written by :func:`write_csv`."""
+    """{column: (N,) float array} from a file written by :func:`write_csv`, or by
+    ``cadcnc path`` (a program: a first column ``segment``, rows of every cut)."""
     file = Path(file)
     try:
         with open(file, newline="", encoding="utf-8") as fh:
             rows = list(csv.reader(fh))
     except FileNotFoundError:
         raise InputError(f"{file}: no such file") from None
-    if not rows or rows[0] != CSV_COLUMNS:
-        raise InputError(f"{file}: not a cadcnc toolpath CSV (unexpected header)")
+    header = rows[0] if rows else []
+    if header not in (CSV_COLUMNS, ["segment", *CSV_COLUMNS]):
+        raise InputError(f"{file}: not a cadcnc toolpath or program CSV (unexpected header)")
     data = np.array([[float(v) for v in r] for r in rows[1:]], dtype=float).reshape(
-        -1, len(CSV_COLUMNS))
-    return {name: data[:, i] for i, name in enumerate(CSV_COLUMNS)}
+        -1, len(header))
+    return {name: data[:, i] for i, name in enumerate(header)}

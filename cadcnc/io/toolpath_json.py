@@ -133,7 +133,7 @@ def write_json(path: Toolpath, out) -> None:
 
 
 def read_json(file) -> Toolpath:
-    """Read a toolpath JSON file; errors name the file."""
+    """Read a toolpath JSON file (or a program of one cut); errors name the file."""
     file = Path(file)
     try:
         data = json.loads(file.read_text(encoding="utf-8"))
@@ -142,6 +142,30 @@ def read_json(file) -> Toolpath:
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise InputError(f"{file}: not a toolpath JSON file ({e})") from None
     try:
-        return toolpath_from_dict(data)
+        return toolpath_from_dict(one_cut_of_program(data))
     except InputError as e:
         raise InputError(f"{file}: {e}") from None
+
+
+PROGRAM_FORMAT = "cadcnc-program"
+CUT_KEYS = ("kind", "edge", "stretch", "at_limit")
+"""Keys of a program's cut segment that a version 1 toolpath does not have."""
+
+
+def cut_as_toolpath_dict(cut: dict) -> dict:
+    """A program's cut segment (dict) as a version 1 toolpath dict."""
+    body = {k: v for k, v in cut.items() if k not in CUT_KEYS}
+    return {**body, "format": FORMAT, "version": VERSION}
+
+
+def one_cut_of_program(data):
+    """``data`` itself, or the only cut of a program (version 2) dict as a version 1
+    toolpath dict: old callers of :func:`read_json` keep working on one-cut programs."""
+    if not (isinstance(data, dict) and data.get("format") == PROGRAM_FORMAT):
+        return data
+    cuts = [s for s in data.get("segments") or [] if isinstance(s, dict)
+            and s.get("kind") == "cut"]
+    if len(cuts) != 1:
+        raise InputError(f"a program of {len(cuts)} cuts is not one toolpath: read it with "
+                         "cadcnc.io.program_json.read_program")
+    return cut_as_toolpath_dict(cuts[0])

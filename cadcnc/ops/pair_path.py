@@ -90,7 +90,12 @@ def shared_edge_for(s1: FaceSurface, s2: FaceSurface, edge: int = 0):
 def pair_job(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,
              period: float, start=None, end=None, offsets=None, edge: int = 0,
              tol: Tolerances = DEFAULT) -> tuple[FaceSurface, FaceSurface, Job]:
-    """The two faces as surfaces and the validated :class:`Job` of keyword arguments."""
+    """The two faces as surfaces and the validated :class:`Job` of keyword arguments (one
+    path: ``edge`` is one index; a program takes None for every edge)."""
+    if edge is None:
+        raise InputError("edge must be an index >= 0 among the shared concave edges: one "
+                         "path follows one edge (cadcnc.ops.pair_program.program_for_job "
+                         "follows every stretch of every edge)")
     tool = Tool(radius, allowance)
     op = PairPath(offsets=(None, None) if offsets is None else offsets, start=start, end=end,
                   edge=edge)

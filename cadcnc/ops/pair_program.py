@@ -18,9 +18,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..errors import InputError, StartPointError
+from ..errors import GeometryError, InputError, StartPointError
 from ..geometry.clearance import guard_for
 from ..interp.cycle import BOUNDARY, COLLISION
+from ..interp.stepper import Tangency
 from ..job import Job
 from ..program.linking import linked
 from ..program.program import STOPPED_SHORT, CutSegment, Program, Skipped
@@ -42,10 +43,16 @@ def safe_height(part, job: Job) -> float:
     return job.clearance if job.clearance is not None else part.top + SAFE_MARGIN
 
 
-def _run(plan: PathPlan, guard, max_cycles: int, progress) -> Toolpath:
+def _run(plan: PathPlan, guard, max_cycles: int, progress, allow_empty: bool = False
+         ) -> Toolpath:
+    """Run the plan's stepper with ``guard``; a path of its start alone is an error unless
+    ``allow_empty`` (the caller then skips it with the stop's reason)."""
     stepper = stepper_for(plan, max_cycles, True)
     stepper.guard = guard
     stepper.run(progress)
+    if stepper.cycles == 0 and not allow_empty:
+        raise GeometryError(f"no path: the interpolator stopped at the start point "
+                            f"({stepper.stop_reason}): {stepper.stop_detail}")
     return toolpath_from_record(stepper.record, plan.job, stepper.stop_reason,
                                 stepper.stop_detail, plan.edge_length)
 
@@ -91,29 +98,84 @@ def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000, progress=Non
                              f"is no edge {op.edge + 1}")
         found = [found[op.edge]]
     refuse_without_stretch(s1, s2, found)
+    cuts, skipped = stretch_cuts(s1, s2, job, found, guard, max_cycles, progress)
+    if op.stretch is not None and not cuts:
+        n = max(len(e.stretches) for e in found)
+        raise InputError(f"faces {i} and {j}: there is no stretch {op.stretch} (the edges "
+                         f"have at most {n})")
+    return Program(job, linked(cuts, safe_height(part, job)), skipped)
+
+
+def climb_measure(tp: Toolpath) -> float:
+    """Mean over the path's moves of (t x z) . m: > 0 when the material lies to the right
+    of the travel (climb milling with a clockwise spindle, M3), < 0 conventional, ~0 for a
+    corner that runs up or down. t: unit move direction; m: the horizontal direction into
+    the material, -(n1 + n2), normalised with the normals' sum (dimensionless)."""
+    d = np.diff(tp.points, axis=0)
+    length = np.linalg.norm(d, axis=1)
+    ok = length > 0.0
+    if not ok.any():
+        return 0.0
+    t = d[ok] / length[ok, None]
+    m = -(tp.normals[1:, 0] + tp.normals[1:, 1])[ok]
+    right = np.stack([t[:, 1], -t[:, 0], np.zeros(len(t))], axis=1)   # t x z
+    return float(np.mean(np.einsum("ij,ij->i", right, m)))
+
+
+CLIMB, CONVENTIONAL = "climb", "conventional"
+SIDE_MIN = 0.05
+"""|climb_measure| below this: the corner runs mostly up or down; its direction is kept."""
+
+
+def _reversed(tp: Toolpath, plan: PathPlan) -> PathPlan:
+    """The plan of the same cut run the other way: from its last point to its first."""
+    last = Tangency(tuple(tp.points[-1]), tuple(tp.uv[-1, 0]), tuple(tp.uv[-1, 1]))
+    first = plan.start
+    if plan.closed:
+        back = -(tp.points[1] - tp.points[0])
+        return replace(plan, direction=tuple(map(float, back)))
+    back = -(tp.points[-1] - tp.points[-2])
+    op = replace(plan.job.operation, start=tuple(last.p), end=tuple(first.p))
+    return replace(plan, job=replace(plan.job, operation=op), start=last, end=first,
+                   direction=tuple(map(float, back)))
+
+
+def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
+                 progress=None, side: str | None = None
+                 ) -> tuple[list[CutSegment], list[Skipped]]:
+    """A cut per stretch of ``found`` (every stretch, or stretch ``job.operation.stretch``
+    of each edge), in order along each edge, and what was skipped: edges with no feasible
+    position, and the rest of a stretch whose cut stopped short of its end.
+
+    ``side``: CLIMB or CONVENTIONAL runs every cut that way (the material on the right of
+    the travel for climb; see :func:`climb_measure`), re-running a cut from its other end
+    where the edge's own direction is the other way; None keeps the edge's direction."""
+    i, j = s1.number, s2.number
     cuts, skipped = [], []
     for e in found:
         if not e.stretches:
             skipped.append(Skipped((i, j), NO_STRETCH, e.refusal, e.edge + 1))
             continue
         for k, st in enumerate(e.stretches, 1):
-            if op.stretch is not None and k != op.stretch:
+            if job.operation.stretch is not None and k != job.operation.stretch:
                 continue
             cjob = _cut_job(job, st, k)
             plan = replace(plan_for_stretch(s1, s2, cjob, st), job=cjob)
             tp = _run(plan, guard, max_cycles, progress)
-            cuts.append(CutSegment(tp, edge=e.edge + 1, stretch=k,
-                                   at_limit=_reached_limit(tp, st)))
+            at_limit = _reached_limit(tp, st)
+            if side is not None and at_limit and len(tp) > 2:
+                measure = climb_measure(tp)
+                if abs(measure) >= SIDE_MIN and (measure > 0) != (side == CLIMB):
+                    back = _run(_reversed(tp, plan), guard, max_cycles, progress)
+                    if back.complete or back.stop_reason in (BOUNDARY, COLLISION):
+                        tp = back
+            cuts.append(CutSegment(tp, edge=e.edge + 1, stretch=k, at_limit=at_limit))
             if not cuts[-1].at_limit:
                 skipped.append(Skipped((i, j), STOPPED_SHORT, (
                     f"stretch {k} of edge {e.edge + 1}: {tp.partial_reason}; the rest of "
                     f"the stretch ({tp.length:.3f} of {st.length:.3f} mm cut) is not cut"),
                     e.edge + 1))
-    if op.stretch is not None and not cuts:
-        n = max(len(e.stretches) for e in found)
-        raise InputError(f"faces {i} and {j}: there is no stretch {op.stretch} (the edges "
-                         f"have at most {n})")
-    return Program(job, linked(cuts, safe_height(part, job)), skipped)
+    return cuts, skipped
 
 
 def _from_start(part, job, s1, s2, guard, max_cycles, progress) -> Program:

@@ -17,6 +17,8 @@ from .program import CutSegment, LinkSegment
 
 APPROACH = 2.0
 """mm above a cut's start where the rapid descent ends and the plunge at feed begins."""
+TWO_OPT_MAX = 150
+"""2-opt (cubic per pass) is run on at most this many chains; above, nearest neighbour."""
 JOINED = 1e-9
 """mm: a cut that starts where the previous one ended continues without a link."""
 
@@ -66,16 +68,86 @@ def retract(a: np.ndarray, z_safe: float) -> LinkSegment:
     return LinkSegment(np.array([a, (a[0], a[1], max(z_safe, a[2]))]), np.array([True]))
 
 
-def linked(cuts: list[CutSegment], z_safe: float, approach_mm: float = APPROACH) -> list:
+def linked(cuts: list[CutSegment], z_safe: float, approach_mm: float = APPROACH,
+           join: float = 0.0) -> list:
     """``cuts`` in order with an approach before the first, a link between each two, and a
-    retract after the last: the segments of a program."""
+    retract after the last: the segments of a program. Two cuts whose gap is at most
+    ``join`` mm (a chain: the next starts where the last stopped, both located to within
+    their limits' accuracy) are joined by one straight feed move instead of a lift."""
     if not cuts:
         return []
     out: list = [approach(cuts[0].points[0], z_safe, approach_mm)]
     for k, cut in enumerate(cuts):
-        gap = np.linalg.norm(cut.points[0] - cuts[k - 1].points[-1]) if k else 0.0
-        if gap > JOINED:
-            out.append(link(cuts[k - 1].points[-1], cut.points[0], z_safe, approach_mm))
+        a = cuts[k - 1].points[-1] if k else cut.points[0]
+        gap = float(np.linalg.norm(cut.points[0] - a))
+        if JOINED < gap <= join:
+            out.append(LinkSegment(np.array([a, cut.points[0]]), np.array([False])))
+        elif gap > JOINED:
+            out.append(link(a, cut.points[0], z_safe, approach_mm))
         out.append(cut)
     out.append(retract(cuts[-1].points[-1], z_safe))
     return out
+
+
+def _travel(a: np.ndarray, b: np.ndarray) -> float:
+    """Cost of moving from a cut's end a to the next cut's start b: 0 for a chain, else the
+    horizontal distance (the lift and plunge are the same for every order)."""
+    return float(np.hypot(*(b[:2] - a[:2])))
+
+
+def order_cuts(cuts: list[CutSegment], join: float = 0.0) -> list[CutSegment]:
+    """``cuts`` reordered (each keeps its direction) to shorten the travel between them:
+    chains first (a cut starting within ``join`` of another's end follows it), then nearest
+    neighbour from the first cut, then 2-opt on the sequence of chains."""
+    if len(cuts) < 2:
+        return list(cuts)
+    starts = np.array([c.points[0] for c in cuts])
+    ends = np.array([c.points[-1] for c in cuts])
+    nxt: dict[int, int] = {}
+    taken: set[int] = set()
+    for i in range(len(cuts)):  # chains: i's end meets j's start
+        d = np.linalg.norm(starts - ends[i], axis=1)
+        d[i] = np.inf
+        for j in np.argsort(d):
+            if d[j] > join:
+                break
+            if j not in taken:
+                nxt[i] = int(j)
+                taken.add(int(j))
+                break
+    heads = [i for i in range(len(cuts)) if i not in taken] or [0]
+    chains = []
+    seen: set[int] = set()
+    for h in heads + list(range(len(cuts))):
+        if h in seen:
+            continue
+        chain = [h]
+        seen.add(h)
+        while chain[-1] in nxt and nxt[chain[-1]] not in seen:
+            chain.append(nxt[chain[-1]])
+            seen.add(chain[-1])
+        chains.append(chain)
+    first = lambda ch: starts[ch[0]]  # noqa: E731
+    last = lambda ch: ends[ch[-1]]  # noqa: E731
+    order = [chains.pop(0)]
+    while chains:  # nearest neighbour
+        k = min(range(len(chains)), key=lambda m: _travel(last(order[-1]), first(chains[m])))
+        order.append(chains.pop(k))
+    improved = len(order) <= TWO_OPT_MAX
+    while improved:  # 2-opt on chains kept in their direction: reverse the visiting order
+        improved = False
+        for i in range(1, len(order) - 1):
+            for j in range(i + 1, len(order)):
+                before = _travel(last(order[i - 1]), first(order[i]))
+                after = _travel(last(order[i - 1]), first(order[j]))
+                if j + 1 < len(order):
+                    before += _travel(last(order[j]), first(order[j + 1]))
+                    after += _travel(last(order[i]), first(order[j + 1]))
+                inner_before = sum(_travel(last(order[m]), first(order[m + 1]))
+                                   for m in range(i, j))
+                inner_after = sum(_travel(last(order[m + 1]), first(order[m]))
+                                  for m in range(i, j))
+                if after + inner_after < before + inner_before - 1e-9:
+                    order[i:j + 1] = order[i:j + 1][::-1]
+                    improved = True
+    return [cuts[k] for chain in order for k in chain]

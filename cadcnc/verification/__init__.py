@@ -19,13 +19,15 @@ its JSON), :mod:`.verdict` (its criteria), :mod:`.surface_checks` (per-face devi
 :mod:`.whole_part` (the ball against every face, at the centres and along the moves),
 :mod:`.sweep` (distances along a polyline), :mod:`.bounds` (the segment bound),
 :mod:`.material` (faces, boxes and the solid classifier), :mod:`.path_checks` (feed,
-theory, stop), :mod:`.reference` (OCCT's intersection curve), :mod:`.gate`, :mod:`.run`
+theory, stop), :mod:`.reference` (OCCT's intersection curve), :mod:`.gate`, :mod:`.program_gate`
+(every cut and link of a program), :mod:`.run`
 (:func:`verify`), :mod:`.probe` (OCCT primitives), :mod:`.table` (text).
 """
 
 from __future__ import annotations
 
 from .gate import GateResult, gouge_gate
+from .program_gate import ProgramGate, gate_program
 from .records import (
     Criterion, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, SweepCheck, SweepHit,
     TheoryRow, WholePartCheck, WholePartHit,
@@ -34,7 +36,7 @@ from .report import VerificationReport
 from .run import verify
 
 __all__ = [
-    "verify", "gouge_gate", "GateResult", "VerificationReport", "SurfaceCheck",
+    "verify", "gouge_gate", "GateResult", "gate_program", "ProgramGate", "VerificationReport", "SurfaceCheck",
     "ReferenceCheck", "FeedCheck", "TheoryRow", "StopCheck", "WholePartCheck",
     "WholePartHit", "SweepCheck", "SweepHit", "Criterion",
 ]

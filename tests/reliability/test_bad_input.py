@@ -65,7 +65,7 @@ def test_negative_start_coordinates_need_no_equals_sign(tmp_path):
 def test_edge_number_is_reported_as_the_user_counts(tmp_path):
     run = cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "--edge", "2",
                      "-o", tmp_path / "p.json")
-    one_line_error(run, 2, "no concave edge number 2")
+    one_line_error(run, 2, "there is no edge 2")
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root reads files whatever their mode")
@@ -123,7 +123,9 @@ def test_api_refuses_mistakes_with_clear_errors():
     with pytest.raises(cadcnc.InputError, match="start must be a point"):
         cadcnc.intersection_path(floor, boss, start="1,2,3", **kw)
     with pytest.raises(cadcnc.InputError, match="edge"):
-        cadcnc.intersection_path(floor, boss, edge=None, **kw)
+        cadcnc.intersection_path(floor, boss, edge=-1, **kw)
+    with pytest.raises(cadcnc.InputError, match="edge"):
+        cadcnc.intersection_path(floor, boss, edge="1", **kw)
     with pytest.raises(cadcnc.FaceNumberError, match="True"):
         part.face(True)
     with pytest.raises(cadcnc.InputError, match="finite"):

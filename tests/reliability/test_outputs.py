@@ -83,7 +83,7 @@ def test_symlinked_output_is_followed_not_replaced(tmp_path):
     link = tmp_path / "link.json"
     link.symlink_to(target)
     cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", link, "--quiet", check=0)
-    assert link.is_symlink() and json.loads(target.read_text())["format"] == "cadcnc-toolpath"
+    assert link.is_symlink() and json.loads(target.read_text())["format"] == "cadcnc-program"
 
 
 def test_a_very_long_output_name_is_a_clear_error(tmp_path):
@@ -92,15 +92,23 @@ def test_a_very_long_output_name_is_a_clear_error(tmp_path):
     one_line(run, 4, "file name too long")
 
 
+def _cut(d: dict) -> dict:
+    """The first cut segment of a program dict (version 2)."""
+    return next(s for s in d["segments"] if s["kind"] == "cut")
+
+
 @pytest.mark.parametrize("edit, needle", [
-    (lambda d: d.update(faces=[4]), "two values"),
-    (lambda d: d.update(offsets=[3.0]), "two values"),
-    (lambda d: d.update(points=[], contacts=[], normals=[], uv=[], steps=[], commanded=[]),
-     "no points"),
-    (lambda d: d["points"][3].__setitem__(0, "NaN"), "non-finite"),
-    (lambda d: d["inputs"].update(radius="NaN"), "radius"),
+    (lambda d: _cut(d).update(faces=[4]), "two values"),
+    (lambda d: _cut(d).update(offsets=[3.0]), "two values"),
+    (lambda d: _cut(d).update(points=[], contacts=[], normals=[], uv=[], steps=[],
+                              commanded=[]), "no points"),
+    (lambda d: _cut(d)["points"][3].__setitem__(0, "NaN"), "non-finite"),
+    (lambda d: _cut(d)["inputs"].update(radius="NaN"), "radius"),
+    (lambda d: d["job"].update(radius="NaN"), "radius"),
+    (lambda d: d["segments"][0]["points"][0].__setitem__(2, "NaN"), "non-finite"),
 ])
 def test_malformed_path_json_is_refused_quickly(tmp_path, edit, needle):
+    """Program JSON (version 2) with a bad cut, job or link is refused with the reason."""
     saved = tmp_path / "p.json"
     cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", saved, "--quiet", check=0)
     data = json.loads(saved.read_text())
@@ -122,16 +130,15 @@ def test_stream_is_gated_before_the_first_increment(tmp_path):
     assert run.returncode == 5 and run.stdout == "" and "face 5 by 2 mm" in run.stderr
 
 
-def test_partial_path_exits_6_and_is_written_only_when_allowed(tmp_path):
+def test_a_path_ending_at_its_stretch_limit_is_complete(tmp_path):
+    """The ramp's wall ends 12 mm before the edge does: the stretch ends there (a contact
+    reaches its face's boundary), an intended end, so the program is complete (exit 0).
+    A program stopped short exits 6: tests/test_cli_program.py."""
     out = tmp_path / "ramp.json"
     args = ["path", FIXTURES / "ramp_wall.step", "--faces", "3", "7", *JOB, "-o", out]
     run = cadcnc_cli(*args)
-    # how far of how much, and why: the same words on stderr and in the summary
-    why = "partial: stopped at 28.000 of 40.0 mm (the edge's length): boundary"
-    assert run.returncode == 6 and why in run.stderr
-    assert not out.exists()
-    run = cadcnc_cli(*args, "--allow-partial")
-    assert run.returncode == 6 and out.exists() and f"result     {why}" in run.stdout
+    assert run.returncode == 0 and out.exists() and "result     complete" in run.stdout
+    assert "edge 1, stretch 1: 28.0" in run.stdout and run.stderr == ""
 
 
 def test_complete_path_says_so(tmp_path):
@@ -142,9 +149,9 @@ def test_complete_path_says_so(tmp_path):
     assert "accuracy   feed reduced on " in run.stdout and "for accuracy (0.001 mm)" in run.stdout
     run = cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", "/dev/null/x.json")
     assert run.returncode == 4  # the destination is checked before computing
-    ok = cadcnc_cli("verify", FIXTURES / "crossing_cylinders.step", "--faces", "1", "2", *JOB,
+    ok = cadcnc_cli("verify", FIXTURES / "stretch_shelf.step", "--faces", "11", "8", *JOB,
                     "--quiet")
-    assert ok.returncode == 0
+    assert ok.returncode == 0, ok.stderr
 
 
 def _cli(*args):
@@ -187,4 +194,4 @@ def test_ctrl_c_after_the_files_are_written_keeps_the_exit_code(tmp_path):
             break
     proc.communicate(timeout=60)
     assert proc.returncode in (0, 130), proc.returncode
-    assert json.loads(out.read_text())["faces"] == [4, 5]
+    assert _cut(json.loads(out.read_text()))["faces"] == [4, 5]

@@ -52,6 +52,7 @@ END_P, END_UV1, END_UV2, HAS_END, CLOSED = 40, 43, 45, 47, 48
 TOL_TANGENT, TOL_FLAT, TOL_SINGULAR, TOL_DIVERGED, TOL_ACCURACY = 49, 50, 51, 52, 53
 TOL_END, MIN_STEP, CHECK_BOUNDARY, WATCH, AUTO_COMMIT = 54, 55, 56, 57, 58
 TRIM_STATE, REESTIMATE = 60, 62          # 2 states (0 in, 1 out, 2 ask), 2 x (u, w)
+GUARD_Q, GUARD_B = 66, 69                # the guard's budget: clear within B of Q
 C1, C2, N1, N2, KEPT1, KEPT2, KEPT_P, KEPT_T = 80, 104, 128, 152, 176, 200, 224, 227
 D_OUT, WORK = 240, 260
 STATE_SIZE = WORK + 2048
@@ -92,8 +93,9 @@ def trim_cell(F: np.ndarray, I: np.ndarray, s: int, u: float, w: float) -> int:
     g = I[h + 13]
     nu = I[h + 14]
     nw = I[h + 15]
-    return lookup(I[g:g + nu * nw].reshape((nu, nw)), F[h], F[h + 1], F[h + 2], F[h + 3],
-                  nu, nw, wrap(u, F[h + 4], F[h + 5]), wrap(w, F[h + 6], F[h + 7]))
+    return lookup(I[g:g + nu * nw].reshape((nu, nw)), I[g + nu * nw:], F[h], F[h + 1],
+                  F[h + 2], F[h + 3], nu, nw, wrap(u, F[h + 4], F[h + 5]),
+                  wrap(w, F[h + 6], F[h + 7]))
 
 
 @_jit
@@ -340,17 +342,28 @@ def begin(F: np.ndarray, I: np.ndarray, S: np.ndarray, R: np.ndarray, n_rec: int
 @_jit
 def step(F: np.ndarray, I: np.ndarray, S: np.ndarray, R: np.ndarray, n_rec: int,
          f_cmd: float) -> int:
-    """One period: DONE when committed (S[AUTO_COMMIT] set: no guard), else the status
+    """One period: DONE when committed (S[AUTO_COMMIT] set: no guard; or the trial centre
+    within the guard's budget), else the status
     the caller finishes (PASSED, CHECK_TRIM, a failure to land on, END_*)."""
     status = begin(F, I, S, R, n_rec, f_cmd)
     if status != DONE:
         return status
     S[WATCH] = WATCH_NONE
     status = trial(F, I, S, S[F_TRIAL])
-    if status == PASSED and S[AUTO_COMMIT] != 0.0:
+    if status == PASSED and (S[AUTO_COMMIT] != 0.0 or within_budget(S)):
         commit(S, R, n_rec, vec(S, P_E), vec(S, TR_T), S[F_TRIAL])
         return DONE
     return status
+
+
+@_jit
+def within_budget(S: np.ndarray) -> bool:
+    """Whether the trial centre lies within the guard's budget (S[GUARD_B] mm of the centre
+    S[GUARD_Q] where the guard gave it): known clear, no need to ask the guard."""
+    d = 0.0
+    for k in range(3):
+        d += (S[P_E + k] - S[GUARD_Q + k]) ** 2
+    return math.sqrt(d) < S[GUARD_B]
 
 
 @_jit

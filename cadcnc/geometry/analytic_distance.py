@@ -1,0 +1,226 @@
+"""Closed-form distances from a point, and from a vertical segment, to analytic faces.
+
+Used by the clearance guard (:mod:`.clearance`) so that OCCT's BRepExtrema is needed
+only where no closed form applies. For a plane, cylinder or sphere (and a torus for the
+point distance) the nearest point of the whole, untrimmed surface is found in closed
+form; the face is a subset of that surface, so when that foot lies strictly inside the
+trimmed face (the face's 2-D classifier says IN) the distance to the face equals the
+distance to the surface. Otherwise (a foot outside the face or on its boundary, another
+kind of surface, a degenerate configuration) the functions return None and the caller
+falls back to OCCT. Lengths mm; points are 3-tuples of floats.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from OCP.TopAbs import TopAbs_IN
+from OCP.gp import gp_Pnt2d
+
+EPS = 1e-12   # relative: below this a direction or radius is degenerate
+
+
+class AnalyticFace:
+    """The closed-form data of one face: kind, frame (origin o, axes x, y, z), radii."""
+
+    def __init__(self, face):
+        self.face = face
+        self.kind = None
+        s = face._adaptor
+        getter = {"plane": s.Plane, "cylinder": s.Cylinder, "sphere": s.Sphere,
+                  "torus": s.Torus}.get(face.kind)
+        if getter is None:
+            return
+        g = getter()
+        pos = g.Position()
+        self.o = _xyz(pos.Location())
+        self.x, self.y, self.z = (_xyz(pos.XDirection()), _xyz(pos.YDirection()),
+                                  _xyz(pos.Direction()))
+        self.r = g.Radius() if face.kind in ("cylinder", "sphere") else 0.0
+        if face.kind == "torus":
+            self.r_major, self.r = g.MajorRadius(), g.MinorRadius()
+            if self.r >= self.r_major:     # a horn or spindle torus: no simple foot
+                return
+        self.kind = face.kind
+        self._uv = gp_Pnt2d()
+
+    # -- the foot's parameters and the trim ------------------------------------------------
+    def _inside(self, q) -> bool:
+        """Whether surface point q lies strictly inside the trimmed face."""
+        w = _sub(q, self.o)
+        lx, ly, lz = _dot(w, self.x), _dot(w, self.y), _dot(w, self.z)
+        if self.kind == "plane":
+            u, v = lx, ly
+        elif self.kind == "cylinder":
+            u, v = math.atan2(ly, lx), lz
+        elif self.kind == "sphere":
+            u = math.atan2(ly, lx)
+            v = math.atan2(lz, math.hypot(lx, ly))
+        else:  # torus
+            u = math.atan2(ly, lx)
+            v = math.atan2(lz, math.hypot(lx, ly) - self.r_major)
+        f = self.face
+        if f._classifier is None:
+            f.classify(*f.wrap(u, v))          # builds the classifier once
+        self._uv.SetCoord(*f.wrap(u, v))
+        return f._classifier.Perform(self._uv) == TopAbs_IN
+
+    # -- point -------------------------------------------------------------------------
+    def point_distance(self, p, trimmed: bool = True) -> float | None:
+        """Distance (mm) from p to the face, or None where no closed form applies;
+        ``trimmed=False``: to the whole surface (a lower bound of the face's)."""
+        if self.kind is None:
+            return None
+        foot_d = self._surface_foot(p)
+        if foot_d is None:
+            return None
+        foot, d = foot_d
+        return d if not trimmed or self._inside(foot) else None
+
+    def _surface_foot(self, p):
+        """(nearest point of the untrimmed surface, distance) or None when not unique."""
+        w = _sub(p, self.o)
+        if self.kind == "plane":
+            h = _dot(w, self.z)
+            return _axpy(-h, self.z, p), abs(h)
+        if self.kind == "sphere":
+            n = _norm(w)
+            if n < EPS * max(self.r, 1.0):
+                return None
+            return _axpy(self.r / n, w, self.o), abs(n - self.r)
+        a = _dot(w, self.z)
+        radial = _axpy(-a, self.z, w)          # w minus its axial part
+        rho = _norm(radial)
+        if rho < EPS * max(self.r, 1.0):
+            return None
+        if self.kind == "cylinder":
+            foot = _axpy(self.r / rho, radial, _axpy(a, self.z, self.o))
+            return foot, abs(rho - self.r)
+        # torus: the tube circle's centre in the meridian plane of p, then a sphere
+        c = _axpy(self.r_major / rho, radial, self.o)
+        t = _sub(p, c)
+        n = _norm(t)
+        if n < EPS * max(self.r, 1.0):
+            return None
+        return _axpy(self.r / n, t, c), abs(n - self.r)
+
+    # -- vertical segment ----------------------------------------------------------------
+    def segment_distance(self, p, length: float, trimmed: bool = True) -> float | None:
+        """Distance (mm) from the segment p .. p + length z (global z) to the face, or None
+        (``trimmed=False``: to the whole surface, a lower bound; a torus's too).
+
+        Plane, cylinder and sphere: along the segment the signed plane height is linear
+        and the squared distance to the axis or centre is a convex quadratic in s, so the
+        nearest segment point is an end, the quadratic's vertex, or a crossing of the
+        surface (distance 0); the foot of that point decides.
+        """
+        if self.kind == "torus" and not trimmed:
+            return self.segment_lower_bound(p, length)
+        if self.kind not in ("plane", "cylinder", "sphere"):
+            return None
+        if self.kind == "plane":
+            h0 = _dot(_sub(p, self.o), self.z)
+            h1 = h0 + length * self.z[2]
+            if h0 * h1 <= 0.0 and h0 != h1:
+                s = -h0 / self.z[2]
+                q = (p[0], p[1], p[2] + s)
+                return 0.0 if not trimmed or self._inside(q) else None
+            s = 0.0 if abs(h0) < abs(h1) else length
+            return self.point_distance((p[0], p[1], p[2] + s), trimmed)
+        # squared distance to the axis (cylinder) or centre (sphere): A s^2 + 2 B s + C
+        w0 = _sub(p, self.o)
+        if self.kind == "cylinder":
+            w0 = _axpy(-_dot(w0, self.z), self.z, w0)
+            e = _axpy(-self.z[2], self.z, (0.0, 0.0, 1.0))
+        else:
+            e = (0.0, 0.0, 1.0)
+        qa, qb, qc = _dot(e, e), _dot(w0, e), _dot(w0, w0)
+        r2 = self.r * self.r
+        f0, f1 = qc, qa * length * length + 2.0 * qb * length + qc
+        s_min = min(max(-qb / qa, 0.0), length) if qa > EPS else 0.0
+        fmin = qa * s_min * s_min + 2.0 * qb * s_min + qc
+        fmax = max(f0, f1)
+        if fmin <= r2 <= fmax:                 # the segment crosses the surface
+            disc = qb * qb - qa * (qc - r2)
+            if qa <= EPS or disc < 0.0:
+                return None
+            for s in ((-qb - math.sqrt(disc)) / qa, (-qb + math.sqrt(disc)) / qa):
+                if 0.0 <= s <= length and (not trimmed or self._inside((p[0], p[1], p[2] + s))):
+                    return 0.0
+            return None
+        # a tie (several nearest segment points) is fine: any global minimiser whose foot
+        # is inside the face gives the face's distance
+        if fmin > r2:                          # wholly outside: the vertex or an end
+            return self.point_distance((p[0], p[1], p[2] + s_min), trimmed)
+        return self.point_distance((p[0], p[1], p[2] + (0.0 if f0 >= f1 else length)), trimmed)
+
+
+    def segment_lower_bound(self, p, length: float) -> float | None:
+        """A lower bound (mm) of the distance from the segment p .. p + length z to a
+        torus face: the distance to the whole torus, min over s of |g(s) - r| with g the
+        distance to the tube's core circle; None for other kinds or near the axis.
+
+        g^2 = q - 2 R rho + R^2 (q: squared distance to the centre, rho: to the axis,
+        both quadratics in s under the square); its critical points solve
+        (s + b)^2 rho^2(s) = R^2 (A s + B)^2, a quartic, so g's range over [0, length]
+        is the range of its values at the quartic's real roots and at both ends (numpy's
+        companion-matrix roots, polished by Newton).
+        """
+        if self.kind != "torus":
+            return None
+        w0 = _sub(p, self.o)
+        w0 = _axpy(-_dot(w0, self.z), self.z, w0)            # radial part at s = 0
+        e = _axpy(-self.z[2], self.z, (0.0, 0.0, 1.0))       # radial part of +z
+        qa, qb, qc = _dot(e, e), _dot(w0, e), _dot(w0, w0)   # rho^2 = qa s^2 + 2 qb s + qc
+        s_v = min(max(-qb / qa, 0.0), length) if qa > EPS else 0.0
+        if qa * s_v * s_v + 2.0 * qb * s_v + qc < (EPS * self.r_major) ** 2 + 1e-18:
+            return None                                     # the segment meets the axis
+        b = p[2] - self.o[2]                                 # q' / 2 = s + b
+        quartic = np.convolve([1.0, 2.0 * b, b * b], [qa, 2.0 * qb, qc])   # 5 coefficients
+        quartic[2:] -= self.r_major ** 2 * np.array([qa * qa, 2.0 * qa * qb, qb * qb])
+        cands = [0.0, length]
+        deriv = np.polyder(quartic)
+        # every root's real part is a candidate: g's value at an extra point stays within
+        # g's true range, and a near-double real root may come out slightly complex
+        for root in np.roots(quartic) if np.any(quartic) else ():
+            s = float(root.real)
+            for _ in range(2):   # polish on the quartic, only where it improves
+                d = float(np.polyval(deriv, s))
+                t = s - float(np.polyval(quartic, s)) / d if d else s
+                if not abs(np.polyval(quartic, t)) < abs(np.polyval(quartic, s)):
+                    break
+                s = t
+            if 0.0 <= s <= length:
+                cands.append(s)
+        gs = []
+        for s in cands:
+            rho = math.sqrt(max(qa * s * s + 2.0 * qb * s + qc, 0.0))
+            ax = _dot(_sub((p[0], p[1], p[2] + s), self.o), self.z)
+            gs.append(math.hypot(rho - self.r_major, ax))
+        lo, hi = min(gs), max(gs)
+        if lo <= self.r <= hi:
+            return 0.0
+        return lo - self.r if lo > self.r else self.r - hi
+
+
+def _xyz(v) -> tuple[float, float, float]:
+    return (v.X(), v.Y(), v.Z())
+
+
+def _sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _dot(a, b) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _axpy(s: float, a, b):
+    """s a + b."""
+    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
+
+
+def _norm(a) -> float:
+    return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])

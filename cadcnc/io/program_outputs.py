@@ -1,0 +1,53 @@
+"""A program rendered by the output file's suffix: .json (version 2), .csv, .ngc, .png, .glb.
+
+CSV of a program: the toolpath CSV's columns (:data:`~cadcnc.io.toolpath_csv.CSV_COLUMNS`)
+after a first column ``segment``, the 1-based index of the cut in the program's
+``segments`` (links included in the count, so segment numbers match the JSON and the
+G-code comments). One row per cycle of every cut, in machining order; links have no row
+(they carry no contacts: their moves are in the JSON and the G-code).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from pathlib import Path
+
+from ..errors import OutputError
+from ..program.program import Program
+from .program_gcode import program_ngc
+from .program_json import program_json
+from .program_plot import program_picture_bytes
+from .toolpath_csv import CSV_COLUMNS, toolpath_rows
+
+PROGRAM_SUFFIXES = (".json", ".csv", ".ngc", ".png", ".glb")
+PROGRAM_CSV_COLUMNS = ["segment", *CSV_COLUMNS]
+
+
+def program_csv(program: Program) -> str:
+    """One row per cycle of every cut (see the module doc)."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(PROGRAM_CSV_COLUMNS)
+    for k, seg in enumerate(program.segments, 1):
+        if seg.kind != "cut":
+            continue
+        for row in toolpath_rows(seg.path):
+            w.writerow([str(k), str(int(row[0]))] + [repr(float(v)) for v in row[1:]])
+    return buf.getvalue()
+
+
+def render_program(program: Program, out, part=None, title: str = "", **gcode) -> str | bytes:
+    """The content of ``out`` by its suffix. ``gcode``: :func:`program_ngc` keywords
+    (tolerance, tool_tip, spindle, plunge_feed); ``part`` is needed for pictures."""
+    kind = Path(out).suffix.lower()
+    if kind == ".json":
+        return program_json(program)
+    if kind == ".csv":
+        return program_csv(program)
+    if kind == ".ngc":
+        return program_ngc(program, title=title, **gcode)
+    if kind in (".png", ".glb"):
+        return program_picture_bytes(program, part, out, title)
+    raise OutputError(f"{out}: unknown output format {kind!r}; use one of "
+                      f"{', '.join(PROGRAM_SUFFIXES)}")
