@@ -24,6 +24,7 @@ import json
 import math
 import multiprocessing
 import os
+import re
 import sys
 import time
 from pathlib import Path
@@ -58,8 +59,13 @@ def pairs_of(step: str) -> tuple[list[tuple[int, int]], str | None]:
 
 
 def judge_path(o: Oracle, faces, polylines, offset: float, cap: int) -> dict:
-    """Silent-bad check of written cut points (at most ``cap`` evenly spread per polyline)."""
+    """Silent-bad check of written cut points (at most ``cap`` evenly spread per polyline).
+
+    ``shank_mm``: how far the shank (p to p + 10 R' z) comes nearer than R' to the part
+    at the worst checked point, with its face; reported beside silent-bad (the shank
+    rule is the spec's, the gouge gate does not check it)."""
     worst_face, worst_gouge, checked = 0.0, 0.0, 0
+    worst_shank, shank_face = 0.0, 0
     for line in polylines:
         idx = np.unique(np.linspace(0, len(line) - 1, min(cap, len(line))).round().astype(int))
         for p in line[idx]:
@@ -69,7 +75,11 @@ def judge_path(o: Oracle, faces, polylines, offset: float, cap: int) -> dict:
             dist, _ = o.clearance(p, offset)
             if math.isfinite(dist):
                 worst_gouge = max(worst_gouge, offset - dist)
+            dist, face = o.shank_clearance(p, 10.0 * offset, offset)
+            if math.isfinite(dist) and offset - dist > worst_shank:
+                worst_shank, shank_face = offset - dist, face
     return {"checked": checked, "off_face_mm": worst_face, "gouge_mm": worst_gouge,
+            "shank_mm": worst_shank, "shank_face": shank_face,
             "bad": worst_face > TOL or worst_gouge > TOL}
 
 
@@ -95,20 +105,30 @@ def run_pair(task: dict) -> dict:
                     feasible.append(v["p"])
             rec["edges"].append({"edge": e.index, "length_mm": round(e.length, 4),
                                  "verdicts": dict(counts)})
-        runs = [run_path(step, faces, radius, task["feed"], task["period"], task["timeout"])]
-        if runs[0]["version"] in (None, 1):  # version 1 writes one edge per run
+        via = task.get("via", "cli")
+        runs = [run_path(step, faces, radius, task["feed"], task["period"], task["timeout"],
+                         via=via)]
+        if via == "cli" and runs[0]["version"] in (None, 1):  # v1: one edge per run
             for k in range(2, len(edges) + 1):
                 runs.append(run_path(step, faces, radius, task["feed"], task["period"],
                                      task["timeout"], edge=k))
         polylines = [line for r in runs for line in r["polylines"]]
-        for name, pts in (("covered", feasible), ("covered_ball", ball)):
-            if pts and polylines:
-                d = distance_to_polylines(np.asarray(pts), polylines)
+        refused = polylines + [line for r in runs for line in r["refused_polylines"]]
+        for name, pts, lines in (("covered", feasible, polylines),
+                                 ("covered_ball", ball, polylines),
+                                 ("covered_ungated", feasible, refused)):
+            if pts and lines:
+                d = distance_to_polylines(np.asarray(pts), lines)
                 rec[name] = int(np.count_nonzero(d <= COVERED))
+        if feasible:  # a few feasible positions left uncovered, for follow-up
+            d = (distance_to_polylines(np.asarray(feasible), polylines) if polylines
+                 else np.full(len(feasible), np.inf))
+            rec["uncovered"] = [[round(float(x), 6) for x in feasible[k]]
+                                for k in np.flatnonzero(d > COVERED)[::7][:6]]
         rec["feasible"], rec["feasible_ball"] = len(feasible), len(ball)
         if polylines:
             rec["path_check"] = judge_path(o, faces, polylines, offset, task["check_points"])
-        rec["runs"] = [{k: v for k, v in r.items() if k != "polylines"}
+        rec["runs"] = [{k: v for k, v in r.items() if k not in ("polylines", "refused_polylines")}
                        | {"points": sum(len(x) for x in r["polylines"])} for r in runs]
     except Exception as exc:  # noqa: BLE001 - the judge's own failure is reported per pair
         rec["error"] = f"{type(exc).__name__}: {exc}"
@@ -142,11 +162,33 @@ def tasks_for(args) -> tuple[list[dict], list[dict]]:
               + (f" ({problem})" if problem else ""), file=sys.stderr, flush=True)
         for radius in args.radius:
             for faces in spread(pairs, args.max_pairs):
-                tasks.append({"step": str(f), "name": f.name, "faces": faces,
+                tasks.append({"step": str(f), "name": f.name, "faces": faces, "via": args.via,
                               "radius": radius, "feed": args.feed, "period": args.period,
                               "timeout": args.timeout, "max_samples": args.max_samples,
                               "check_points": args.check_points})
     return tasks, notes
+
+
+EDGE_REASONS = re.compile(r"edge \d+: no feasible ball position: ([^(;]+)")
+
+
+def program_notes(records: list[dict], radius: float) -> list[str]:
+    """Version 2 runs: edges refused or skipped by the stretch finder, by its reason;
+    cuts the gate refused, and the feasible positions they would have covered."""
+    edges, gated = collections.Counter(), 0
+    for r in records:
+        for run in r.get("runs", []):
+            text = " ".join([run.get("message", "")] + run.get("skipped", []))
+            edges.update(m.strip() for m in EDGE_REASONS.findall(text))
+            edges.update("cut stopped short" for k in run.get("skipped", [])
+                         if "stopped short" in k)
+            gated += len(run.get("gate_refused", []))
+    if not edges and not gated:
+        return []
+    extra = sum(r.get("covered_ungated", 0) - r["covered"] for r in records)
+    return [f"R {radius}: edges without a cut, by the stretch finder's reason: "
+            + ", ".join(f"{k} {v}" for k, v in edges.most_common())
+            + f"; cuts refused by the gate {gated} (they would have covered {extra} more)"]
 
 
 def table(records: list[dict], notes: list[dict]) -> str:
@@ -178,6 +220,8 @@ def table(records: list[dict], notes: list[dict]) -> str:
     for radius, counts in sorted(reasons.items()):
         rows.append(f"R {radius}: runs not written, by reason: "
                     + ", ".join(f"{k} {v}" for k, v in counts.most_common()))
+    for radius in sorted({r["radius"] for r in records}):
+        rows.extend(program_notes([r for r in records if r["radius"] == radius], radius))
     for n in notes:
         if n["problem"] or not n["pairs"]:
             rows.append(f"{n['part']}: no pair judged ({n['problem'] or 'no concave edge'}); "
@@ -212,6 +256,9 @@ def main(argv=None) -> int:
     ap.add_argument("--check-points", type=int, default=100,
                     help="written points judged per cut polyline at most (silent-bad)")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--via", choices=("cli", "api"), default="cli",
+                    help="cli: `cadcnc path`; api: the program pipeline (program_for_job, "
+                    "gate per cut) through benchmarks/coverage_run_pair.py")
     ap.add_argument("--json", help="write per-pair records here")
     ap.add_argument("--table", metavar="JSON", help="print the table of an earlier --json "
                     "file instead of running (refusals re-read with today's reasons)")

@@ -21,6 +21,7 @@ import numpy as np
 EXPECTED_CODES = {0, 2, 3, 4, 5, 6}  # anything else (or a traceback) is a crash
 
 REASONS = [  # (reason, pattern in cadcnc's message), first match wins
+    ("no feasible position (stretch finder)", re.compile(r"no feasible ball position")),
     ("start off a face", re.compile(r"touches face \d+ outside the face|outside the face")),
     ("ball cuts the part (gouge gate)", re.compile(r"cuts into the part")),
     ("faces tangent at the start", re.compile(r"stopped at the start point \(tangent\)")),
@@ -64,16 +65,36 @@ def cut_polylines(data: dict) -> list[np.ndarray]:
     return [np.asarray(data["points"], float).reshape(-1, 3)]
 
 
+def period_seconds(period: str) -> float:
+    """'4ms' / '250us' / '0.004' as seconds."""
+    m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*(ms|us|s)?\s*", period)
+    if not m:
+        raise ValueError(f"period {period!r}")
+    return float(m.group(1)) * {"ms": 1e-3, "us": 1e-6, "s": 1.0, None: 1.0}[m.group(2)]
+
+
+def path_command(step: str, faces, radius: float, feed: float, period: str, out: str,
+                 edge: int | None, via: str) -> list[str]:
+    """The subprocess that writes the pair's path: the CLI, or (``via == "api"``) the
+    program pipeline through ``coverage_run_pair.py`` (every stretch, gated per cut)."""
+    if via == "api":
+        return [sys.executable, os.path.join(os.path.dirname(__file__), "coverage_run_pair.py"),
+                step, str(faces[0]), str(faces[1]), repr(radius), repr(feed),
+                repr(period_seconds(period)), out]
+    cmd = [*cadcnc_command(), "path", step, "--faces", str(faces[0]), str(faces[1]),
+           "--radius", repr(radius), "--feed", repr(feed), "--period", period, "-o", out]
+    return cmd + (["--edge", str(edge)] if edge is not None else [])
+
+
 def run_path(step: str, faces: tuple[int, int], radius: float, feed: float, period: str,
-             timeout: float, edge: int | None = None) -> dict:
+             timeout: float, edge: int | None = None, via: str = "cli") -> dict:
     """One ``cadcnc path`` run: {"edge", "code", "outcome", "message", "seconds",
-    "version", "polylines"} (polylines empty unless a file was written)."""
+    "version", "polylines", "refused_polylines", "skipped", "gate_refused"} (polylines
+    empty unless a file was written; the last three from version 2 files)."""
+    refused_lines, skipped, gated = [], [], []
     with tempfile.TemporaryDirectory(prefix="cadcnc-cov-") as tmp:
         out = os.path.join(tmp, "path.json")
-        cmd = [*cadcnc_command(), "path", step, "--faces", str(faces[0]), str(faces[1]),
-               "--radius", repr(radius), "--feed", repr(feed), "--period", period, "-o", out]
-        if edge is not None:
-            cmd += ["--edge", str(edge)]
+        cmd = path_command(step, faces, radius, feed, period, out, edge, via)
         t0 = time.perf_counter()
         try:
             proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
@@ -88,11 +109,18 @@ def run_path(step: str, faces: tuple[int, int], radius: float, feed: float, peri
                 data = json.load(fh)
             version = data.get("version")
             polylines = cut_polylines(data)
+            skipped = [f"edge {k.get('edge')}: {k.get('reason')}: {k.get('detail')}"[:300]
+                       for k in data.get("skipped", [])]
+            gated = [f"edge {k['edge']} stretch {k['stretch']}: {k['message']}"[:300]
+                     for k in data.get("gate_refused", [])]
+            refused_lines = [np.asarray(k["points"], float).reshape(-1, 3)
+                             for k in data.get("gate_refused", [])]
         elif outcome == "written":
             outcome = "exit 0 without a file"
-    message = " ".join(stderr.strip().splitlines()[-1:])[:300]
+    message = " ".join(stderr.strip().splitlines()[-1:])[:2000]
     return {"edge": edge, "code": code, "outcome": outcome, "message": message,
-            "seconds": round(seconds, 2), "version": version, "polylines": polylines}
+            "seconds": round(seconds, 2), "version": version, "polylines": polylines,
+            "refused_polylines": refused_lines, "skipped": skipped, "gate_refused": gated}
 
 
 def run_faces(step: str, timeout: float) -> str:

@@ -111,3 +111,21 @@ def test_edge_angles_agree_with_the_fixture_sidecar(fixture):
             assert by_index[e["edge"]].concave == (e["class"] == "concave")
             checked += 1
     assert checked >= 10
+
+
+def test_api_mode_runs_the_pair_runner_with_the_period_in_seconds():
+    """``--via api`` runs benchmarks/coverage_run_pair.py (which exists) with the period
+    converted to seconds; refusals from the stretch finder get their own reason."""
+    assert _paths.period_seconds("4ms") == pytest.approx(0.004)
+    assert _paths.period_seconds("250us") == pytest.approx(2.5e-4)
+    assert _paths.period_seconds("0.01") == pytest.approx(0.01)
+    with pytest.raises(ValueError):
+        _paths.period_seconds("fast")
+    cmd = _paths.path_command("a.step", (3, 4), 2.0, 1500.0, "4ms", "o.json", None, "api")
+    assert Path(cmd[1]).name == "coverage_run_pair.py" and Path(cmd[1]).is_file()
+    assert cmd[2:] == ["a.step", "3", "4", "2.0", "1500.0", "0.004", "o.json"]
+    assert "path" in _paths.path_command("a.step", (3, 4), 2.0, 1500.0, "4ms", "o.json", 2,
+                                         "cli")
+    msg = "cadcnc: path: faces 3 and 4: no feasible ball position along their shared " \
+          "concave edge(s): edge 1: the ball touches face 4 outside the face"
+    assert classify(2, msg) == "no feasible position (stretch finder)"
