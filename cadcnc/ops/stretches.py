@@ -210,7 +210,9 @@ def edge_stretches(feas: Feasibility, shared_edge, edge: int,
     grid = np.linspace(0.0, curve.length, n)
     if curve.closed:
         grid = grid[:-1]
-    step = grid[1] - grid[0]
+    # past the ends at the search's own spacing, however short the edge (a 1 um edge's
+    # in-edge step would give tens of thousands of samples)
+    step = max(grid[1] - grid[0], spacing)
     k_ext = int(math.ceil(ext / step)) if ext > 0 else 0
     k_lo, k_hi = (k_ext if go else 0 for go in extend)
     grid = np.concatenate([-step * np.arange(k_lo, 0, -1), grid,
