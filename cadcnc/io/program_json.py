@@ -22,7 +22,6 @@ a rapid (else a feed move at the plunge feed). Written atomically.
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 
@@ -117,14 +116,4 @@ def write_program_json(program: Program, out) -> None:
 
 def read_program(file) -> Program:
     """Read a program (version 2) or toolpath (version 1) JSON file; errors name the file."""
-    file = Path(file)
-    try:
-        data = json.loads(file.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"{file}: no such file") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise InputError(f"{file}: not a program JSON file ({e})") from None
-    try:
-        return program_from_dict(data)
-    except InputError as e:
-        raise InputError(f"{file}: {e}") from None
+    return v1.read_json_file(file, "program", program_from_dict)

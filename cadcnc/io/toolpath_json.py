@@ -132,19 +132,26 @@ def write_json(path: Toolpath, out) -> None:
     write_text(out, toolpath_json(path))
 
 
-def read_json(file) -> Toolpath:
-    """Read a toolpath JSON file (or a program of one cut); errors name the file."""
+def read_json_file(file, what: str, parse):
+    """``parse(data)`` of the JSON in ``file``; every error names the file (``what``: the
+    kind of file expected, for the message)."""
     file = Path(file)
     try:
         data = json.loads(file.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise InputError(f"{file}: no such file") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise InputError(f"{file}: not a toolpath JSON file ({e})") from None
+        raise InputError(f"{file}: not a {what} JSON file ({e})") from None
     try:
-        return toolpath_from_dict(one_cut_of_program(data))
+        return parse(data)
     except InputError as e:
         raise InputError(f"{file}: {e}") from None
+
+
+def read_json(file) -> Toolpath:
+    """Read a toolpath JSON file (or a program of one cut); errors name the file."""
+    return read_json_file(file, "toolpath",
+                          lambda data: toolpath_from_dict(one_cut_of_program(data)))
 
 
 PROGRAM_FORMAT = "cadcnc-program"
