@@ -74,7 +74,9 @@ def pencil_command(args) -> int:
     from cadcnc.io.program_gcode import program_ngc
     from cadcnc.io.program_json import program_json
     from cadcnc.io.program_plot import program_picture_bytes
-    from cadcnc.ops.pencil import pencil
+    from cadcnc.ops.pair_program import safe_height
+    from cadcnc.ops.pencil import CHAIN_GAP, pencil
+    from cadcnc.verification.cut_back import cut_back
 
     from .options import clearance, program_gcode_options, tolerances
     from .program_commands import judge_program
@@ -99,6 +101,11 @@ def pencil_command(args) -> int:
                          f"({_skipped_line(program) or 'no concave corner found'})")
     title = f"pencil R {radius:g} of {Path(args.step).name}"
     gopts = program_gcode_options(args)
+    if not args.allow_gouge:  # a gouging cut is cut back and listed, not the program lost
+        program = cut_back(program, part, safe_height(part, program.job), CHAIN_GAP)
+        if not program.cuts:
+            raise InputError(f"{args.step}: every cut gouges the part: "
+                             f"{_skipped_line(program)}")
     ngc = program_ngc(program, title=title, **gopts)
     write, code = judge_program(args, program, part, "pencil", gopts)
     if not args.quiet:

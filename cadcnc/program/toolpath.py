@@ -10,7 +10,7 @@ last step landed on the end or a limit.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -164,3 +164,16 @@ def compute_bounds(path: Toolpath, ru: np.ndarray, rw: np.ndarray,
             b.eq16 = np.where(exact, b.eq12, b.eq16)
         out.append(b)
     return out[0], out[1]
+
+
+def toolpath_head(path: Toolpath, n: int, stop_reason: str, stop_detail: str) -> Toolpath:
+    """The first ``n`` points of ``path`` (n >= 2) as a toolpath of their own, stopped for
+    ``stop_reason``: a cut cut back to its last verified point."""
+    if not 2 <= n <= len(path):
+        raise ValueError(f"a cut back path needs 2..{len(path)} points, got {n}")
+    bounds = None if path.bounds is None else tuple(
+        replace(b, **{f.name: getattr(b, f.name)[:n] for f in fields(b)}) for b in path.bounds)
+    return replace(path, points=path.points[:n], contacts=path.contacts[:n],
+                   normals=path.normals[:n], uv=path.uv[:n], steps=path.steps[:n],
+                   commanded=path.commanded[:n], stop_reason=stop_reason,
+                   stop_detail=stop_detail, bounds=bounds)
