@@ -112,7 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
             "Compute the program of faces I and J: every feasible stretch of their shared "
             "concave edges cut by the ball, linked by retract, rapid and plunge; gate it "
             "against the whole part and write it; the format follows each output's suffix. "
-            "Exit 0 complete and verified, 3 no feasible stretch, 5 gouge, 6 partial.")
+            "Exit 0 complete and verified, 2 no feasible stretch, 5 gouge, 6 partial.")
     p.add_argument("step", metavar="PART.step", help="the part (STEP file, mm)")
     _job_options(p, required=True)
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
