@@ -45,6 +45,7 @@ from ..job import Job, PairPath
 from ..program.program import STOPPED_SHORT, CutSegment, Skipped
 from ..program.toolpath import Toolpath, toolpath_from_record
 from .finish_crossings import Crossing, FaceEdges, edge_owners
+from .finish_polish import polish
 from .finish_transitions import CONCAVE, CONVEX, TANGENT, Transition, transition
 
 REACHED = 1e-3
@@ -235,9 +236,10 @@ class _Pass:
         """Cut ``face`` from ``start`` towards ``end`` (its planned exit), resuming past
         collisions; the last state when the cuts reached ``end`` (None otherwise)."""
         guard = self.guard(face)
-        pos = start
+        pos, exact = start, True
         while True:
             tp = self.run_stepper(face, pos, end, guard)
+            self.exact(face, tp, guard, exact)
             if len(tp) > 1:
                 self.result.cuts.append(CutSegment(
                     tp, at_limit=tp.stop_reason in (END, BOUNDARY, COLLISION)))
@@ -251,9 +253,52 @@ class _Pass:
             if tp.stop_reason != COLLISION:
                 self.skip(face, STOPPED_SHORT, f"the cut from {_xyz(pos.p)} {tp.partial_reason}")
                 return None
-            pos = self.clear_again(face, last, end, guard, tp.stop_detail)
+            pos, exact = self.clear_again(face, last, end, guard, tp.stop_detail), False
             if pos is None:
                 return None
+
+    def exact(self, face: int, tp: Toolpath, guard, keep_first: bool) -> None:
+        """Move the cut's points onto the exact offset curve (:mod:`.finish_polish`), in
+        place; an exact start (an entry, a transition) and an end landed on are kept as
+        they are. A point landed on a guard's zero (first after a resume, last after a
+        collision) that the move made negative is put back on the zero, on the curve."""
+        surface, rp = self.setup.surfaces[face], self.job.tool.offset
+        c, uv, r, n = polish(surface, rp, self.nrm, self.plane.offset, tp.points,
+                             tp.uv[:, 0])
+        keep = [0] if keep_first else []
+        if tp.stop_reason == END:
+            keep.append(len(tp) - 1)
+        for k in keep:
+            c[k], uv[k], r[k], n[k] = tp.points[k], tp.uv[k, 0], tp.contacts[k, 0], \
+                tp.normals[k, 0]
+        if guard is not None and len(tp) > 1:
+            for k, clear in ((0, 1), (len(tp) - 1, len(tp) - 2)):
+                if k not in keep and guard.margin(tuple(c[k]))[0] < 0.0:
+                    c[k], uv[k], r[k], n[k] = self.land_exact(surface, c[clear], c[k], uv[k],
+                                                              guard)
+        tp.points[:] = c
+        tp.contacts[:, 0], tp.contacts[:, 1], tp.normals[:, 0], tp.uv[:, 0] = r, c, n, uv
+        d = c - self.origin
+        tp.uv[:, 1] = np.stack([d @ self.plane.direction, d @ self.y_axis], axis=1)
+        tp.steps[1:] = np.linalg.norm(np.diff(c, axis=0), axis=1)
+
+    def land_exact(self, surface, clear: np.ndarray, hit: np.ndarray, uv, guard):
+        """The point of the exact offset curve between ``clear`` and ``hit`` (mm) where
+        the guard's clearance reaches 0, on its clear side (bisection to 1e-10 of the
+        chord): (centre, uv, contact, normal)."""
+        lo, hi, best = 0.0, 1.0, None
+        for _ in range(34):
+            mid = 0.5 * (lo + hi)
+            found = polish(surface, self.job.tool.offset, self.nrm, self.plane.offset,
+                           (clear + mid * (hit - clear))[None], np.asarray(uv)[None])
+            if guard.margin(tuple(found[0][0]))[0] >= 0.0:
+                lo, best = mid, found
+            else:
+                hi = mid
+        if best is None:
+            best = polish(surface, self.job.tool.offset, self.nrm, self.plane.offset,
+                          clear[None], np.asarray(uv)[None])
+        return tuple(a[0] for a in best)
 
     def clear_again(self, face: int, at: Tangency, end, guard, why: str) -> Tangency | None:
         """Where the plane's curve on ``face`` past a collision at ``at`` is clear again:
