@@ -271,33 +271,39 @@ class _Pass:
         for k in keep:
             c[k], uv[k], r[k], n[k] = tp.points[k], tp.uv[k, 0], tp.contacts[k, 0], \
                 tp.normals[k, 0]
-        if guard is not None and len(tp) > 1:
-            for k, clear in ((0, 1), (len(tp) - 1, len(tp) - 2)):
-                if k not in keep and guard.margin(tuple(c[k]))[0] < 0.0:
-                    c[k], uv[k], r[k], n[k] = self.land_exact(surface, c[clear], c[k], uv[k],
-                                                              guard)
+        landed = [] if keep_first else [(0, 1)]
+        if tp.stop_reason == COLLISION:
+            landed.append((len(tp) - 1, len(tp) - 2))
+        for k, clear in landed if guard is not None and len(tp) > 1 else ():
+            found = self.land_exact(surface, c[clear], 2.0 * c[k] - c[clear], uv[k], guard)
+            if found is not None:
+                c[k], uv[k], r[k], n[k] = found
         tp.points[:] = c
         tp.contacts[:, 0], tp.contacts[:, 1], tp.normals[:, 0], tp.uv[:, 0] = r, c, n, uv
         d = c - self.origin
         tp.uv[:, 1] = np.stack([d @ self.plane.direction, d @ self.y_axis], axis=1)
         tp.steps[1:] = np.linalg.norm(np.diff(c, axis=0), axis=1)
 
-    def land_exact(self, surface, clear: np.ndarray, hit: np.ndarray, uv, guard):
-        """The point of the exact offset curve between ``clear`` and ``hit`` (mm) where
-        the guard's clearance reaches 0, on its clear side (bisection to 1e-10 of the
-        chord): (centre, uv, contact, normal)."""
-        lo, hi, best = 0.0, 1.0, None
+    def land_exact(self, surface, clear: np.ndarray, beyond: np.ndarray, uv, guard):
+        """The point of the exact offset curve between ``clear`` and ``beyond`` (mm;
+        ``beyond`` one step past a landed point) where the guard's clearance reaches 0, on
+        its clear side (bisection to 1e-10 of the chord): (centre, uv, contact, normal),
+        or None when the curve is clear up to ``beyond``."""
+        def on_curve(x: float):
+            return polish(surface, self.job.tool.offset, self.nrm, self.plane.offset,
+                          (clear + x * (beyond - clear))[None], np.asarray(uv)[None])
+
+        best = on_curve(1.0)
+        if guard.margin(tuple(best[0][0]))[0] >= 0.0:
+            return None
+        lo, hi, best = 0.0, 1.0, on_curve(0.0)
         for _ in range(34):
             mid = 0.5 * (lo + hi)
-            found = polish(surface, self.job.tool.offset, self.nrm, self.plane.offset,
-                           (clear + mid * (hit - clear))[None], np.asarray(uv)[None])
+            found = on_curve(mid)
             if guard.margin(tuple(found[0][0]))[0] >= 0.0:
                 lo, best = mid, found
             else:
                 hi = mid
-        if best is None:
-            best = polish(surface, self.job.tool.offset, self.nrm, self.plane.offset,
-                          clear[None], np.asarray(uv)[None])
         return tuple(a[0] for a in best)
 
     def clear_again(self, face: int, at: Tangency, end, guard, why: str) -> Tangency | None:
