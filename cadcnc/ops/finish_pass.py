@@ -45,6 +45,7 @@ from ..job import Job, PairPath
 from ..program.program import STOPPED_SHORT, CutSegment, Skipped
 from ..program.toolpath import Toolpath, toolpath_from_record
 from .finish_crossings import Crossing, FaceEdges, edge_owners
+from .finish_polish import polish
 from .finish_transitions import CONCAVE, CONVEX, TANGENT, Transition, transition
 
 REACHED = 1e-3
@@ -235,9 +236,10 @@ class _Pass:
         """Cut ``face`` from ``start`` towards ``end`` (its planned exit), resuming past
         collisions; the last state when the cuts reached ``end`` (None otherwise)."""
         guard = self.guard(face)
-        pos = start
+        pos, exact = start, True
         while True:
             tp = self.run_stepper(face, pos, end, guard)
+            self.exact(face, tp, guard, exact)
             if len(tp) > 1:
                 self.result.cuts.append(CutSegment(
                     tp, at_limit=tp.stop_reason in (END, BOUNDARY, COLLISION)))
@@ -251,9 +253,58 @@ class _Pass:
             if tp.stop_reason != COLLISION:
                 self.skip(face, STOPPED_SHORT, f"the cut from {_xyz(pos.p)} {tp.partial_reason}")
                 return None
-            pos = self.clear_again(face, last, end, guard, tp.stop_detail)
+            pos, exact = self.clear_again(face, last, end, guard, tp.stop_detail), False
             if pos is None:
                 return None
+
+    def exact(self, face: int, tp: Toolpath, guard, keep_first: bool) -> None:
+        """Move the cut's points onto the exact offset curve (:mod:`.finish_polish`), in
+        place; an exact start (an entry, a transition) and an end landed on are kept as
+        they are. A point landed on a guard's zero (first after a resume, last after a
+        collision) that the move made negative is put back on the zero, on the curve."""
+        surface, rp = self.setup.surfaces[face], self.job.tool.offset
+        c, uv, r, n = polish(surface, rp, self.nrm, self.plane.offset, tp.points,
+                             tp.uv[:, 0])
+        keep = [0] if keep_first else []
+        if tp.stop_reason == END:
+            keep.append(len(tp) - 1)
+        for k in keep:
+            c[k], uv[k], r[k], n[k] = tp.points[k], tp.uv[k, 0], tp.contacts[k, 0], \
+                tp.normals[k, 0]
+        landed = [] if keep_first else [(0, 1)]
+        if tp.stop_reason == COLLISION:
+            landed.append((len(tp) - 1, len(tp) - 2))
+        for k, clear in landed if guard is not None and len(tp) > 1 else ():
+            found = self.land_exact(surface, c[clear], 2.0 * c[k] - c[clear], uv[k], guard)
+            if found is not None:
+                c[k], uv[k], r[k], n[k] = found
+        tp.points[:] = c
+        tp.contacts[:, 0], tp.contacts[:, 1], tp.normals[:, 0], tp.uv[:, 0] = r, c, n, uv
+        d = c - self.origin
+        tp.uv[:, 1] = np.stack([d @ self.plane.direction, d @ self.y_axis], axis=1)
+        tp.steps[1:] = np.linalg.norm(np.diff(c, axis=0), axis=1)
+
+    def land_exact(self, surface, clear: np.ndarray, beyond: np.ndarray, uv, guard):
+        """The point of the exact offset curve between ``clear`` and ``beyond`` (mm;
+        ``beyond`` one step past a landed point) where the guard's clearance reaches 0, on
+        its clear side (bisection to 1e-10 of the chord): (centre, uv, contact, normal),
+        or None when the curve is clear up to ``beyond``."""
+        def on_curve(x: float):
+            return polish(surface, self.job.tool.offset, self.nrm, self.plane.offset,
+                          (clear + x * (beyond - clear))[None], np.asarray(uv)[None])
+
+        best = on_curve(1.0)
+        if guard.margin(tuple(best[0][0]))[0] >= 0.0:
+            return None
+        lo, hi, best = 0.0, 1.0, on_curve(0.0)
+        for _ in range(34):
+            mid = 0.5 * (lo + hi)
+            found = on_curve(mid)
+            if guard.margin(tuple(found[0][0]))[0] >= 0.0:
+                lo, best = mid, found
+            else:
+                hi = mid
+        return tuple(a[0] for a in best)
 
     def clear_again(self, face: int, at: Tangency, end, guard, why: str) -> Tangency | None:
         """Where the plane's curve on ``face`` past a collision at ``at`` is clear again:

@@ -121,23 +121,12 @@ def roll_arc(ps, face: int, exit_: Crossing, kg: int, entry: Crossing, first) ->
         m = _slerp(n_f, g_edges.centre(cg, t)[2], alpha)
         return q + rp * m, q, uv, m
 
-    points, contacts, uvs, normals = [], [], [], []
-    t_prev = exit_.t
-    for k in range(n + 1):
-        alpha = k / n
-        if k == 0:
-            t = exit_.t
-        elif k == n:
-            t = entry.t
-        else:
-            t = _root(lambda x: float(at(x, alpha)[0] @ nrm - off),
-                      t_prev, entry.t, span)
-        c, q, uv, m = at(t, alpha)
-        points.append(c)
-        contacts.append(q)
-        uvs.append(uv)
-        normals.append(m)
-        t_prev = t
+    for _ in range(4):   # an edge crossing the plane obliquely makes the arc longer
+        points, contacts, uvs, normals = _arc_points(at, n, exit_.t, entry.t, nrm, off, span)
+        longest = float(np.linalg.norm(np.diff(points, axis=0), axis=1).max())
+        if longest <= ps.job.step * (1.0 + 1e-6):
+            break
+        n = int(math.ceil(n * longest / ps.job.step))
     points[0] = np.asarray(first, float)
     points[-1] = entry.point
     pts = np.array(points)
@@ -152,6 +141,27 @@ def roll_arc(ps, face: int, exit_: Crossing, kg: int, entry: Crossing, first) ->
         commanded=np.r_[0.0, np.full(len(pts) - 1, job.step)],
         job=replace(job, operation=op), stop_reason=END,
         stop_detail=f"rolled over the convex edge of faces {face} and {entry.face}")
+
+
+def _arc_points(at, n: int, t_first: float, t_last: float, nrm, off: float, span: float):
+    """n + 1 arc points at alpha = k / n: (centres, edge points, uv, normals), lists."""
+    points, contacts, uvs, normals = [], [], [], []
+    t_prev = t_first
+    for k in range(n + 1):
+        alpha = k / n
+        if k == 0:
+            t = t_first
+        elif k == n:
+            t = t_last
+        else:
+            t = _root(lambda x: float(at(x, alpha)[0] @ nrm - off), t_prev, t_last, span)
+        c, q, uv, m = at(t, alpha)
+        points.append(c)
+        contacts.append(q)
+        uvs.append(uv)
+        normals.append(m)
+        t_prev = t
+    return points, contacts, uvs, normals
 
 
 def _root(h, t0: float, t1: float, span: float) -> float:
