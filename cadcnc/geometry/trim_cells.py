@@ -89,34 +89,34 @@ def mark(mask: np.ndarray, p: np.ndarray, q: np.ndarray, h: np.ndarray,
 
 @_jit
 def regions(mask: np.ndarray) -> tuple:
-    """(region (nu, nw) int64, -1 on marked cells; picks (r, 3) int64 flat cell indices):
+    """(region (nu, nw) int32, -1 on marked cells; picks (r, 3) int64 flat cell indices):
     the 4-connected regions of unmarked cells, numbered in row-major order of first cell."""
     nu, nw = mask.shape
-    region = np.full((nu, nw), -1, np.int64)
-    stack = np.empty(nu * nw, np.int64)
+    flat = mask.ravel()
+    region = np.full(nu * nw, -1, np.int32)
+    stack = np.empty(nu * nw, np.int32)
     count = 0
     for start in range(nu * nw):
-        if mask.flat[start] or region.flat[start] >= 0:
+        if flat[start] or region[start] >= 0:
             continue
-        region.flat[start] = count
+        region[start] = count
         top = 1
         stack[0] = start
         while top:
             top -= 1
             c = stack[top]
             i, j = c // nw, c % nw
-            for ni, nj in ((i - 1, j), (i + 1, j), (i, j - 1), (i, j + 1)):
-                if 0 <= ni < nu and 0 <= nj < nw:
-                    n = ni * nw + nj
-                    if not mask.flat[n] and region.flat[n] < 0:
-                        region.flat[n] = count
-                        stack[top] = n
-                        top += 1
+            for n, ok in ((c - nw, i > 0), (c + nw, i < nu - 1), (c - 1, j > 0),
+                          (c + 1, j < nw - 1)):
+                if ok and not flat[n] and region[n] < 0:
+                    region[n] = count
+                    stack[top] = n
+                    top += 1
         count += 1
     size = np.zeros(count, np.int64)
     picks = np.full((count, 3), -1, np.int64)
     for c in range(nu * nw):
-        r = region.flat[c]
+        r = region[c]
         if r >= 0:
             if picks[r, 0] < 0:
                 picks[r, 0] = c
@@ -124,12 +124,21 @@ def regions(mask: np.ndarray) -> tuple:
             size[r] += 1
     seen = np.zeros(count, np.int64)
     for c in range(nu * nw):
-        r = region.flat[c]
+        r = region[c]
         if r >= 0:
             if seen[r] == size[r] // 2:
                 picks[r, 1] = c
             seen[r] += 1
-    return region, picks
+    return region.reshape((nu, nw)), picks
+
+
+@_jit
+def paint(labels: np.ndarray, region: np.ndarray, code: np.ndarray) -> None:
+    """labels[c] = code[region[c]] on every cell of a region (region >= 0)."""
+    flat, reg = labels.ravel(), region.ravel()
+    for c in range(reg.size):
+        if reg[c] >= 0:
+            flat[c] = code[reg[c]]
 
 
 @_jit
@@ -207,7 +216,14 @@ def refine(mask: np.ndarray, labels: np.ndarray, p: np.ndarray, q: np.ndarray,
     Ru x Rw labels (row-major).
     """
     nu, nw = mask.shape
-    var = np.zeros((nu, nw, 2))
+    index = np.full((nu, nw), -1, np.int64)   # the marked cells, numbered
+    m = 0
+    for i in range(nu):
+        for j in range(nw):
+            if mask[i, j]:
+                index[i, j] = m
+                m += 1
+    var = np.zeros((m, 2))
     for s in range(p.shape[0]):   # the bands' variation per cell (shape heuristic)
         i0 = max(int(math.floor((min(p[s, 0], q[s, 0]) - h[s, 0] - origin[0]) / size[0])), 0)
         i1 = min(int(math.floor((max(p[s, 0], q[s, 0]) + h[s, 0] - origin[0]) / size[0])), nu - 1)
@@ -216,29 +232,32 @@ def refine(mask: np.ndarray, labels: np.ndarray, p: np.ndarray, q: np.ndarray,
         n = max((i1 - i0 + 1) * (j1 - j0 + 1), 1)
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
-                var[i, j, 0] += abs(q[s, 0] - p[s, 0]) / size[0] / n
-                var[i, j, 1] += abs(q[s, 1] - p[s, 1]) / size[1] / n
+                if index[i, j] >= 0:
+                    var[index[i, j], 0] += abs(q[s, 0] - p[s, 0]) / size[0] / n
+                    var[index[i, j], 1] += abs(q[s, 1] - p[s, 1]) / size[1] / n
     codes = labels.astype(np.int64)
-    shape = np.zeros((nu, nw, 2), np.int64)
+    shape = np.zeros((m, 2), np.int64)
     total = 0
     for i in range(nu):
         for j in range(nw):
-            if mask[i, j]:
-                ratio = (var[i, j, 1] + 1e-3) / (var[i, j, 0] + 1e-3)
+            k = index[i, j]
+            if k >= 0:
+                ratio = (var[k, 1] + 1e-3) / (var[k, 0] + 1e-3)
                 n = budget
                 ru = min(max(int(round(math.sqrt(n * ratio))), 1), n)
                 if 1 < ru < n:  # not a strip: a band across the cell, fewer sub-cells
                     n = square
                     ru = min(max(int(round(math.sqrt(n * ratio))), 1), n)
-                shape[i, j, 0], shape[i, j, 1] = ru, max(n // ru, 1)
+                shape[k, 0], shape[k, 1] = ru, max(n // ru, 1)
                 codes[i, j] = 3 + total
-                total += 2 + shape[i, j, 0] * shape[i, j, 1]
+                total += 2 + shape[k, 0] * shape[k, 1]
     fine = np.zeros(total, np.int64)
     for i in range(nu):
         for j in range(nw):
-            if mask[i, j]:
-                fine[codes[i, j] - 3] = shape[i, j, 0]
-                fine[codes[i, j] - 2] = shape[i, j, 1]
+            k = index[i, j]
+            if k >= 0:
+                fine[codes[i, j] - 3] = shape[k, 0]
+                fine[codes[i, j] - 2] = shape[k, 1]
     for s in range(p.shape[0]):   # mark sub-cells met by a band
         i0 = max(int(math.floor((min(p[s, 0], q[s, 0]) - h[s, 0] - eps[0] - origin[0])
                                 / size[0])), 0)
@@ -250,9 +269,10 @@ def refine(mask: np.ndarray, labels: np.ndarray, p: np.ndarray, q: np.ndarray,
                                 / size[1])), nw - 1)
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
-                if not mask[i, j]:
+                k = index[i, j]
+                if k < 0:
                     continue
-                off, ru, rw = codes[i, j] - 1, shape[i, j, 0], shape[i, j, 1]
+                off, ru, rw = codes[i, j] - 1, shape[k, 0], shape[k, 1]
                 su, sw = size[0] / ru, size[1] / rw
                 cu, cw = origin[0] + i * size[0], origin[1] + j * size[1]
                 a0 = max(int(math.floor((min(p[s, 0], q[s, 0]) - h[s, 0] - cu) / su)) - 1, 0)
@@ -272,9 +292,10 @@ def refine(mask: np.ndarray, labels: np.ndarray, p: np.ndarray, q: np.ndarray,
     comp = np.empty(budget, np.int64)
     for i in range(nu):   # free sub-cells: 4-connected components inside the cell
         for j in range(nw):
-            if not mask[i, j]:
+            mi = index[i, j]
+            if mi < 0:
                 continue
-            off, ru, rw = codes[i, j] - 1, shape[i, j, 0], shape[i, j, 1]
+            off, ru, rw = codes[i, j] - 1, shape[mi, 0], shape[mi, 1]
             if ru == 1 or rw == 1:   # strips: runs between marked ones
                 unresolved += _label_strips(fine, off, ru * rw, rw == 1, labels, mask, i, j)
             for c in range(ru * rw):   # 0 free, 1 marked -> 2 + label, or 4 unresolved
