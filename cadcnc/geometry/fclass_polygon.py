@@ -56,17 +56,17 @@ def _distance(a: tuple, b: tuple) -> float:
 def _keep_distinct(seq: list, pts: list, us: list, du: float, c3, last, p3=None):
     """Append to ``seq`` the samples FClass2d keeps: a point repeating the last kept one in
     3-D is dropped unless the half-step point differs. ``last``: None or (the last kept 3-D
-    point, its curve, its parameter); returns the new one. ``p3`` (n, 3): the 3-D points
+    point, its curve, its parameter); returns the new one and whether every point was kept. ``p3`` (n, 3): the 3-D points
     from numpy (round-off from OCCT's), trusted only when every successive distance clears
     Confusion by 1 % (then every point is kept); otherwise OCCT's own points decide."""
     if not len(us):
-        return last
+        return last, True
     if p3 is not None:
         a = p3 if last is None else np.vstack([last[0], p3])
         d = a[1:] - a[:-1]
         if len(d) == 0 or (d * d).sum(axis=1).min() >= (_CONFUSION * 1.01) ** 2:
             seq += pts
-            return tuple(p3[-1]), c3, us[-1]
+            return (tuple(p3[-1]), c3, us[-1]), True
     p3 = [c3.Value(t).Coord() for t in us]
     last3d = None if last is None else last[1].Value(last[2]).Coord()
     a = np.array(p3 if last3d is None else [last3d] + p3)
@@ -74,7 +74,7 @@ def _keep_distinct(seq: list, pts: list, us: list, du: float, c3, last, p3=None)
     if len(d) == 0 or (d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2]).min() >= \
             _CONFUSION * _CONFUSION * (1.0 + 1e-9):
         seq += pts
-        return p3[-1], c3, us[-1]
+        return (p3[-1], c3, us[-1]), True
     for (x, y), t, q in zip(pts, us, p3):
         real = True
         if len(seq) > 1 and last is not None and _distance(q, last[0]) < _CONFUSION:
@@ -82,7 +82,7 @@ def _keep_distinct(seq: list, pts: list, us: list, du: float, c3, last, p3=None)
         if real:
             seq.append((x, y))
             last = q, c3, t
-    return last
+    return last, False
 
 
 def _close(fast: np.ndarray, exact: tuple) -> bool:
@@ -106,12 +106,12 @@ def _fast_points(c2, c3, surface, us: np.ndarray):
     return uv, xyz
 
 
-def _fleches(seq: list, before: int, fu: float, fv: float) -> tuple[float, float]:
-    """``_fleche`` over every point appended after ``before`` (from the fifth one on) whose
-    triple's ends differ, as FClass2d checks after each sample; vectorised."""
-    if len(seq) <= before + 4:
+def _fleches(a: np.ndarray, fu: float, fv: float) -> tuple[float, float]:
+    """``_fleche`` over the points an edge appended (``a`` (k, 2)) from the fifth one on
+    whose triple's ends differ, as FClass2d checks after each sample; vectorised."""
+    if len(a) <= 4:
         return fu, fv
-    a = np.asarray(seq[before + 2:], dtype=float)
+    a = a[2:]
     pa, pb, pc = a[:-2], a[1:-1], a[2:]
     use = np.any(pa != pc, axis=1)
     pa, pb, pc = pa[use], pb[use], pc[use]
@@ -155,11 +155,12 @@ def _edges(wire, face):
 
 def _sample(wire, face, box: list, defl: float = 0.0,
             surface=None) -> tuple[list, float, float, int] | None:
-    """FClass2d's polygon of one wire: (points, FlecheU, FlecheV, edges walked). ``defl`` > 0:
+    """FClass2d's polygon of one wire: (points (k, 2), FlecheU, FlecheV, edges walked). ``defl`` > 0:
     its re-sampling pass (quasi-uniform deflection, no 3-D test, ``box`` left alone).
     ``surface`` (the face's BRepAdaptor_Surface): evaluate the samples in numpy where
     supported (``_fast_points``); None: OCCT's calls only."""
     seq, fu, fv, first_point, walked, last3d = [], 0.0, 0.0, 1, 0, None
+    chunks = [np.zeros((0, 2))]  # seq's points as arrays, edge by edge (not re-sampled)
     for item in _edges(wire, face):
         if item is None:
             return None
@@ -195,14 +196,16 @@ def _sample(wire, face, box: list, defl: float = 0.0,
         if pts:
             (x0, y0), (x1, y1) = uv.min(axis=0), uv.max(axis=0)
             box[:] = min(box[0], x0), max(box[1], x1), min(box[2], y0), max(box[3], y1)
-        before = len(seq)
+        before, kept_all = len(seq), True
         if degenerated:
             seq += pts
         else:
-            last3d = _keep_distinct(seq, pts, us, du, c3, last3d, xyz)
-        fu, fv = _fleches(seq, before, fu, fv)
+            last3d, kept_all = _keep_distinct(seq, pts, us, du, c3, last3d, xyz)
+        chunks.append(uv if kept_all else np.asarray(seq[before:], dtype=float).reshape(-1, 2))
+        fu, fv = _fleches(chunks[-1], fu, fv)
         first_point = 2
-    return seq, fu, fv, walked
+    return (np.asarray(seq, dtype=float).reshape(-1, 2) if defl else np.concatenate(chunks)), \
+        fu, fv, walked
 
 
 def _thickness(seq: list) -> float:
@@ -232,7 +235,7 @@ def _bands(face_surface, tol_uv: float) -> tuple[np.ndarray, ...] | None:
         if first is None or first[3] != wire.NbChildren():  # the explorer missed edges
             return None
         seq, fu, fv, _ = first
-        if not seq:
+        if not len(seq):
             continue
         if len(seq) <= 3:
             return None

@@ -13,37 +13,45 @@ calls otherwise. Anything else gives None (the caller evaluates with OCCT).
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 from OCP.GeomAbs import (GeomAbs_BSplineCurve, GeomAbs_BSplineSurface, GeomAbs_Cone,
                          GeomAbs_Cylinder, GeomAbs_Line, GeomAbs_Plane, GeomAbs_Sphere,
                          GeomAbs_Torus)
 from OCP.gp import gp_Trsf
 
+_jit = numba.njit(cache=True, nogil=True)
+
 
 def _flat(seq) -> np.ndarray:
     return np.array([seq.Value(i) for i in range(seq.Lower(), seq.Upper() + 1)])
 
 
+@_jit
 def basis(knots: np.ndarray, degree: int, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(span (n,) int, N (n, degree + 1)): the non-zero B-spline basis functions at each t
-    (knots: the flat, non-periodic knot vector; t clamped into its range)."""
-    p = degree
-    lo, hi = knots[p], knots[len(knots) - p - 1]
-    t = np.clip(t, lo, hi)
-    span = np.clip(np.searchsorted(knots, t, side="right") - 1, p, len(knots) - p - 2)
-    n = np.zeros((len(t), p + 1))
-    n[:, 0] = 1.0
-    left, right = np.empty((len(t), p + 1)), np.empty((len(t), p + 1))
-    for j in range(1, p + 1):  # The NURBS Book, A2.2, over all t at once
-        left[:, j] = t - knots[span + 1 - j]
-        right[:, j] = knots[span + j] - t
-        saved = np.zeros(len(t))
-        for r in range(j):
-            temp = n[:, r] / (right[:, r + 1] + left[:, j - r])
-            n[:, r] = saved + right[:, r + 1] * temp
-            saved = left[:, j - r] * temp
-        n[:, j] = saved
-    return span, n
+    (knots: the flat, non-periodic knot vector; t clamped into its range; The NURBS Book,
+    A2.1 and A2.2)."""
+    p, m = degree, len(knots)
+    lo, hi = knots[p], knots[m - p - 1]
+    span = np.empty(len(t), np.int64)
+    out = np.zeros((len(t), p + 1))
+    left, right = np.empty(p + 1), np.empty(p + 1)
+    for k in range(len(t)):
+        x = min(max(t[k], lo), hi)
+        s = min(max(np.searchsorted(knots, x, side="right") - 1, p), m - p - 2)
+        span[k] = s
+        out[k, 0] = 1.0
+        for j in range(1, p + 1):
+            left[j] = x - knots[s + 1 - j]
+            right[j] = knots[s + j] - x
+            saved = 0.0
+            for r in range(j):
+                temp = out[k, r] / (right[r + 1] + left[j - r])
+                out[k, r] = saved + right[r + 1] * temp
+                saved = left[j - r] * temp
+            out[k, j] = saved
+    return span, out
 
 
 def _periodic_copy(curve, periodic: bool, set_not_periodic):
