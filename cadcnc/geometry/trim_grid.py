@@ -46,14 +46,15 @@ from OCP.gp import gp_Pnt2d
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT
 
 from .fclass_polygon import _bands, classifier_tolerance  # noqa: F401 (re-exported)
-from .trim_cells import layout, mark, paint, refine, regions
-from ..trim import BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE
+from .trim_cells import layout, paint, regions, segment_blocks, segment_lists
+from ..trim import BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE, lookup
 
 
 def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
     """(origin (2,), cell size (2,), mask (nu, nw) uint8, windows, segments): the layout, and
     the cells (mask 1) that a band, or its copies whole periods away, or the wrap's seam
-    touches; segments (p, q, h, eps) are those bands for ``trim_cells.refine``."""
+    touches; segments: (p, q, h, eps, start, ids), those bands and which touch each cell
+    (``trim_cells.segment_lists``)."""
     p, q, h = bands
     lo, hi = (np.minimum(p, q) - h).min(axis=0), (np.maximum(p, q) + h).max(axis=0)
     axes, windows = layout(lo, hi, p, q, face_surface, max_cells, target)
@@ -70,9 +71,8 @@ def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
             a, b = origin - size, origin + (shape + 1) * size
             a[k] = b[k] = seam
             segs = [np.vstack([x, y]) for x, y in zip(segs, (a[None], b[None], np.zeros((1, 2))))]
-    mask = np.zeros(shape, dtype=np.uint8)
-    mark(mask, *segs, origin, size, eps)
-    return origin, size, mask, windows, (*segs, eps)
+    mask, start, ids = segment_lists(*segs, origin, size, eps, int(shape[0]), int(shape[1]))
+    return origin, size, mask, windows, (*segs, eps, start, ids)
 
 
 _STATE_CODE = {TopAbs_IN: CELL_INSIDE, TopAbs_OUT: CELL_OUTSIDE}
@@ -94,15 +94,15 @@ class TrimGrid:
         (self.u0, self.w0), (self.du, self.dw) = map(float, origin), map(float, size)
         self.window = tuple(float(x) for win in windows for x in win[:2])
         self.nu, self.nw = labels.shape
-        self.codes, self.fine = labels.astype(np.int64), np.zeros(0, np.int64)  # no sub-cells
-        self._flat = labels.tobytes()  # C order: cell (i, j) at i * nw + j
+        self.codes, self.fine = labels.astype(np.int64), np.zeros(0)  # no segment lists
 
     @classmethod
-    def build(cls, face_surface, max_cells: int = 65536, target_share: float = 0.02,
+    def build(cls, face_surface, max_cells: int = 4096, target_share: float = 0.02,
               checks: int = 3, sub_cells: int = 256) -> "TrimGrid":
         """Label a grid for ``face_surface`` (a FaceSurface) by the module's rule, with
-        ``checks`` (1..3) exact calls per region (the first decides, the others confirm)
-        and up to ``sub_cells`` sub-cells per MIXED cell (1: none)."""
+        ``checks`` (1..3) exact calls per region (the first decides, the others confirm);
+        ``sub_cells`` > 1: MIXED cells keep their segments (``cadcnc.trim.resolve``), 1:
+        they always defer to FClass2d."""
         t_start = time.perf_counter()
         tol_uv = classifier_tolerance(face_surface)
         fc = getattr(face_surface, "_classifier", None)  # FaceSurface.classify's, if made
@@ -120,9 +120,8 @@ class TrimGrid:
                    windows, fc, stats)
         grid._label_regions(mask, checks)
         if segs is not None and sub_cells > 1:
-            grid.codes, grid.fine, stats["unresolved"] = refine(
-                mask, grid.labels, *segs[:3], np.asarray(origin), np.asarray(size), segs[3],
-                sub_cells, min(sub_cells, 16))
+            p, q, h, eps, start, ids = segs
+            grid.codes, grid.fine = segment_blocks(grid.labels, start, ids, p, q, h, eps)
         stats["build_s"] = time.perf_counter() - t_start
         return grid
 
@@ -141,7 +140,7 @@ class TrimGrid:
             self.stats["suspect"] += label == CELL_MIXED
         self.stats.update(regions=len(picks), calls=len(picks) * min(max(1, checks), 3))
         paint(self.labels, region, code)
-        self._flat = self.labels.tobytes()
+        self.codes = self.labels.astype(np.int64)
 
     def to_window(self, u: float, w: float) -> tuple[float, float]:
         """(u, w) moved by whole periods into the grid's window, as ``lookup`` expects."""
@@ -149,21 +148,10 @@ class TrimGrid:
         return (us + (u - us) % pu if pu else u), (ws + (w - ws) % pw if pw else w)
 
     def cell(self, u: float, w: float) -> int:
-        """The label of the cell holding (u, w), given in the window (CELL_MIXED if not finite)."""
-        x, y = (u - self.u0) / self.du, (w - self.w0) / self.dw
-        if not (abs(x) < 1e15 and abs(y) < 1e15):
-            return CELL_MIXED
-        i = min(max(math.floor(x), 0), self.nu - 1)
-        j = min(max(math.floor(y), 0), self.nw - 1)
-        code = self._flat[i * self.nw + j]
-        if code != CELL_MIXED or not self.fine.size:
-            return code
-        k = int(self.codes[i, j]) - 3  # trim_lookup.lookup's sub-cell, from Python
-        if k < 0:
-            return code
-        ru, rw = int(self.fine[k]), int(self.fine[k + 1])
-        a, b = min(max(math.floor((x - i) * ru), 0), ru - 1), min(max(math.floor((y - j) * rw), 0), rw - 1)
-        return int(self.fine[k + 2 + a * rw + b])
+        """The label of (u, w), given in the window (CELL_MIXED if not finite), read as the
+        kernel reads it (``cadcnc.trim.lookup``)."""
+        return lookup(self.codes, self.fine, self.u0, self.w0, self.du, self.dw, self.nu,
+                      self.nw, u, w)
 
     def classify(self, u: float, w: float) -> str:
         """inside / boundary / outside, exactly as ``FaceSurface.classify``."""
