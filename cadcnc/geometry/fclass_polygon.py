@@ -90,13 +90,13 @@ def _close(fast: np.ndarray, exact: tuple) -> bool:
     return bool(np.abs(fast - exact).max() <= 1e-12 * (1.0 + np.abs(exact).max()))
 
 
-def _fast_points(c2, c3, surface, us: np.ndarray):
+def _fast_points(c2, c3, surface, us: np.ndarray, data=None):
     """(2-D points (n, 2), 3-D points (n, 3) or None) from numpy, each checked against
     OCCT at its first and last sample; (None, None) where the pcurve is not supported."""
     uv = pcurve_points(c2, us)
     if uv is None or not all(_close(uv[k], c2.Value(us[k]).Coord()) for k in (0, -1)):
         return None, None
-    xyz = surface_points(surface, uv)
+    xyz = surface_points(surface, uv, data)
     if xyz is not None:
         t = surface.Trsf()
         m = np.array([[t.Value(i, j) for j in range(1, 5)] for i in range(1, 4)])
@@ -153,12 +153,13 @@ def _edges(wire, face):
         explorer.Next()
 
 
-def _sample(wire, face, box: list, defl: float = 0.0,
-            surface=None) -> tuple[list, float, float, int] | None:
+def _sample(wire, face, box: list, defl: float = 0.0, surface=None,
+            data=None) -> tuple[list, float, float, int] | None:
     """FClass2d's polygon of one wire: (points (k, 2), FlecheU, FlecheV, edges walked). ``defl`` > 0:
     its re-sampling pass (quasi-uniform deflection, no 3-D test, ``box`` left alone).
     ``surface`` (the face's BRepAdaptor_Surface): evaluate the samples in numpy where
-    supported (``_fast_points``); None: OCCT's calls only."""
+    supported (``_fast_points``; ``data``: the face's SurfaceData, if any); None: OCCT's
+    calls only."""
     seq, fu, fv, first_point, walked, last3d = [], 0.0, 0.0, 1, 0, None
     chunks = [np.zeros((0, 2))]  # seq's points as arrays, edge by edge (not re-sampled)
     for item in _edges(wire, face):
@@ -186,13 +187,21 @@ def _sample(wire, face, box: list, defl: float = 0.0,
         du = (pl - pf) / (nbs - 1) * (1.0 if orient == TopAbs_FORWARD else -1.0)
         u = (pf if orient == TopAbs_FORWARD else pl) + (du if first_point == 2 else 0.0)
         count = nbs + 1 - first_point
-        # the same running sum as FClass2d's (cumsum adds in order)
-        us = np.cumsum(np.r_[u, np.full(max(count - 1, 0), du)])[:count]
-        uv, xyz = _fast_points(c2, c3, surface, us) if surface is not None and \
-            count >= _FAST_FROM else (None, None)
+        uv = xyz = None
+        if surface is not None and count >= _FAST_FROM:
+            us = np.full(count, du)
+            us[0] = u
+            us = np.cumsum(us)  # the same running sum as FClass2d's (in order)
+            uv, xyz = _fast_points(c2, c3, surface, us, data)
+            us = us.tolist()
+        else:
+            us = []
+            for _ in range(count):  # the same running sum as FClass2d's
+                us.append(u)
+                u += du
         if uv is None:
-            uv = np.array([c2.Value(t).Coord() for t in us.tolist()]).reshape(-1, 2)
-        pts, us = uv.tolist(), us.tolist()
+            uv = np.array([c2.Value(t).Coord() for t in us]).reshape(-1, 2)
+        pts = uv.tolist()
         if pts:
             (x0, y0), (x1, y1) = uv.min(axis=0), uv.max(axis=0)
             box[:] = min(box[0], x0), max(box[1], x1), min(box[2], y0), max(box[3], y1)
@@ -216,7 +225,7 @@ def _thickness(seq: list) -> float:
     return max(2.0 * abs(square) / per, 1e-7) if per > 0.0 else math.nan
 
 
-def _bands(face_surface, tol_uv: float) -> tuple[np.ndarray, ...] | None:
+def _bands(face_surface, tol_uv: float, data=None) -> tuple[np.ndarray, ...] | None:
     """FClass2d's bands: segment starts, ends, half-widths, each (k, 2) in (u, w); None where
     it uses BRepClass for every point. Each wire's closed polygon, plus its CSLib_Class2d box
     outline where a re-sampled polygon leaves that box (the quick rejection then cuts it)."""
@@ -231,7 +240,7 @@ def _bands(face_surface, tol_uv: float) -> tuple[np.ndarray, ...] | None:
     while wires.More():
         wire = TopoDS.Wire_s(wires.Current())
         wires.Next()
-        first = _sample(wire, face, box, surface=surface)
+        first = _sample(wire, face, box, surface=surface, data=data)
         if first is None or first[3] != wire.NbChildren():  # the explorer missed edges
             return None
         seq, fu, fv, _ = first

@@ -66,14 +66,48 @@ def _wrap(t: np.ndarray, first: float, last: float, periodic: bool) -> np.ndarra
     return first + np.mod(t - first, last - first) if periodic else t
 
 
-def _curve_points(knots, degree, poles, weights, t) -> np.ndarray:
-    """(n, d) points of a (rational) B-spline curve with poles (m, d), weights (m,) or None."""
+@_jit
+def _curve_points(knots: np.ndarray, degree: int, poles: np.ndarray, weights: np.ndarray,
+                  t: np.ndarray) -> np.ndarray:
+    """(n, d) points of a B-spline curve with poles (m, d) and weights (m,) (empty: not
+    rational) at parameters t (n,)."""
     span, n = basis(knots, degree, t)
-    idx = span[:, None] - degree + np.arange(degree + 1)[None, :]
-    if weights is None:
-        return np.einsum("nk,nkd->nd", n, poles[idx])
-    w = n * weights[idx]
-    return np.einsum("nk,nkd->nd", w, poles[idx]) / w.sum(axis=1)[:, None]
+    out = np.zeros((len(t), poles.shape[1]))
+    for k in range(len(t)):
+        w = 0.0
+        for r in range(degree + 1):
+            i = span[k] - degree + r
+            b = n[k, r] * (weights[i] if weights.size else 1.0)
+            w += b
+            for d in range(poles.shape[1]):
+                out[k, d] += b * poles[i, d]
+        if weights.size:
+            for d in range(poles.shape[1]):
+                out[k, d] /= w
+    return out
+
+
+@_jit
+def _patch_points(ku: np.ndarray, kv: np.ndarray, p: int, q: int, poles: np.ndarray,
+                  weights: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """(n, 3) points of a B-spline surface with poles (nu, nv, 3) and weights (nu, nv)
+    (empty: not rational) at (u, v) (n,) each."""
+    su, bu = basis(ku, p, u)
+    sv, bv = basis(kv, q, v)
+    out = np.zeros((len(u), 3))
+    for k in range(len(u)):
+        w = 0.0
+        for a in range(p + 1):
+            for b in range(q + 1):
+                i, j = su[k] - p + a, sv[k] - q + b
+                c = bu[k, a] * bv[k, b] * (weights[i, j] if weights.size else 1.0)
+                w += c
+                out[k, 0] += c * poles[i, j, 0]
+                out[k, 1] += c * poles[i, j, 1]
+                out[k, 2] += c * poles[i, j, 2]
+        if weights.size:
+            out[k] /= w
+    return out
 
 
 def pcurve_points(c2, t: np.ndarray) -> np.ndarray | None:
@@ -91,7 +125,7 @@ def pcurve_points(c2, t: np.ndarray) -> np.ndarray | None:
     bs = _periodic_copy(bs, periodic, lambda c: c.SetNotPeriodic())
     poles = np.array([bs.Pole(i).Coord() for i in range(1, bs.NbPoles() + 1)])
     weights = (np.array([bs.Weight(i) for i in range(1, bs.NbPoles() + 1)])
-               if bs.IsRational() else None)
+               if bs.IsRational() else np.zeros(0))
     return _curve_points(_flat(bs.KnotSequence()), bs.Degree(), poles, weights,
                          _wrap(t, first, last, periodic))
 
@@ -101,13 +135,20 @@ def _frame(ax3) -> tuple[np.ndarray, ...]:
                                                 ax3.YDirection(), ax3.Direction()))
 
 
-def surface_points(adaptor, uv: np.ndarray) -> np.ndarray | None:
+def surface_points(adaptor, uv: np.ndarray, data=None) -> np.ndarray | None:
     """(n, 3) points S(u, w) of a BRepAdaptor_Surface at uv (n, 2), in the surface's frame
-    before the face's (rigid) location; None if not supported."""
+    before the face's (rigid) location; None if not supported. ``data``: the face's
+    SurfaceData (geometry/surface_data.py), whose B-spline poles are then not read again."""
     trsf: gp_Trsf = adaptor.Trsf()
     if abs(abs(trsf.ScaleFactor()) - 1.0) > 1e-15:
         return None
     s, kind = adaptor.Surface(), adaptor.GetType()
+    if data is not None and kind == GeomAbs_BSplineSurface and \
+            data.kind == int(GeomAbs_BSplineSurface) and not any(data.ints[3:5]):
+        p, q, rational = int(data.ints[1]), int(data.ints[2]), bool(data.ints[5])
+        weights = data.weights if rational else np.zeros((0, 0))
+        return _patch_points(data.knots_u, data.knots_v, p, q, data.poles, weights,
+                             uv[:, 0].copy(), uv[:, 1].copy()) + data.params[20:23]
     u, w = uv[:, 0:1], uv[:, 1:2]
     if kind == GeomAbs_Plane:
         o, x, y, _ = _frame(s.Plane().Position())
@@ -128,17 +169,11 @@ def surface_points(adaptor, uv: np.ndarray) -> np.ndarray | None:
     p, q, nu, nv = bs.UDegree(), bs.VDegree(), bs.NbUPoles(), bs.NbVPoles()
     poles = np.array([[bs.Pole(i, j).Coord() for j in range(1, nv + 1)]
                       for i in range(1, nu + 1)])
-    su, bu = basis(_flat(bs.UKnotSequence()), p, _wrap(uv[:, 0], u0, u1, per_u))
-    sv, bv = basis(_flat(bs.VKnotSequence()), q, _wrap(uv[:, 1], v0, v1, per_v))
-    iu = su[:, None] - p + np.arange(p + 1)[None, :]
-    iv = sv[:, None] - q + np.arange(q + 1)[None, :]
-    grid = poles[iu[:, :, None], iv[:, None, :]]  # (n, p + 1, q + 1, 3)
-    if bs.IsURational() or bs.IsVRational():
-        weights = np.array([[bs.Weight(i, j) for j in range(1, nv + 1)]
-                            for i in range(1, nu + 1)])
-        wb = bu[:, :, None] * bv[:, None, :] * weights[iu[:, :, None], iv[:, None, :]]
-        return np.einsum("nab,nabd->nd", wb, grid) / wb.sum(axis=(1, 2))[:, None]
-    return np.einsum("na,nb,nabd->nd", bu, bv, grid)
+    weights = (np.array([[bs.Weight(i, j) for j in range(1, nv + 1)]
+                         for i in range(1, nu + 1)])
+               if bs.IsURational() or bs.IsVRational() else np.zeros((0, 0)))
+    return _patch_points(_flat(bs.UKnotSequence()), _flat(bs.VKnotSequence()), p, q, poles,
+                         weights, _wrap(uv[:, 0], u0, u1, per_u), _wrap(uv[:, 1], v0, v1, per_v))
 
 
 def _elementary(s, kind, u: np.ndarray, w: np.ndarray) -> np.ndarray:

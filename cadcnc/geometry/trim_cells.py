@@ -75,22 +75,18 @@ def _visit(p: np.ndarray, q: np.ndarray, h: np.ndarray, origin: np.ndarray,
         steps = max(math.ceil(max(abs(q[s, 0] - p[s, 0]) / size[0],
                                   abs(q[s, 1] - p[s, 1]) / size[1])), 1.0)
         for k in range(int(steps)):
-            lo = np.empty(2, np.int64)
-            hi = np.empty(2, np.int64)
-            clear = False
-            for d, n in ((0, nu), (1, nw)):
-                a = p[s, d] + k / steps * (q[s, d] - p[s, d])
-                b = p[s, d] + (k + 1) / steps * (q[s, d] - p[s, d])
-                i0 = math.floor((min(a, b) - h[s, d] - eps[d] - origin[d]) / size[d])
-                i1 = math.floor((max(a, b) + h[s, d] + eps[d] - origin[d]) / size[d])
-                if not (i1 >= 0 and i0 < n):
-                    clear = True
-                lo[d] = int(min(max(i0, 0), n - 1)) if not clear else 0
-                hi[d] = int(min(max(i1, 0), n - 1)) if not clear else -1
-            if clear:
+            a = p[s, 0] + k / steps * (q[s, 0] - p[s, 0])
+            b = p[s, 0] + (k + 1) / steps * (q[s, 0] - p[s, 0])
+            i0 = math.floor((min(a, b) - h[s, 0] - eps[0] - origin[0]) / size[0])
+            i1 = math.floor((max(a, b) + h[s, 0] + eps[0] - origin[0]) / size[0])
+            a = p[s, 1] + k / steps * (q[s, 1] - p[s, 1])
+            b = p[s, 1] + (k + 1) / steps * (q[s, 1] - p[s, 1])
+            j0 = math.floor((min(a, b) - h[s, 1] - eps[1] - origin[1]) / size[1])
+            j1 = math.floor((max(a, b) + h[s, 1] + eps[1] - origin[1]) / size[1])
+            if not (i1 >= 0 and i0 < nu and j1 >= 0 and j0 < nw):
                 continue
-            for i in range(lo[0], hi[0] + 1):
-                for j in range(lo[1], hi[1] + 1):
+            for i in range(int(max(i0, 0)), int(min(i1, nu - 1)) + 1):
+                for j in range(int(max(j0, 0)), int(min(j1, nw - 1)) + 1):
                     c = i * nw + j
                     if last[c] == s:
                         continue

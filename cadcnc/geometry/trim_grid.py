@@ -98,17 +98,18 @@ class TrimGrid:
 
     @classmethod
     def build(cls, face_surface, max_cells: int = 4096, target_share: float = 0.02,
-              checks: int = 3, sub_cells: int = 256) -> "TrimGrid":
+              checks: int = 3, sub_cells: int = 256, data=None) -> "TrimGrid":
         """Label a grid for ``face_surface`` (a FaceSurface) by the module's rule, with
         ``checks`` (1..3) exact calls per region (the first decides, the others confirm);
         ``sub_cells`` > 1: MIXED cells keep their segments (``cadcnc.trim.resolve``), 1:
-        they always defer to FClass2d."""
+        they always defer to FClass2d. ``data``: the face's SurfaceData, if built already
+        (its B-spline poles are reused)."""
         t_start = time.perf_counter()
         tol_uv = classifier_tolerance(face_surface)
         fc = getattr(face_surface, "_classifier", None)  # FaceSurface.classify's, if made
         if fc is None:  # the same classifier (face, tolerance) FaceSurface.classify builds
             fc = face_surface._classifier = BRepTopAdaptor_FClass2d(face_surface.topods, tol_uv)
-        bands = _bands(face_surface, tol_uv)
+        bands = _bands(face_surface, tol_uv, data)
         stats = {"exact_only": bands is None, "regions": 0, "suspect": 0, "calls": 0}
         if bands is None or not len(bands[0]):  # exact only, or no wire (all IN): one cell
             origin, size, windows = (0.0, 0.0), (1.0, 1.0), [(0.0, 0.0)] * 2
