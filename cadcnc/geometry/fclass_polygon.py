@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_Surface
@@ -53,36 +54,37 @@ def _distance(a: tuple, b: tuple) -> float:
     return math.sqrt(d)
 
 
-def _keep_distinct(seq: list, pts: list, us: list, du: float, c3, last, p3=None):
-    """Append to ``seq`` the samples FClass2d keeps: a point repeating the last kept one in
-    3-D is dropped unless the half-step point differs. ``last``: None or (the last kept 3-D
-    point, its curve, its parameter); returns the new one and whether every point was kept. ``p3`` (n, 3): the 3-D points
+def _keep_distinct(kept: int, uv: np.ndarray, us, du: float, c3, last, p3=None):
+    """The samples ``uv`` (k, 2) at parameters ``us`` that FClass2d keeps after ``kept``
+    points of the wire: a point repeating the last kept one in 3-D is dropped unless the
+    half-step point differs. ``last``: None or (the last kept 3-D point, its curve, its
+    parameter). Returns (kept points (m, 2), the new ``last``). ``p3`` (k, 3): the 3-D points
     from numpy (round-off from OCCT's), trusted only when every successive distance clears
     Confusion by 1 % (then every point is kept); otherwise OCCT's own points decide."""
     if not len(us):
-        return last, True
+        return uv, last
     if p3 is not None:
         a = p3 if last is None else np.vstack([last[0], p3])
         d = a[1:] - a[:-1]
         if len(d) == 0 or (d * d).sum(axis=1).min() >= (_CONFUSION * 1.01) ** 2:
-            seq += pts
-            return (tuple(p3[-1]), c3, us[-1]), True
+            return uv, (tuple(p3[-1]), c3, float(us[-1]))
+    us = [float(t) for t in us]
     p3 = [c3.Value(t).Coord() for t in us]
     last3d = None if last is None else last[1].Value(last[2]).Coord()
     a = np.array(p3 if last3d is None else [last3d] + p3)
     d = a[1:] - a[:-1]
     if len(d) == 0 or (d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2]).min() >= \
             _CONFUSION * _CONFUSION * (1.0 + 1e-9):
-        seq += pts
-        return (p3[-1], c3, us[-1]), True
-    for (x, y), t, q in zip(pts, us, p3):
+        return uv, (p3[-1], c3, us[-1])
+    out = []
+    for (x, y), t, q in zip(uv.tolist(), us, p3):
         real = True
-        if len(seq) > 1 and last is not None and _distance(q, last[0]) < _CONFUSION:
+        if kept + len(out) > 1 and last is not None and _distance(q, last[0]) < _CONFUSION:
             real = _distance(q, c3.Value(t - du / 2.0).Coord()) >= _CONFUSION
         if real:
-            seq.append((x, y))
+            out.append((x, y))
             last = q, c3, t
-    return last, False
+    return np.array(out, dtype=float).reshape(-1, 2), last
 
 
 def _close(fast: np.ndarray, exact: tuple) -> bool:
@@ -106,23 +108,22 @@ def _fast_points(c2, c3, surface, us: np.ndarray, data=None):
     return uv, xyz
 
 
+@numba.njit(cache=True, nogil=True)
 def _fleches(a: np.ndarray, fu: float, fv: float) -> tuple[float, float]:
     """``_fleche`` over the points an edge appended (``a`` (k, 2)) from the fifth one on
-    whose triple's ends differ, as FClass2d checks after each sample; vectorised."""
-    if len(a) <= 4:
-        return fu, fv
-    a = a[2:]
-    pa, pb, pc = a[:-2], a[1:-1], a[2:]
-    use = np.any(pa != pc, axis=1)
-    pa, pb, pc = pa[use], pb[use], pc[use]
-    n = np.hypot(pc[:, 0] - pa[:, 0], pc[:, 1] - pa[:, 1])
-    pa, pb, pc, n = pa[n > 0], pb[n > 0], pc[n > 0], n[n > 0]
-    if not len(n):
-        return fu, fv
-    d = (pc - pa) / n[:, None]
-    t = (pb[:, 0] - pa[:, 0]) * d[:, 0] + (pb[:, 1] - pa[:, 1]) * d[:, 1]
-    return (max(fu, float(np.abs(pa[:, 0] + t * d[:, 0] - pb[:, 0]).max())),
-            max(fv, float(np.abs(pa[:, 1] + t * d[:, 1] - pb[:, 1]).max())))
+    whose triple's ends differ, as FClass2d checks after each sample (compiled)."""
+    for k in range(4, len(a)):
+        ax, ay, bx, by, cx, cy = a[k - 2, 0], a[k - 2, 1], a[k - 1, 0], a[k - 1, 1], a[k, 0], a[k, 1]
+        if ax == cx and ay == cy:
+            continue
+        n = math.hypot(cx - ax, cy - ay)
+        if n == 0.0:
+            continue
+        dx, dy = (cx - ax) / n, (cy - ay) / n
+        t = (bx - ax) * dx + (by - ay) * dy
+        fu = max(fu, abs(ax + t * dx - bx))
+        fv = max(fv, abs(ay + t * dy - by))
+    return fu, fv
 
 
 def _is_degenerated(c3: BRepAdaptor_Curve, first: float, last: float) -> bool:
@@ -160,8 +161,8 @@ def _sample(wire, face, box: list, defl: float = 0.0, surface=None,
     ``surface`` (the face's BRepAdaptor_Surface): evaluate the samples in numpy where
     supported (``_fast_points``; ``data``: the face's SurfaceData, if any); None: OCCT's
     calls only."""
-    seq, fu, fv, first_point, walked, last3d = [], 0.0, 0.0, 1, 0, None
-    chunks = [np.zeros((0, 2))]  # seq's points as arrays, edge by edge (not re-sampled)
+    seq, fu, fv, first_point, walked, last3d, kept = [], 0.0, 0.0, 1, 0, None, 0
+    chunks = [np.zeros((0, 2))]  # the kept points, edge by edge (seq: re-sampled ones)
     for item in _edges(wire, face):
         if item is None:
             return None
@@ -193,7 +194,6 @@ def _sample(wire, face, box: list, defl: float = 0.0, surface=None,
             us[0] = u
             us = np.cumsum(us)  # the same running sum as FClass2d's (in order)
             uv, xyz = _fast_points(c2, c3, surface, us, data)
-            us = us.tolist()
         else:
             us = []
             for _ in range(count):  # the same running sum as FClass2d's
@@ -201,17 +201,14 @@ def _sample(wire, face, box: list, defl: float = 0.0, surface=None,
                 u += du
         if uv is None:
             uv = np.array([c2.Value(t).Coord() for t in us]).reshape(-1, 2)
-        pts = uv.tolist()
-        if pts:
+        if len(uv):
             (x0, y0), (x1, y1) = uv.min(axis=0), uv.max(axis=0)
             box[:] = min(box[0], x0), max(box[1], x1), min(box[2], y0), max(box[3], y1)
-        before, kept_all = len(seq), True
-        if degenerated:
-            seq += pts
-        else:
-            last3d, kept_all = _keep_distinct(seq, pts, us, du, c3, last3d, xyz)
-        chunks.append(uv if kept_all else np.asarray(seq[before:], dtype=float).reshape(-1, 2))
-        fu, fv = _fleches(chunks[-1], fu, fv)
+        if not degenerated:
+            uv, last3d = _keep_distinct(kept, uv, us, du, c3, last3d, xyz)
+        chunks.append(uv)
+        kept += len(uv)
+        fu, fv = _fleches(uv, fu, fv)
         first_point = 2
     return (np.asarray(seq, dtype=float).reshape(-1, 2) if defl else np.concatenate(chunks)), \
         fu, fv, walked
