@@ -63,11 +63,9 @@ def _keep_distinct(kept: int, uv: np.ndarray, us, du: float, c3, last, p3=None):
     Confusion by 1 % (then every point is kept); otherwise OCCT's own points decide."""
     if not len(us):
         return uv, last
-    if p3 is not None:
-        a = p3 if last is None else np.vstack([last[0], p3])
-        d = a[1:] - a[:-1]
-        if len(d) == 0 or (d * d).sum(axis=1).min() >= (_CONFUSION * 1.01) ** 2:
-            return uv, (tuple(p3[-1]), c3, float(us[-1]))
+    if p3 is not None and _min_gap2(np.array(last[0] if last else (np.nan,) * 3), p3) >= \
+            (_CONFUSION * 1.01) ** 2:
+        return uv, (tuple(p3[-1]), c3, float(us[-1]))
     us = [float(t) for t in us]
     p3 = [c3.Value(t).Coord() for t in us]
     last3d = None if last is None else last[1].Value(last[2]).Coord()
@@ -85,6 +83,20 @@ def _keep_distinct(kept: int, uv: np.ndarray, us, du: float, c3, last, p3=None):
             out.append((x, y))
             last = q, c3, t
     return np.array(out, dtype=float).reshape(-1, 2), last
+
+
+@numba.njit(cache=True, nogil=True)
+def _min_gap2(first: np.ndarray, p3: np.ndarray) -> float:
+    """The smallest squared distance between successive points of ``first`` (3,) (left out
+    if NaN) followed by p3 (k, 3); inf if there is no pair."""
+    best = math.inf
+    for k in range(len(p3)):
+        a = first if k == 0 else p3[k - 1]
+        if k == 0 and math.isnan(first[0]):
+            continue
+        d = (p3[k, 0] - a[0]) ** 2 + (p3[k, 1] - a[1]) ** 2 + (p3[k, 2] - a[2]) ** 2
+        best = min(best, d)
+    return best
 
 
 def _close(fast: np.ndarray, exact: tuple) -> bool:

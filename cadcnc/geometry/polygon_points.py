@@ -13,6 +13,8 @@ calls otherwise. Anything else gives None (the caller evaluates with OCCT).
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 from OCP.GeomAbs import (GeomAbs_BSplineCurve, GeomAbs_BSplineSurface, GeomAbs_Cone,
@@ -23,8 +25,13 @@ from OCP.gp import gp_Trsf
 _jit = numba.njit(cache=True, nogil=True)
 
 
-def _flat(seq) -> np.ndarray:
-    return np.array([seq.Value(i) for i in range(seq.Lower(), seq.Upper() + 1)])
+def _values(seq) -> list:
+    return [seq.Value(i) for i in range(seq.Lower(), seq.Upper() + 1)]
+
+
+def _flat(knots, mults) -> np.ndarray:
+    """The flat knot vector of a non-periodic B-spline from its knots and multiplicities."""
+    return np.repeat(np.array(_values(knots), dtype=float), _values(mults))
 
 
 @_jit
@@ -126,7 +133,7 @@ def pcurve_points(c2, t: np.ndarray) -> np.ndarray | None:
     poles = np.array([bs.Pole(i).Coord() for i in range(1, bs.NbPoles() + 1)])
     weights = (np.array([bs.Weight(i) for i in range(1, bs.NbPoles() + 1)])
                if bs.IsRational() else np.zeros(0))
-    return _curve_points(_flat(bs.KnotSequence()), bs.Degree(), poles, weights,
+    return _curve_points(_flat(bs.Knots(), bs.Multiplicities()), bs.Degree(), poles, weights,
                          _wrap(t, first, last, periodic))
 
 
@@ -172,7 +179,8 @@ def surface_points(adaptor, uv: np.ndarray, data=None) -> np.ndarray | None:
     weights = (np.array([[bs.Weight(i, j) for j in range(1, nv + 1)]
                          for i in range(1, nu + 1)])
                if bs.IsURational() or bs.IsVRational() else np.zeros((0, 0)))
-    return _patch_points(_flat(bs.UKnotSequence()), _flat(bs.VKnotSequence()), p, q, poles,
+    return _patch_points(_flat(bs.UKnots(), bs.UMultiplicities()),
+                         _flat(bs.VKnots(), bs.VMultiplicities()), p, q, poles,
                          weights, _wrap(uv[:, 0], u0, u1, per_u), _wrap(uv[:, 1], v0, v1, per_v))
 
 
@@ -180,20 +188,36 @@ def _elementary(s, kind, u: np.ndarray, w: np.ndarray) -> np.ndarray:
     """ElSLib's formulas for the cylinder, cone, sphere and torus."""
     if kind == GeomAbs_Cylinder:
         g = s.Cylinder()
-        o, x, y, z = _frame(g.Position())
-        return o + g.Radius() * (np.cos(u) * x + np.sin(u) * y) + w * z
-    if kind == GeomAbs_Cone:
+        code, a, b = 0, g.Radius(), 0.0
+    elif kind == GeomAbs_Cone:
         g = s.Cone()
-        o, x, y, z = _frame(g.Position())
-        r = g.RefRadius() + w * np.sin(g.SemiAngle())
-        return o + r * (np.cos(u) * x + np.sin(u) * y) + w * np.cos(g.SemiAngle()) * z
-    if kind == GeomAbs_Sphere:
+        code, a, b = 1, g.RefRadius(), g.SemiAngle()
+    elif kind == GeomAbs_Sphere:
         g = s.Sphere()
-        o, x, y, z = _frame(g.Position())
-        r = g.Radius()
-        return o + r * np.cos(w) * (np.cos(u) * x + np.sin(u) * y) + r * np.sin(w) * z
-    g = s.Torus()
-    o, x, y, z = _frame(g.Position())
-    big, small = g.MajorRadius(), g.MinorRadius()
-    r = big + small * np.cos(w)
-    return o + r * (np.cos(u) * x + np.sin(u) * y) + small * np.sin(w) * z
+        code, a, b = 2, g.Radius(), 0.0
+    else:
+        g = s.Torus()
+        code, a, b = 3, g.MajorRadius(), g.MinorRadius()
+    return _revolved(code, np.array([v for axis in _frame(g.Position()) for v in axis]), a,
+                     b, u.ravel().copy(), w.ravel().copy())
+
+
+@_jit
+def _revolved(code: int, frame: np.ndarray, a: float, b: float, u: np.ndarray,
+              w: np.ndarray) -> np.ndarray:
+    """o + R(w) (cos u x + sin u y) + H(w) z for the cylinder (0), cone (1), sphere (2),
+    torus (3); frame: o, x, y, z (12,); a, b: the radii or angle."""
+    out = np.empty((len(u), 3))
+    for k in range(len(u)):
+        cu, su = math.cos(u[k]), math.sin(u[k])
+        if code == 0:
+            r, z = a, w[k]
+        elif code == 1:
+            r, z = a + w[k] * math.sin(b), w[k] * math.cos(b)
+        elif code == 2:
+            r, z = a * math.cos(w[k]), a * math.sin(w[k])
+        else:
+            r, z = a + b * math.cos(w[k]), b * math.sin(w[k])
+        for d in range(3):
+            out[k, d] = frame[d] + r * (cu * frame[3 + d] + su * frame[6 + d]) + z * frame[9 + d]
+    return out

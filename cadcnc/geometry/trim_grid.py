@@ -64,7 +64,9 @@ def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
     shifts = [[k * t for k in range(math.ceil((o - b) / t) - 1,
                                     math.floor((o + n * s - a) / t) + 2)] if t else [0.0]
               for a, b, o, s, n, (_, t, _) in zip(lo, hi, origin, size, shape, windows)]
-    moved = np.array(list(product(*shifts)))[:, None, :]  # every copy in one pass
+    grid_lo, grid_hi = origin - eps, origin + shape * size + eps
+    moved = np.array([m for m in product(*shifts)  # copies wholly beyond the grid touch nothing
+                      if np.all(lo + m <= grid_hi) and np.all(hi + m >= grid_lo)])[:, None, :]
     segs = [(p + moved).reshape(-1, 2), (q + moved).reshape(-1, 2), np.tile(h, (len(moved), 1))]
     for k, (_, _, seam) in enumerate(windows):
         if seam is not None:  # a line across the grid
