@@ -125,6 +125,7 @@ class TrimGrid:
         if segs is not None and sub_cells > 1:
             p, q, h, eps, start, ids = segs
             grid.codes, grid.fine = segment_blocks(grid.labels, start, ids, p, q, h, eps)
+        grid.cell(grid.u0, grid.w0)  # loads the reader for Python once (not in a step)
         stats["build_s"] = time.perf_counter() - t_start
         return grid
 
