@@ -1,6 +1,6 @@
 """FClass2d's polygon and bands of a face, rebuilt for the trim grid (geometry/trim_grid.py).
 
-``bands(face_surface, tol_uv)`` samples each wire's pcurves with FClass2d's own rule
+``polygon_bands(face_surface, tol_uv)`` samples each wire's pcurves with FClass2d's own rule
 (``NbSamples`` x 4 per edge, the same running parameter sum, 3-D repeats dropped, sag
 estimates, the quasi-uniform re-sampling of thin wires) and returns the segments and their
 half-widths. The samples are evaluated in one numpy pass (``polygon_points``) where the
@@ -125,7 +125,8 @@ def _fleches(a: np.ndarray, fu: float, fv: float) -> tuple[float, float]:
     """``_fleche`` over the points an edge appended (``a`` (k, 2)) from the fifth one on
     whose triple's ends differ, as FClass2d checks after each sample (compiled)."""
     for k in range(4, len(a)):
-        ax, ay, bx, by, cx, cy = a[k - 2, 0], a[k - 2, 1], a[k - 1, 0], a[k - 1, 1], a[k, 0], a[k, 1]
+        ax, ay, bx, by = a[k - 2, 0], a[k - 2, 1], a[k - 1, 0], a[k - 1, 1]
+        cx, cy = a[k, 0], a[k, 1]
         if ax == cx and ay == cy:
             continue
         n = math.hypot(cx - ax, cy - ay)
@@ -168,8 +169,8 @@ def _edges(wire, face):
 
 def _sample(wire, face, box: list, defl: float = 0.0, surface=None,
             data=None) -> tuple[list, float, float, int] | None:
-    """FClass2d's polygon of one wire: (points (k, 2), FlecheU, FlecheV, edges walked). ``defl`` > 0:
-    its re-sampling pass (quasi-uniform deflection, no 3-D test, ``box`` left alone).
+    """FClass2d's polygon of one wire: (points (k, 2), FlecheU, FlecheV, edges walked).
+    ``defl`` > 0: its re-sampling pass (quasi-uniform deflection, no 3-D test, ``box`` left alone).
     ``surface`` (the face's BRepAdaptor_Surface): evaluate the samples in numpy where
     supported (``_fast_points``; ``data``: the face's SurfaceData, if any); None: OCCT's
     calls only."""
@@ -234,7 +235,7 @@ def _thickness(seq: list) -> float:
     return max(2.0 * abs(square) / per, 1e-7) if per > 0.0 else math.nan
 
 
-def _bands(face_surface, tol_uv: float, data=None) -> tuple[np.ndarray, ...] | None:
+def polygon_bands(face_surface, tol_uv: float, data=None) -> tuple[np.ndarray, ...] | None:
     """FClass2d's bands: segment starts, ends, half-widths, each (k, 2) in (u, w); None where
     it uses BRepClass for every point. Each wire's closed polygon, plus its CSLib_Class2d box
     outline where a re-sampled polygon leaves that box (the quick rejection then cuts it)."""

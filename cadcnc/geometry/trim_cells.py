@@ -22,8 +22,8 @@ _jit = numba.njit(cache=True, nogil=True)
 
 
 def layout(lo, hi, p, q, face_surface, max_cells: int, target: float) -> tuple[list, list]:
-    """Per direction (origin, cell size, count) by trim_grid's resolution rule, and the window (start,
-    period, seam): periodic points are wrapped into [start, start + period) before lookup
+    """Per direction (origin, cell size, count) by trim_grid's resolution rule, and the window
+    (start, period, seam): periodic points are wrapped into [start, start + period) before lookup
     (period 0: not periodic); ``seam`` is where FaceSurface.wrap jumps inside a window that
     the grid does not span (lo, hi are widened to hold it), else None."""
     windows = []

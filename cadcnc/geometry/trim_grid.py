@@ -8,11 +8,12 @@ samples, ``NbSamples`` x 4 per edge, re-sampled by ``GCPnts_QuasiUniformDeflecti
 wires) with a band of half-widths Tu = max(FlecheU, tol), Tv = max(FlecheV, tol): a point is
 ON (sent to BRepClass_FaceClassifier) only if the polygon meets the box p +- (Tu, Tv); off the
 bands the answer is ray-crossing parity, constant on any connected set meeting no band;
-``Perform`` also tries the point shifted by whole periods. ``_bands`` rebuilds FClass2d's
-polygons and bands (same OCCT calls and parameter arithmetic); every cell touched by a band, a
-copy of one whole periods away or the wrap's seam (+ 1e-12 relative round-off) is MIXED; the
-other cells form 4-connected regions, each labelled by one exact call at a cell centre,
-confirmed by two more (disagreement or ON: the region stays MIXED, counted in
+``Perform`` also tries the point shifted by whole periods. ``fclass_polygon`` rebuilds
+FClass2d's polygons and bands (same OCCT calls and parameter arithmetic; long pcurves
+evaluated compiled, OCCT deciding wherever round-off could matter); every cell touched by a
+band, a copy of one whole periods away or the wrap's seam (+ 1e-12 relative round-off) is
+MIXED; the other cells form 4-connected regions, each labelled by one exact call at a cell
+centre, confirmed by two more (disagreement or ON: the region stays MIXED, counted in
 ``stats["suspect"]``). Where FClass2d uses BRepClass for every point (bad wire, <= 3 points,
 no pcurve, flat box) or its periods differ from FaceSurface's, the grid is one MIXED cell
 (``stats["exact_only"]``).
@@ -21,17 +22,20 @@ Resolution rule: a boundary with total variations Lu = sum |du_k|, Lw = sum |dw_
 Lu dw + Lw du of MIXED area, so N cells over the grid box Du x Dw are best shaped du = sqrt(C
 Lu / Lw), dw = sqrt(C Lw / Lu), C = Du Dw / N, for a MIXED share of the face box Fu x Fw of
 about 2 sqrt(Lu Lw C) / (Fu Fw); N makes that ``target_share`` (2 %), within [256,
-``max_cells`` = 65536] (64 KiB; benchmarks/bench_trim_grid.py). A periodic direction whose
-bands cover over 3/4 of the period spans exactly the wrap range; any other spans the bands +
-1.1 clear cells each side (periodic ones inside a one-period window centred on them), so a
-point beyond the grid takes its nearest border cell's label.
+``max_cells`` = 4096] (benchmarks/bench_trim_grid.py). A periodic direction whose bands cover
+over 3/4 of the period spans exactly the wrap range; any other spans the bands + 1.1 clear
+cells each side (periodic ones inside a one-period window centred on them), so a point
+beyond the grid takes its nearest border cell's label.
 
-Sub-cells (``trim_cells.refine``): each MIXED cell is split in up to ``sub_cells`` (256)
-sub-cells, thin strips where its bands run along u or w (a periodic face's seam edge), else
-up to 4 x 4; a sub-cell is MIXED if a band segment meets it inflated by the half-widths
-(FClass2d's own ON test, + the 1e-12 round-off margin); free sub-cells connected inside the
-cell take the label of the free cells beside them (they agree, or the sub-cells stay MIXED:
-``stats["unresolved"]``). ``kernel_args`` hands both levels to ``trim_lookup.lookup``.
+MIXED cells (``trim_cells.segment_blocks``) keep the band segments that meet them (seam and
+periodic copies included). ``cadcnc.trim.resolve`` answers a point of such a cell with the
+label of a labelled neighbour cell when the axis-parallel move from the point to their
+shared side, swept by each segment's half-widths + eps (FClass2d's own ON test), meets no
+segment: that rectangle and the neighbour form a connected set meeting no band, so
+FClass2d's answer is the neighbour's. Only a point that no such move clears (inside a band,
+where FClass2d itself turns to BRepClass, or boxed in between bands) is classified exactly.
+``kernel_args`` hands codes and segment lists to ``cadcnc.trim.lookup``, the reader the
+kernel and ``cell`` share.
 """
 
 from __future__ import annotations
@@ -45,7 +49,7 @@ from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.gp import gp_Pnt2d
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT
 
-from .fclass_polygon import _bands, classifier_tolerance  # noqa: F401 (re-exported)
+from .fclass_polygon import classifier_tolerance, polygon_bands  # noqa: F401 (re-exported)
 from .trim_cells import layout, paint, regions, segment_blocks, segment_lists
 from ..trim import BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE, lookup
 
@@ -111,7 +115,7 @@ class TrimGrid:
         fc = getattr(face_surface, "_classifier", None)  # FaceSurface.classify's, if made
         if fc is None:  # the same classifier (face, tolerance) FaceSurface.classify builds
             fc = face_surface._classifier = BRepTopAdaptor_FClass2d(face_surface.topods, tol_uv)
-        bands = _bands(face_surface, tol_uv, data)
+        bands = polygon_bands(face_surface, tol_uv, data)
         stats = {"exact_only": bands is None, "regions": 0, "suspect": 0, "calls": 0}
         if bands is None or not len(bands[0]):  # exact only, or no wire (all IN): one cell
             origin, size, windows = (0.0, 0.0), (1.0, 1.0), [(0.0, 0.0)] * 2
