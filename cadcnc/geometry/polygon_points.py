@@ -29,9 +29,9 @@ def _values(seq) -> list:
     return [seq.Value(i) for i in range(seq.Lower(), seq.Upper() + 1)]
 
 
-def _flat(knots, mults) -> np.ndarray:
-    """The flat knot vector of a non-periodic B-spline from its knots and multiplicities."""
-    return np.repeat(np.array(_values(knots), dtype=float), _values(mults))
+def _flat(sequence) -> np.ndarray:
+    """A non-periodic B-spline's flat knot vector from its KnotSequence (one call)."""
+    return np.array(_values(sequence), dtype=float)
 
 
 @_jit
@@ -133,7 +133,7 @@ def pcurve_points(c2, t: np.ndarray) -> np.ndarray | None:
     poles = np.array([bs.Pole(i).Coord() for i in range(1, bs.NbPoles() + 1)])
     weights = (np.array([bs.Weight(i) for i in range(1, bs.NbPoles() + 1)])
                if bs.IsRational() else np.zeros(0))
-    return _curve_points(_flat(bs.Knots(), bs.Multiplicities()), bs.Degree(), poles, weights,
+    return _curve_points(_flat(bs.KnotSequence()), bs.Degree(), poles, weights,
                          _wrap(t, first, last, periodic))
 
 
@@ -179,8 +179,7 @@ def surface_points(adaptor, uv: np.ndarray, data=None) -> np.ndarray | None:
     weights = (np.array([[bs.Weight(i, j) for j in range(1, nv + 1)]
                          for i in range(1, nu + 1)])
                if bs.IsURational() or bs.IsVRational() else np.zeros((0, 0)))
-    return _patch_points(_flat(bs.UKnots(), bs.UMultiplicities()),
-                         _flat(bs.VKnots(), bs.VMultiplicities()), p, q, poles,
+    return _patch_points(_flat(bs.UKnotSequence()), _flat(bs.VKnotSequence()), p, q, poles,
                          weights, _wrap(uv[:, 0], u0, u1, per_u), _wrap(uv[:, 1], v0, v1, per_v))
 
 
