@@ -14,8 +14,8 @@ BOUNDARY = "boundary"
 OUTSIDE = "outside"
 TRIM_STATES = (INSIDE, BOUNDARY, OUTSIDE)
 
-# Cell labels of a trim grid (cadcnc.geometry.trim_grid builds it, the compiled kernel's
-# cadcnc.interp.kernel.trim_lookup reads it): small ints, stored as an int8 array.
+# Cell labels of a trim grid (cadcnc.geometry.trim_grid builds it, ``lookup`` below reads
+# it for the compiled kernel and for TrimGrid.cell): small ints, stored as an int8 array.
 CELL_OUTSIDE = 0
 """The whole cell is outside the trimmed face (the exact classifier says OUT everywhere)."""
 CELL_INSIDE = 1

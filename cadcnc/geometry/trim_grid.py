@@ -90,7 +90,7 @@ class TrimGrid:
 
     ``classify(u, w)`` is ``face_surface.classify(u, w)``, O(1) outside MIXED cells. The
     kernel: ``lookup(*kernel_args, *to_window(u, w))`` (``window`` = (u start, u period,
-    w start, w period), period 0 where not periodic; ``trim_lookup.wrap`` does to_window).
+    w start, w period), period 0 where not periodic; ``cadcnc.trim.wrap`` does to_window).
     ``stats``: build_s (s), regions, calls (exact calls at build), suspect, exact_only.
     """
 
@@ -172,5 +172,5 @@ class TrimGrid:
     @property
     def kernel_args(self) -> tuple:
         """(codes, fine, u0, w0, du, dw, nu, nw): the leading arguments of
-        ``trim_lookup.lookup``."""
+        ``cadcnc.trim.lookup``."""
         return self.codes, self.fine, self.u0, self.w0, self.du, self.dw, self.nu, self.nw
