@@ -86,6 +86,16 @@ def _keep_distinct(kept: int, uv: np.ndarray, us, du: float, c3, last, p3=None):
 
 
 @numba.njit(cache=True, nogil=True)
+def _extend(box: np.ndarray, uv: np.ndarray) -> tuple[float, float, float, float]:
+    """(umin, umax, wmin, wmax) of ``box`` (4,) and the points uv (k, 2)."""
+    u0, u1, w0, w1 = box[0], box[1], box[2], box[3]
+    for k in range(len(uv)):
+        u0, u1 = min(u0, uv[k, 0]), max(u1, uv[k, 0])
+        w0, w1 = min(w0, uv[k, 1]), max(w1, uv[k, 1])
+    return u0, u1, w0, w1
+
+
+@numba.njit(cache=True, nogil=True)
 def _min_gap2(first: np.ndarray, p3: np.ndarray) -> float:
     """The smallest squared distance between successive points of ``first`` (3,) (left out
     if NaN) followed by p3 (k, 3); inf if there is no pair."""
@@ -215,8 +225,7 @@ def _sample(wire, face, box: list, defl: float = 0.0, surface=None,
         if uv is None:
             uv = np.array([c2.Value(t).Coord() for t in us]).reshape(-1, 2)
         if len(uv):
-            (x0, y0), (x1, y1) = uv.min(axis=0), uv.max(axis=0)
-            box[:] = min(box[0], x0), max(box[1], x1), min(box[2], y0), max(box[3], y1)
+            box[:] = _extend(np.array(box), uv)
         if not degenerated:
             uv, last3d = _keep_distinct(kept, uv, us, du, c3, last3d, xyz)
         chunks.append(uv)
