@@ -3,9 +3,13 @@
 Per fixture pair (ball 3 mm, f = 0.1 mm): per step (``Stepper.step`` from Python, record
 off; compiled and the plain-Python reference) against two bare OCCT D2 calls from Python
 with their .Coord() calls; per cycle with the loop compiled (``Stepper.run``); the whole
-path (``intersection_path``, planning included) against ``GeomAPI_IntSS`` of the two
-offset surfaces, with the trim-grid build separately; latency p50 / p99 / p99.9 / max over
-``--steps`` steps with GC off; a landing step against the median step; memory per cycle
+path (``intersection_path`` from faces with nothing cached: trim classifier, SurfaceData
+and trim grids built inside) against ``GeomAPI_IntSS`` of the two offset surfaces, best of
+15 interleaved runs each, CPU and wall time, with the trim-grid build separately; latency
+p50 / p99 / p99.9 / max over ``--steps`` steps with GC off, measured five ways
+(benchmarks/latency.py: raw, SCHED_FIFO pinned, kernel-only as the minimum of three
+lockstep replays, CPU time, and this machine's floor); a landing step against the median
+step; memory per cycle
 with the record on, and growth over ``--streamed`` cycles with it off. docs/performance.md
 records a run. Times are minima or percentiles of perf_counter_ns (wall) or thread_time_ns
 (CPU), in microseconds; the latency methods are latency.py's.
