@@ -1,8 +1,8 @@
-"""Many points of a pcurve and of its face's surface in one numpy pass (trim-grid build).
+"""Many points of a pcurve and of its face's surface in one compiled pass (trim-grid build).
 
 FClass2d samples each edge's pcurve (2-D) and the curve on the surface (3-D) at about a
 thousand parameters per face; one OCCT call per point from Python costs about 0.6 us, most
-of a trim grid's build. These evaluate the same geometry vectorised: B-spline (rational,
+of a trim grid's build. These evaluate the same geometry in numba: B-spline (rational,
 periodic) and line pcurves; plane, cylinder, cone, sphere, torus and B-spline surfaces,
 in the surface's own frame (the face's location is a rigid motion: distances, the only
 use of the 3-D points, are kept; a scaling location gives None). They agree with OCCT to
@@ -61,16 +61,9 @@ def basis(knots: np.ndarray, degree: int, t: np.ndarray) -> tuple[np.ndarray, np
     return span, out
 
 
-def _periodic_copy(curve, periodic: bool, set_not_periodic):
-    if not periodic:
-        return curve
-    copy = curve.Copy()
-    set_not_periodic(copy)
-    return copy
-
-
 def _wrap(t: np.ndarray, first: float, last: float, periodic: bool) -> np.ndarray:
-    return first + np.mod(t - first, last - first) if periodic else t
+    """Periodic parameters moved into [first, last); others unchanged (float64 copy)."""
+    return first + np.mod(t - first, last - first) if periodic else np.array(t, dtype=float)
 
 
 @_jit
@@ -129,7 +122,9 @@ def pcurve_points(c2, t: np.ndarray) -> np.ndarray | None:
     bs = c2.BSpline()
     periodic = bs.IsPeriodic()
     first, last = bs.FirstParameter(), bs.LastParameter()
-    bs = _periodic_copy(bs, periodic, lambda c: c.SetNotPeriodic())
+    if periodic:  # the same curve with flat, clamped knots (OCCT inserts them exactly)
+        bs = bs.Copy()
+        bs.SetNotPeriodic()
     poles = np.array([bs.Pole(i).Coord() for i in range(1, bs.NbPoles() + 1)])
     weights = (np.array([bs.Weight(i) for i in range(1, bs.NbPoles() + 1)])
                if bs.IsRational() else np.zeros(0))
