@@ -46,7 +46,7 @@ from scipy.optimize import brentq
 from ..geometry.face_surface import FaceSurface
 from ..geometry.part import Part
 from ..interp.cycle import Contact, inverse_exact
-from ..interp.vec3 import add
+from ..interp.vec3 import add, cross, dot, norm
 
 SAMPLE_MM = 0.25
 """Largest edge sample spacing (mm)."""
@@ -119,8 +119,14 @@ class FaceEdges:
         """(r + R' n (3,), (u, w), n (3,)) with the contact at edge parameter t."""
         uv = curve.Value(t)
         u, w = uv.X(), uv.Y()
-        n = self.face.normal(u, w)
-        return self.face.point(u, w) + self.offset * n, (u, w), n
+        r, ru, rw = self.face.derivative_tuples(u, w)[:3]
+        c = cross(ru, rw)
+        length = norm(c)
+        if length <= self.face.tol.singular * (dot(ru, ru) + dot(rw, rw)):
+            n = self.face.normal(u, w)   # a pole: names the point (SingularPointError)
+        else:
+            n = np.array(c) * (self.face.normal_sign / length)
+        return np.array(r) + self.offset * n, (u, w), n
 
     def velocity(self, curve, t: float) -> np.ndarray:
         """(3,) d(centre)/dt at edge parameter t (central difference inside the edge)."""
