@@ -12,10 +12,10 @@ least rho over the points of F above p_z, and the margin dist(S, F) - d_p + tol 
 least tol (clear) whenever rho_min >= d_p. :class:`HeightCells` bounds both sides
 without OCCT distances:
 
-- rho_min from below: F's surface over a grid of cells of its (u, w) box, each with
-  OCCT's box of the surface over the cell (``BndLib_AddSurface.Add``: the control
-  points of the spans it covers for a B-spline, closed forms for elementary surfaces:
-  a box containing the cell's points; widened by ``SLACK``). Only cells whose top is
+- rho_min from below: F's surface over a grid of cells of its (u, w) box, each with a
+  box containing the surface over the cell (:class:`_Boxes`: a B-spline cut to the cell
+  and boxed by its control points, convex hull property; closed forms for elementary
+  surfaces; widened by ``SLACK``). Only cells whose top is
   above p_z count; rho_min >= the least horizontal distance from p to their boxes.
 - d_p from above: |p - q| for a point q of the trimmed face (the cells' centres that
   lie inside its trims; the nearest one, found again only when the bound falls short).
@@ -42,6 +42,7 @@ import math
 import numpy as np
 from OCP.Bnd import Bnd_Box
 from OCP.BndLib import BndLib_AddSurface
+from OCP.GeomAbs import GeomAbs_BSplineCurve
 from scipy.spatial import cKDTree
 
 from ..geometry.clearance import ClearanceGuard
@@ -77,14 +78,61 @@ def _cells(face, cell_mm: float) -> tuple[np.ndarray, np.ndarray]:
     return np.linspace(u0, u1, nu + 1), np.linspace(w0, w1, nw + 1)
 
 
-def _box(face, u0: float, u1: float, w0: float, w1: float) -> tuple:
-    """OCCT's box of the face's surface over [u0, u1] x [w0, w1], widened by SLACK:
-    (xmin, ymin, zmin, xmax, ymax, zmax)."""
-    box = Bnd_Box()
-    BndLib_AddSurface.Add_s(face._adaptor, u0, u1, w0, w1, 0.0, box)
-    b = box.Get()
-    return (b[0] - SLACK, b[1] - SLACK, b[2] - SLACK, b[3] + SLACK, b[4] + SLACK,
-            b[5] + SLACK)
+class _Boxes:
+    """Boxes of a face's surface over (u, w) ranges, widened by SLACK. A B-spline surface
+    (or an extrusion of a B-spline curve) is cut to the range (``Segment``, exact knot
+    insertion) and boxed by the control points of that piece: the convex hull property,
+    tight as the range shrinks. Other kinds: OCCT's ``BndLib_AddSurface.Add``."""
+
+    def __init__(self, face):
+        self.face, self.surface, self.curve = face, None, None
+        try:
+            if face.kind == "bspline":
+                self.surface = face._adaptor.BSpline()
+            elif face.kind == "extrusion" and face._adaptor.BasisCurve().GetType() == \
+                    GeomAbs_BSplineCurve:
+                self.curve = face._adaptor.BasisCurve().BSpline()
+                self.axis = np.array(face._adaptor.Direction().Coord())
+        except Exception:   # noqa: BLE001 - any trouble: OCCT's generic boxes
+            self.surface = self.curve = None
+        if not self._agrees():
+            self.surface = self.curve = None
+
+    def _agrees(self) -> bool:
+        """Whether the B-spline evaluates as the face (no placement left out)."""
+        if self.surface is None and self.curve is None:
+            return True
+        (u0, u1), (w0, w1) = self.face.u_range, self.face.w_range
+        for u in np.linspace(u0, u1, 3):
+            for w in np.linspace(w0, w1, 3):
+                got = np.array(self.surface.Value(u, w).Coord()) if self.surface is not None \
+                    else np.array(self.curve.Value(u).Coord()) + w * self.axis
+                if np.linalg.norm(got - self.face.point(u, w)) > 1e-9:
+                    return False
+        return True
+
+    def box(self, u0: float, u1: float, w0: float, w1: float) -> tuple:
+        """(xmin, ymin, zmin, xmax, ymax, zmax) containing the surface over the range."""
+        if self.surface is not None:
+            piece = self.surface.Copy()
+            piece.Segment(u0, u1, w0, w1)
+            poles = piece.Poles()
+            pts = np.array([poles.Value(i, j).Coord()
+                            for i in range(poles.LowerRow(), poles.UpperRow() + 1)
+                            for j in range(poles.LowerCol(), poles.UpperCol() + 1)])
+        elif self.curve is not None:
+            piece = self.curve.Copy()
+            piece.Segment(u0, u1)
+            poles = piece.Poles()
+            base = np.array([poles.Value(i).Coord()
+                             for i in range(poles.Lower(), poles.Upper() + 1)])
+            pts = np.vstack([base + w0 * self.axis, base + w1 * self.axis])
+        else:
+            b = Bnd_Box()
+            BndLib_AddSurface.Add_s(self.face._adaptor, u0, u1, w0, w1, 0.0, b)
+            pts = np.array(b.Get()).reshape(2, 3)
+        lo, hi = pts.min(axis=0) - SLACK, pts.max(axis=0) + SLACK
+        return (*lo.tolist(), *hi.tolist())
 
 
 def _segment_box(p, length: float, b) -> float:
@@ -99,10 +147,10 @@ class BoxTree:
     """Boxes of a face's surface over a grid of cells, halved lazily (module doc)."""
 
     def __init__(self, face, cell_mm: float = CELL_MM):
-        self.face = face
+        self.source = _Boxes(face)
         self.us, self.ws = _cells(face, cell_mm)
-        self.top = np.array([[_box(face, self.us[i], self.us[i + 1], self.ws[j],
-                                   self.ws[j + 1]) for j in range(len(self.ws) - 1)]
+        self.top = np.array([[self.source.box(self.us[i], self.us[i + 1], self.ws[j],
+                                              self.ws[j + 1]) for j in range(len(self.ws) - 1)]
                              for i in range(len(self.us) - 1)]).reshape(-1, 6)
         self._sub: dict = {}
 
@@ -113,7 +161,7 @@ class BoxTree:
             um, wm = 0.5 * (u0 + u1), 0.5 * (w0 + w1)
             kids = [(a, b, c, d, level + 1) for a, b in ((u0, um), (um, u1))
                     for c, d in ((w0, wm), (wm, w1))]
-            self._sub[node] = [(k, _box(self.face, *k[:4])) for k in kids]
+            self._sub[node] = [(k, self.source.box(*k[:4])) for k in kids]
         return self._sub[node]
 
     def lower_bound(self, p, length: float, need: float) -> float | None:
@@ -154,10 +202,10 @@ class HeightCells:
     def __init__(self, face, cell_mm: float = CELL_MM):
         us, ws = _cells(face, cell_mm)
         nu, nw = len(us) - 1, len(ws) - 1
-        boxes, inside = [], []
+        boxes, inside, source = [], [], _Boxes(face)
         for i in range(nu):
             for j in range(nw):
-                boxes.append(_box(face, us[i], us[i + 1], ws[j], ws[j + 1]))
+                boxes.append(source.box(us[i], us[i + 1], ws[j], ws[j + 1]))
                 u, w = 0.5 * (us[i] + us[i + 1]), 0.5 * (ws[j] + ws[j + 1])
                 if face.classify(u, w) != OUTSIDE:
                     inside.append(face.point(u, w))
