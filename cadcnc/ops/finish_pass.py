@@ -32,14 +32,15 @@ from typing import Sequence
 
 import numpy as np
 
-from ..errors import CadcncError
+from ..errors import CadcncError, GeometryError
 from ..geometry.part import Part
 from ..interp.cycle import BOUNDARY, COLLISION, END
 from ..interp.stepper import Stepper, Tangency
 from ..job import Job, PairPath
-from ..program.program import STOPPED_SHORT, CutSegment, Skipped
+from ..program.program import FAILED, STOPPED_SHORT, CutSegment, Skipped
 from ..program.toolpath import Toolpath, toolpath_from_record
-from .finish_crossings import Crossing
+from .finish_check import pass_problems
+from .finish_crossings import Crossing, pass_tangent
 from .finish_setup import PassSetup, guide_face, pass_setup
 from .finish_polish import polish
 from .finish_transitions import CONCAVE, CONVEX, TANGENT, transition
@@ -48,6 +49,9 @@ REACHED = 1e-3
 """mm: a cut stopping on its face's boundary this near the planned exit has reached it."""
 RESUME_STEPS = 4     # cycles allowed to the run landing back on a clearance's zero
 SHORTEST = 2e-6      # mm: the step of a piece shorter than two steps is a third of it
+NO_PIECE = 1e-4
+"""mm: a piece of a face this short between its entry and exit (a plane grazing a corner)
+is not cut: the chain goes on from its exit (the chord's sag would be below 1e-9 mm)."""
 
 
 @dataclass(frozen=True)
@@ -119,6 +123,7 @@ class _Pass:
         self.crossings = {f: sorted(e.crossings(self.nrm, plane.offset, self.travel),
                                     key=lambda c: c.s) for f, e in setup.edges.items()}
         self.result = PassResult()
+        self.accounted: list[tuple[float, float]] = []   # s stretches skipped with a reason
 
     # -- helpers ------------------------------------------------------------------------
     def guard(self, face: int):
@@ -136,9 +141,12 @@ class _Pass:
         return f"plane at angle {self.plane.angle:g} deg, offset {self.plane.offset:.4f} mm, " \
                f"face {face}"
 
-    def skip(self, face: int, reason: str, detail: str) -> None:
+    def skip(self, face: int, reason: str, detail: str, stretch=None) -> None:
+        """Record a skipped stretch; ``stretch`` (two points, mm) its ends when known."""
         self.result.skipped.append(Skipped((face, None), reason,
                                            f"{self.where(face)}: {detail}"))
+        if stretch is not None:
+            self.accounted.append(tuple(float(np.dot(p, self.travel)) for p in stretch))
 
     # -- the pass -----------------------------------------------------------------------
     def run(self) -> PassResult:
@@ -151,18 +159,30 @@ class _Pass:
             try:
                 self.chain(c.face, self.tangency(c.point, c.uv))
             except CadcncError as e:
-                self.skip(c.face, "failed", f"from {_xyz(c.point)}: {e}")
+                self.skip(c.face, FAILED, f"from {_xyz(c.point)}: {e}")
+        problems = pass_problems(self.result.cuts, self.crossings, self.accounted,
+                                 self.travel)
+        if problems:   # never a wrong path: the plane's cuts are dropped, the plane listed
+            self.result.cuts = []
+            self.result.skipped.append(Skipped((None, None), FAILED, (
+                f"plane at angle {self.plane.angle:g} deg, offset {self.plane.offset:.4f} "
+                f"mm{' (reversed)' if self.sense < 0 else ''} failed its self-check, not "
+                f"cut: {'; '.join(problems)}")))
         return self.result
 
-    def next_exit(self, face: int, s: float) -> Crossing | None:
-        """The first exit of ``face`` ahead of travel coordinate s."""
-        return next((c for c in self.crossings[face]
-                     if not c.entry and c.s > s + 1e-9), None)
+    def next_exit(self, face: int, p) -> Crossing | None:
+        """The first exit of ``face`` ahead of the centre ``p`` (mm) along the travel: the
+        least s not behind p's, the nearest to p among equal s (a wall climbed)."""
+        s = float(np.dot(p, self.travel))
+        ahead = [c for c in self.crossings[face] if not c.entry and not c.used
+                 and c.s >= s - 1e-9]
+        return min(ahead, key=lambda c: (round(c.s, 9), float(np.linalg.norm(c.point - p))),
+                   default=None)
 
     def chain(self, face: int, start: Tangency) -> None:
         """Cuts from ``start`` on ``face`` across selected faces until the chain ends."""
         while True:
-            exit_ = self.next_exit(face, float(np.dot(start.p, self.travel)))
+            exit_ = self.next_exit(face, np.asarray(start.p))
             step = transition(self, face, exit_) if exit_ is not None else None
             end = step.end if step is not None else None
             last = self.piece(face, start, end)
@@ -188,6 +208,8 @@ class _Pass:
         collisions; the last state when the cuts reached ``end`` (None otherwise)."""
         guard = self.guard(face)
         pos, exact = start, True
+        if end is not None and np.linalg.norm(np.subtract(end.p, start.p)) <= NO_PIECE:
+            return end
         while True:
             tp = self.run_stepper(face, pos, end, guard)
             self.exact(face, tp, guard, exact)
@@ -200,9 +222,15 @@ class _Pass:
             if tp.stop_reason == BOUNDARY:
                 near = end is not None and np.linalg.norm(
                     np.subtract(last.p, end.p)) <= REACHED
-                return last if near else None
+                if near or end is None:
+                    return last if near else None
+                self.skip(face, STOPPED_SHORT, f"the cut from {_xyz(pos.p)} stopped on the "
+                          f"face's boundary at {_xyz(last.p)}, short of its planned exit "
+                          f"{_xyz(end.p)}", (last.p, end.p))
+                return None
             if tp.stop_reason != COLLISION:
-                self.skip(face, STOPPED_SHORT, f"the cut from {_xyz(pos.p)} {tp.partial_reason}")
+                self.skip(face, STOPPED_SHORT, f"the cut from {_xyz(pos.p)} {tp.partial_reason}",
+                          (last.p, end.p) if end is not None else None)
                 return None
             pos, exact = self.clear_again(face, last, end, guard, tp.stop_detail), False
             if pos is None:
@@ -272,13 +300,14 @@ class _Pass:
             k = None
         if k is None or not hit:
             self.skip(face, COLLISION, f"from {_xyz(at.p)} to {_xyz(free.points[-1])} "
-                      f"({why})")
+                      f"({why})", (at.p, end.p if end is not None else free.points[-1]))
             return None
         clear = _state(free, k)
         back = self.run_stepper(face, clear, None, guard, backwards=True,
                                 max_cycles=RESUME_STEPS)
         resume = _last_state(back) if back.stop_reason == COLLISION else clear
-        self.skip(face, COLLISION, f"from {_xyz(at.p)} to {_xyz(resume.p)} ({why})")
+        self.skip(face, COLLISION, f"from {_xyz(at.p)} to {_xyz(resume.p)} ({why})",
+                  (at.p, resume.p))
         return resume
 
     def run_stepper(self, face: int, start: Tangency, end: Tangency | None, guard, *,
@@ -286,10 +315,10 @@ class _Pass:
         """The stepper on ``face`` and the guide plane from ``start`` (to ``end``)."""
         job = self.job
         surface = self.setup.surfaces[face]
-        n = surface.normal(*start.uv1)
-        tau = np.cross(self.nrm, n)
-        if tau @ self.travel < 0.0:
-            tau = -tau
+        try:
+            tau = pass_tangent(surface.normal(*start.uv1), self.travel)
+        except ValueError as e:
+            raise GeometryError(f"at {_xyz(start.p)} on face {face}: {e}") from None
         if backwards:
             tau = -tau
         feed = job.feed

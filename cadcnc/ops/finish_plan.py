@@ -68,7 +68,7 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
     total = sum(lu * lw for lu, lw in extents) / spacing ** 2
     if total > max_samples:
         spacing *= math.sqrt(total / max_samples)
-    rows: list = []
+    numbers, weights, derivs = [], [], []
     for s, (lu, lw) in zip(surfs, extents):
         nu = max(MIN_PER_SIDE, math.ceil(lu / spacing))
         nw = max(MIN_PER_SIDE, math.ceil(lw / spacing))
@@ -80,19 +80,27 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
             for w, dw in zip(ws, ww):
                 if s.classify(u, w) == OUTSIDE:
                     continue
-                d = s.derivatives_array(u, w, out)
-                if s.singularity(d[1], d[2]) < s.tol.singular:
-                    continue  # a pole: no normal; its cell has no area either
-                c = np.cross(d[1], d[2])
-                area = float(np.linalg.norm(c))
-                rows.append((s.number, area * du * dw, *d.ravel(),
-                             *(s.normal_sign * c / area)))
-    if not rows:
+                derivs.append(s.derivatives_array(u, w, out).copy())
+                numbers.append(s.number)
+                weights.append(du * dw)
+    if not derivs:
         raise InputError(f"faces {', '.join(map(str, faces))}: no sample inside their trims")
-    a = np.array(rows)
-    d = a[:, 2:20].reshape(-1, 6, 3)
-    return FaceSamples(d[:, 0], a[:, 20:23], d[:, 1], d[:, 2], d[:, 3], d[:, 4], d[:, 5],
-                       a[:, 0].astype(int), a[:, 1], spacing)
+    d = np.array(derivs)                                   # (N, 6, 3)
+    c = np.cross(d[:, 1], d[:, 2])
+    area = np.linalg.norm(c, axis=1)
+    scale = (d[:, 1] ** 2).sum(1) + (d[:, 2] ** 2).sum(1) + 1e-300
+    tol = {s.number: s.tol.singular for s in surfs}
+    sign = {s.number: s.normal_sign for s in surfs}
+    numbers = np.array(numbers)
+    # a pole (|r_u x r_w| / (|r_u|^2 + |r_w|^2) below the face's tolerance, as
+    # FaceSurface.singularity): no normal; its cell has no area either
+    keep = area / scale >= np.array([tol[n] for n in numbers])
+    if not keep.any():
+        raise InputError(f"faces {', '.join(map(str, faces))}: no sample inside their trims")
+    d, c, area, numbers = d[keep], c[keep], area[keep], numbers[keep]
+    normals = np.array([sign[n] for n in numbers])[:, None] * c / area[:, None]
+    return FaceSamples(d[:, 0], normals, d[:, 1], d[:, 2], d[:, 3], d[:, 4], d[:, 5],
+                       numbers, area * np.array(weights)[keep], spacing)
 
 
 def _nodes(t0: float, t1: float, n: int) -> tuple[np.ndarray, np.ndarray]:

@@ -19,8 +19,7 @@ ITERATIONS = 2
 
 def _offset_points(surface, offset: float, uv: np.ndarray):
     """(c (N, 3), Jacobian columns c_u, c_w (N, 3) each, r (N, 3), n (N, 3)) at uv (N, 2)."""
-    d = np.array([np.concatenate(surface.derivative_tuples(float(u), float(w)))
-                  for u, w in uv]).reshape(-1, 6, 3)
+    d = np.array([surface.derivative_tuples(u, w) for u, w in uv.tolist()]).reshape(-1, 6, 3)
     r, ru, rw, ruu, ruw, rww = (d[:, k] for k in range(6))
     m = np.cross(ru, rw)
     mn = np.linalg.norm(m, axis=1)[:, None]

@@ -17,11 +17,11 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt
 
 from ..errors import InputError
-from ..geometry.clearance import guard_for
 from ..geometry.face_surface import FaceSurface
 from ..geometry.part import Part
 from ..job import Job
 from .finish_crossings import FaceEdges, edge_owners
+from .finish_guard import finish_guard
 
 GUIDE_MARGIN = 10.0  # mm beyond the part's bounding box: the guide face's half size
 
@@ -40,7 +40,7 @@ class PassSetup:
         owners = edge_owners(part)
         self.edges = {f: FaceEdges(part, s, job.tool.offset, owners)
                       for f, s in self.surfaces.items()}
-        self._guards = {f: guard_for(part, (f,), job) for f in self.faces} if guarded else {}
+        self._guards = {f: finish_guard(part, f, job) for f in self.faces} if guarded else {}
         lo, hi = part.bounding_box()
         self.size = float(np.linalg.norm(hi - lo)) + GUIDE_MARGIN
 

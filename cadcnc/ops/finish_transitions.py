@@ -89,10 +89,21 @@ def transition(ps, face: int, exit_: Crossing) -> Transition:
         if not (ps.setup.surfaces[face].contains(*tri.uv1)
                 and ps.setup.surfaces[g].contains(*tri.uv2)):
             return Transition(None, end)
-        return Transition(CONCAVE, ps.tangency(tri.p, tri.uv1), g, tri.uv2, entry)
+        return Transition(CONCAVE, ps.tangency(tri.p, tri.uv1), g, tri.uv2,
+                          _entry_before(ps.crossings[g], float(np.dot(tri.p, ps.travel))))
     if entry is None:
         return Transition(None, end)
     return Transition(CONVEX, end, g, entry.uv, entry, roll=(ps, face, exit_, kg, entry))
+
+
+def _entry_before(crossings, s: float) -> Crossing | None:
+    """The entry of the piece of a face's curve that contains travel coordinate ``s``
+    (the last of its crossings at or before s, when that is an unused entry): a concave
+    transition starts the next face inside that piece, past its entry (which lies in the
+    shadow of the face left, on whichever edge of it)."""
+    before = [c for c in crossings if c.s <= s + 1e-9]
+    last = max(before, key=lambda c: (c.s, c.entry), default=None)
+    return last if last is not None and last.entry and not last.used else None
 
 
 def _slerp(a: np.ndarray, b: np.ndarray, alpha: float) -> np.ndarray:

@@ -87,6 +87,8 @@ class LinkSegment:
 
 STOPPED_SHORT = "stopped short"
 """Skipped reason of the rest of a stretch after a cut that stopped before its end."""
+FAILED = "failed"
+"""Skipped reason of what could not be computed (or failed its self-check): not complete."""
 
 
 @dataclass(frozen=True)
@@ -160,7 +162,7 @@ class Program:
     def complete(self) -> bool:
         """Every cut stopped where it was meant to (nothing partial passed as whole)."""
         return all(s.complete for s in self.cuts) and not any(
-            s.reason == STOPPED_SHORT for s in self.skipped)
+            s.reason in (STOPPED_SHORT, FAILED) for s in self.skipped)
 
     @property
     def partial_reasons(self) -> list[str]:

@@ -1,0 +1,86 @@
+"""A finishing pass's self-check: its cuts travel its way and cover what was planned.
+
+A plane's pass is planned from the crossings of its offset curve with the boundaries of
+the selected faces (:mod:`.finish_crossings`) and cut piece by piece. A wrong pairing of
+crossings, a piece run the wrong way or a chain ending early would still give cuts whose
+every point is exact on its face, so the gate alone cannot see it. This check can:
+
+- **direction**: along every cut the centre's coordinate s along the travel never goes
+  back by more than ``BACK_MM`` (the centre's curve advances along the pass direction,
+  or its reverse for a reversed pass; a climbed wall keeps s);
+- **coverage**: the planned intervals of s, per face from its crossings (a sweep over
+  them in s order, entries before exits at equal s: inside the face while more entries
+  than exits were passed), united over the faces, lie within the union of the cuts'
+  s ranges and the stretches the pass accounted for (skipped with a reason), up to
+  gaps of ``GAP_MM`` (a cut landed on its boundary this near its planned end has
+  reached it);
+- **no overlap**: no two cuts cover the same s range by more than ``OVERLAP_MM`` (a
+  stretch cut twice).
+
+:func:`pass_problems` returns the sentences of what failed (empty when the pass is
+right). Lengths mm.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+BACK_MM = 1e-6
+GAP_MM = 1e-3
+OVERLAP_MM = 1e-6
+
+
+def _union(intervals, gap: float) -> list[tuple[float, float]]:
+    """The union of (a, b) intervals (a <= b), merging those less than ``gap`` apart."""
+    out: list[list[float]] = []
+    for a, b in sorted(intervals):
+        if out and a <= out[-1][1] + gap:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([a, b])
+    return [(a, b) for a, b in out]
+
+
+def planned_intervals(crossings: dict) -> list[tuple[float, float]]:
+    """The s intervals (mm) of the plane inside the selected faces: per face (its
+    crossings, each with ``s`` and ``entry``) a sweep in s order, united over faces."""
+    spans = []
+    for cs in crossings.values():
+        depth, start = 0, 0.0
+        for c in sorted(cs, key=lambda c: (c.s, not c.entry)):
+            if c.entry:
+                if depth == 0:
+                    start = c.s
+                depth += 1
+            elif depth > 0:
+                depth -= 1
+                if depth == 0:
+                    spans.append((start, c.s))
+    return _union(spans, 0.0)
+
+
+def pass_problems(cuts, crossings: dict, accounted, travel: np.ndarray) -> list[str]:
+    """What is wrong with one plane's ``cuts`` (CutSegments, in order) against its
+    ``crossings`` (face -> Crossings) and the ``accounted`` (s0, s1) stretches skipped
+    with a reason, for centres travelling along ``travel`` (3,): sentences, [] if none."""
+    problems = []
+    ranges = []
+    for k, cut in enumerate(cuts, 1):
+        s = cut.points @ travel
+        back = float(-np.diff(s).min()) if len(s) > 1 else 0.0
+        if back > BACK_MM:
+            i = int(np.argmin(np.diff(s)))
+            problems.append(f"cut {k} (face {cut.path.faces[0]}) goes back {back:.3g} mm "
+                            f"against the travel near ({', '.join(f'{v:.3f}' for v in cut.points[i])})")
+        ranges.append((float(s.min()), float(s.max())))
+    order = sorted(ranges)
+    for (a0, a1), (b0, b1) in zip(order, order[1:]):
+        if min(a1, b1) - b0 > OVERLAP_MM:
+            problems.append(f"two cuts both cover s {b0:.4f} .. {min(a1, b1):.4f} mm")
+    covered = _union(ranges + [tuple(sorted(st)) for st in accounted], GAP_MM)
+    for a, b in planned_intervals(crossings):
+        inside = any(c0 - GAP_MM <= a and b <= c1 + GAP_MM for c0, c1 in covered)
+        if not inside:
+            problems.append(f"the planned stretch s {a:.4f} .. {b:.4f} mm is not covered by "
+                            "the cuts")
+    return problems
