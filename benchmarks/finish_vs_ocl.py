@@ -1,0 +1,284 @@
+"""Guide-surface finishing against OpenCAMLib's drop-cutter (issue 13, docs/finishing_vs_ocl.md).
+
+The same faces, the same pass lines (vertical planes at ``--angle``, ``--stepover`` apart),
+the same point spacing (``--spacing``, cadcnc's step f = F Ts): cadcnc's ball centres
+against OCL's BatchDropCutter on OCCT tessellations of the faces at ``--tol`` (1e-2 and
+1e-3 mm), one OCL thread, in a subprocess (benchmarks/ocl_worker.py). Every ball centre's
+true deviation from the exact offset of the faces is measured with OCCT
+(benchmarks/finish_bench_tools.py): max, p50, p99 of |distance - R'|, gouge side and
+leave side, counted where the ball lies wholly over a face (its nearest point inside the
+face, the ball grown by ``--margin`` clear of the face's boundary). Time per point: OCL's
+with its tessellation (BRepMesh, building the STLSurf, appending the points, the run);
+cadcnc's with its planning (reading the part, planes, starts, trim grids, stepping) and
+without the verification gate, which is timed separately.
+
+    python benchmarks/finish_vs_ocl.py [--slab] [--fixtures] [--tol 1e-2 1e-3]
+        [--json OUT] [--png docs/img/finish_vs_ocl.png]
+
+``--slab`` (default when neither is given): the held-out-like free-form slab of
+benchmarks/freeform_slab.py, 80 x 60 mm, 60 passes. ``--fixtures``: every
+fixtures/finish_*.step named in fixtures/finish_fixtures.json, on its selected faces.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+# benchmarks/coverage.py would shadow the `coverage` package numba probes when imported:
+# import numba with this folder off sys.path, then put it back for the sibling modules
+sys.path[:] = [p for p in sys.path if os.path.abspath(p or ".") != HERE]
+import numba  # noqa: E402,F401
+sys.path.insert(0, HERE)
+
+import numpy as np  # noqa: E402
+
+import cadcnc  # noqa: E402
+from cadcnc.geometry.part import optimal_box  # noqa: E402
+from finish_bench_tools import FaceDistances, run_ocl, tessellate  # noqa: E402
+import freeform_slab  # noqa: E402
+
+ROOT = Path(HERE).parent
+R, FEED, PERIOD = 3.0, 1500.0, 0.004
+SPACING = FEED * PERIOD / 60.0    # 0.1 mm: cadcnc's step, OCL's point spacing
+clock = time.perf_counter
+
+
+@dataclass
+class CadcncRun:
+    polylines: list            # [(N_k, 3)] ball centres of every cut, in order
+    offsets: list              # plane offset (mm, along the plane normal) of each cut
+    seconds: float             # part, planning and cutting, gate excluded
+    seconds_part: float        # of which reading the shape into a Part
+    seconds_gate: float | None  # the verification gate alone (None: not run)
+    points: int
+
+
+def plane_frame(angle: float) -> tuple[np.ndarray, np.ndarray]:
+    """(direction, normal) of guide planes at ``angle`` degrees to +X (FINISH_INTERFACE)."""
+    a = np.radians(angle)
+    return np.array([np.cos(a), np.sin(a), 0.0]), np.array([-np.sin(a), np.cos(a), 0.0])
+
+
+def cadcnc_finish(shape, faces: list[int], *, radius: float, stepover: float,
+                  angle: float, source: str) -> CadcncRun:
+    """cadcnc's finishing of ``faces`` of ``shape``: the one function to swap for
+    ``cadcnc.finish`` once it exists. Until then: one guide-surface ``intersection_path``
+    per plane (cq.Face.makePlane as the guide, offsets (None, 0)), planes ``stepover``
+    apart from half a stepover inside the faces' box, each from the first start whose
+    contact is inside the face to the far side of the box."""
+    import cadquery as cq  # only this interim side builds guide faces
+
+    t0 = clock()
+    part = cadcnc.Part(shape, source=source)
+    t_part = clock() - t0
+    if len(faces) != 1:
+        raise NotImplementedError("the interim cadcnc side machines one face")
+    face = part.face(faces[0])
+    direction, normal = plane_frame(angle)
+    lo, hi = optimal_box(face.topods, use_triangulation=False)
+    corners = np.array([[x, y, 0.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])])
+    s_lo, s_hi = (corners @ direction).min(), (corners @ direction).max()
+    n_lo, n_hi = (corners @ normal).min(), (corners @ normal).max()
+    polylines, offsets = [], []
+    for c in np.arange(n_lo + 0.5 * stepover, n_hi, stepover):
+        guide = cq.Face.makePlane(4 * (s_hi - s_lo + n_hi - n_lo), 4 * (s_hi - s_lo + n_hi - n_lo),
+                                  basePnt=tuple(c * normal + 0.5 * (s_lo + s_hi) * direction),
+                                  dir=tuple(normal))
+        end = c * normal + (s_hi + radius) * direction + [0.0, 0.0, hi[2] + radius]
+        for s in np.arange(s_lo + 0.5, s_lo + 4 * radius, 0.5):
+            above = c * normal + s * direction + [0.0, 0.0, hi[2] + radius]
+            u, w, _ = face.project(above)
+            start = face.point(u, w) + radius * face.normal(u, w)
+            try:
+                tp = cadcnc.intersection_path(face, guide, radius=radius, offsets=(None, 0.0),
+                                              start=tuple(start), end=tuple(end), feed=FEED,
+                                              period=PERIOD)
+            except (cadcnc.StartPointError, cadcnc.GeometryError):
+                continue
+            polylines.append(tp.points)
+            offsets.append(float(c))
+            break
+    seconds = clock() - t0
+    return CadcncRun(polylines, offsets, seconds, t_part, None,
+                     int(sum(len(p) for p in polylines)))
+
+
+def ocl_points(faces_topods, offsets: list, angle: float) -> tuple[np.ndarray, list]:
+    """((N, 2) x, y of OCL's cutter locations, [(start, stop)] rows of each line): every
+    plane offset's line across the faces' box, SPACING apart (the box's ends included)."""
+    boxes = [optimal_box(f, use_triangulation=False) for f in faces_topods]
+    lo = np.min([b[0] for b in boxes], axis=0)
+    hi = np.max([b[1] for b in boxes], axis=0)
+    direction, normal = plane_frame(angle)
+    corners = np.array([[x, y, 0.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])])
+    s = np.arange((corners @ direction).min(), (corners @ direction).max() + 1e-9, SPACING)
+    rows, out, k = [], [], 0
+    for c in sorted(set(offsets)):
+        xy = (c * normal + s[:, None] * direction)[:, :2]
+        out.append(xy)
+        rows.append((k, k + len(xy)))
+        k += len(xy)
+    return np.concatenate(out), rows
+
+
+def compare(name: str, shape, faces: list[int], tols: list[float], *, angle: float = 0.0,
+            stepover: float = 1.0, margin: float = 0.5, source: str = "<shape>") -> dict:
+    """Every figure of one case (see the module doc), and the polylines for the picture."""
+    run = cadcnc_finish(shape, faces, radius=R, stepover=stepover, angle=angle, source=source)
+    part = cadcnc.Part(shape, source=source)  # for the faces only (not timed)
+    topods = [part.face(n).topods for n in faces]
+    judge = FaceDistances(topods, R, margin=margin)
+    t0 = clock()
+    dev = judge.measure(run.polylines)
+    devs = {"cadcnc": dev.per_line()}
+    rows = {"cadcnc": dict(dev.summary(), points=run.points,
+                           seconds=run.seconds, seconds_part=run.seconds_part,
+                           seconds_gate=run.seconds_gate,
+                           us_per_point=1e6 * run.seconds / run.points,
+                           passes=len(run.polylines))}
+    lines = {"cadcnc": run.polylines}
+    print(f"{name}: cadcnc {run.points} points in {run.seconds:.2f} s, measured in "
+          f"{clock() - t0:.1f} s", file=sys.stderr)
+    xy, spans = ocl_points(topods, run.offsets, angle)
+    for tol in tols:
+        tris, mesh_s = tessellate(topods, tol)
+        ocl = run_ocl(tris, xy, R, threads=1)
+        polys = [ocl.centres[a:b] for a, b in spans]
+        total = mesh_s + sum(ocl.seconds.values())
+        key = f"ocl {tol:g}"
+        dev = judge.measure(polys)
+        devs[key] = dev.per_line()
+        rows[key] = dict(dev.summary(), triangles=int(len(tris)),
+                         points=int(len(xy)), seconds=total, seconds_mesh=mesh_s,
+                         seconds_ocl=ocl.seconds, threads=ocl.threads,
+                         us_per_point=1e6 * total / len(xy))
+        lines[key] = polys
+        print(f"{name}: {key}: {len(tris)} triangles, {total:.2f} s", file=sys.stderr)
+    return dict(name=name, faces=faces, angle=angle, stepover=stepover, margin=margin,
+                offsets=run.offsets, rows=rows, lines=lines, devs=devs)
+
+
+def table(case: dict) -> str:
+    """The markdown table of one case: every row, and OCL / cadcnc ratios."""
+    rows, ours = case["rows"], case["rows"]["cadcnc"]
+    out = [f"**{case['name']}** (faces {case['faces']}, {ours['passes']} passes, "
+           f"counted {ours['counted']} of {ours['points']} cadcnc points)", "",
+           "| | triangles | points | worst dev. | p50 | p99 | gouge side | leave side "
+           "| time per point | worst dev. / cadcnc's | time per point / cadcnc's |",
+           "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for key, r in rows.items():
+        ratio_dev = r["max"] / ours["max"] if ours["max"] > 0 else float("inf")
+        ratio_t = r["us_per_point"] / ours["us_per_point"]
+        out.append(f"| {key} | {r.get('triangles', '-')} | {r['points']} | {r['max']:.2e} mm "
+                   f"| {r['p50']:.1e} | {r['p99']:.1e} | {r['gouge']:.1e} | {r['leave']:.1e} "
+                   f"| {r['us_per_point']:.1f} µs | {ratio_dev:.0f}x | {ratio_t:.1f}x |")
+    if ours["seconds_gate"] is not None:
+        out += ["", f"cadcnc's verification gate: {ours['seconds_gate']:.2f} s "
+                f"({1e6 * ours['seconds_gate'] / ours['points']:.1f} µs per point)."]
+    return "\n".join(out)
+
+
+def picture(case: dict, path: Path) -> None:
+    """Deviation along the middle pass, and histograms of |deviation| over every counted
+    centre, for cadcnc and each OCL mesh."""
+    import matplotlib  # noqa: PLC0415 - 0.5 s, only when a picture is asked for
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.2))
+    direction, _ = plane_frame(case["angle"])
+    colours = {"cadcnc": "C2"}
+    mid = len(case["lines"]["cadcnc"]) // 2
+    for k, (key, polys) in enumerate(case["lines"].items()):
+        colour = colours.get(key, f"C{k - 1}")
+        pl = polys[mid] if key == "cadcnc" else polys[sorted(set(case["offsets"])).index(
+            case["offsets"][mid])]
+        per_line = case["devs"][key]
+        signed, over = per_line[mid] if key == "cadcnc" else per_line[
+            sorted(set(case["offsets"])).index(case["offsets"][mid])]
+        shown = np.where(over, signed, np.nan)
+        ax1.plot(pl @ direction, 1e3 * shown, lw=0.8, color=colour, label=key)
+        counted = np.concatenate([d[o] for d, o in per_line])
+        a = np.abs(counted)
+        bins = np.logspace(-10, -1, 91)
+        ax2.hist(np.clip(a, 1e-10, None), bins=bins, histtype="step", color=colour,
+                 label=f"{key}: max {a.max():.1e} mm")
+    ax1.set_xlabel("position along the pass (mm)")
+    ax1.set_ylabel("distance - R' (µm); < 0: gouge side")
+    ax1.set_title(f"{case['name']}: deviation along pass {mid + 1} "
+                  f"(offset {case['offsets'][mid]:g} mm)")
+    ax1.legend()
+    ax2.set_xscale("log")
+    ax2.set_xlabel("|distance - R'| (mm), centres where the ball lies wholly over a face")
+    ax2.set_ylabel("ball centres")
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def slab_case(tols: list[float]) -> dict:
+    shape = freeform_slab.slab_shape()
+    part = cadcnc.Part(shape, source="freeform slab")
+    return compare("free-form slab 80 x 60 mm", shape, [freeform_slab.top_face_number(part)],
+                   tols, source="freeform slab")
+
+
+def fixture_cases(tols: list[float]) -> list[dict]:
+    facts = json.loads((ROOT / "fixtures" / "finish_fixtures.json").read_text())
+    out = []
+    for name, f in facts.items():
+        path = ROOT / "fixtures" / f["file"]
+        part = cadcnc.load_step(path)
+        out.append(compare(name, part.shape, list(f["faces"]), tols, source=str(path)))
+    return out
+
+
+def warm_up() -> None:
+    """Load (or compile) the numba kernel on a throwaway part, so the timed runs measure
+    the steady state (importing and loading the kernel are a process's one-time cost)."""
+    shape = freeform_slab.slab_shape()
+    part = cadcnc.Part(shape, source="warm-up")
+    face = part.face(freeform_slab.top_face_number(part))
+    import cadquery as cq
+    guide = cq.Face.makePlane(400, 400, basePnt=(40, 30.5, 0), dir=(0, 1, 0))
+    z = float(freeform_slab.height(np.array(20.0), np.array(30.5))) + R
+    cadcnc.intersection_path(face, guide, radius=R, offsets=(None, 0.0), start=(20, 30.5, z),
+                             end=(25, 30.5, z), feed=FEED, period=PERIOD)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--slab", action="store_true")
+    ap.add_argument("--fixtures", action="store_true")
+    ap.add_argument("--tol", type=float, nargs="+", default=[1e-2, 1e-3])
+    ap.add_argument("--json", type=Path)
+    ap.add_argument("--png", type=Path, default=ROOT / "docs" / "img" / "finish_vs_ocl.png")
+    args = ap.parse_args(argv)
+    t0 = clock()
+    warm_up()
+    print(f"warm-up {clock() - t0:.1f} s", file=sys.stderr)
+    cases = []
+    if args.slab or not args.fixtures:
+        cases.append(slab_case(args.tol))
+        picture(cases[-1], args.png)
+    if args.fixtures:
+        cases += fixture_cases(args.tol)
+    for case in cases:
+        print(table(case), end="\n\n")
+    if args.json:
+        keep = [{k: v for k, v in c.items() if k not in ("lines", "devs")} for c in cases]
+        args.json.write_text(json.dumps(keep, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
