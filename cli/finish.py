@@ -16,7 +16,7 @@ from cadcnc.errors import InputError  # light: OCCT is imported in finish_comman
 from cadcnc.units import parse_duration, parse_feed, parse_length
 
 from .feedback import say_error
-from .pencil import DEFAULT_FEED, DEFAULT_PERIOD, SUFFIXES, _skipped_line, program_csv
+from .pencil import DEFAULT_FEED, DEFAULT_PERIOD, SUFFIXES, _skipped_line, gate_and_write
 
 PROGRESS_EVERY_S = 1.0  # s between two progress lines on stderr
 
@@ -72,15 +72,9 @@ def _angle(text: str) -> float:
 def finish_command(args) -> int:
     import cadcnc
     from cadcnc.io.output_set import OutputSet
-    from cadcnc.io.program_gcode import program_ngc
-    from cadcnc.io.program_json import program_json
-    from cadcnc.io.program_plot import program_picture_bytes
     from cadcnc.ops.finish import JOIN, finish
-    from cadcnc.ops.pair_program import safe_height
-    from cadcnc.verification.cut_back import cut_back
 
-    from .options import clearance, program_gcode_options, tolerances
-    from .program_commands import judge_program
+    from .options import clearance, tolerances
 
     outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])
     radius = parse_length(args.radius, "radius", allow_zero=False)
@@ -103,28 +97,8 @@ def finish_command(args) -> int:
         raise InputError(f"{args.step}: no pass cuts faces {' '.join(map(str, args.faces))}"
                          f" with a {radius:g} mm ball ({_skipped_line(program) or 'nothing'})")
     title = f"finish R {radius:g} of {Path(args.step).name}"
-    gopts = program_gcode_options(args)
-    if not args.allow_gouge:  # a gouging cut is cut back and listed, not the program lost
-        program = cut_back(program, part, safe_height(part, program.job), JOIN)
-        if not program.cuts:
-            raise InputError(f"{args.step}: every cut gouges the part: "
-                             f"{_skipped_line(program)}")
-    ngc = program_ngc(program, title=title, **gopts)
-    write, code = judge_program(args, program, part, "finish", gopts)
-    if not args.quiet:
-        print(_summary(program, args.step, time.monotonic() - t0, t_cut))
-    if not write:
-        return code
-    contents = {}
-    for out in args.output:
-        suffix = Path(out).suffix.lower()
-        contents[out] = (program_json(program) if suffix == ".json" else ngc
-                         if suffix == ".ngc" else program_csv(program) if suffix == ".csv"
-                         else program_picture_bytes(program, part, out, title))
-    outputs.write(contents)
-    if not args.quiet:
-        print(f"  wrote      {', '.join(args.output)}")
-    return code
+    return gate_and_write(args, program, part, outputs, "finish", title, JOIN,
+                          lambda p: _summary(p, args.step, time.monotonic() - t0, t_cut))
 
 
 def _progress(args):

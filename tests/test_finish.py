@@ -15,7 +15,7 @@ from cadcnc.ops.finish_plan import centre_chord, plan_planes, sample_faces
 from cadcnc.ops.finish_uncut import uncut_report
 from cadcnc.verification import gate_program
 from cadcnc.verification.probe import shape_distances
-from conftest import FIXTURES, ROOT
+from conftest import FIXTURES
 
 R = 3.0
 _runs: dict = {}
@@ -224,16 +224,3 @@ def test_a_face_pointing_down_is_refused():
     wp = cq.Workplane("XY").box(20, 10, 5)
     with pytest.raises(cadcnc.InputError, match="points down"):
         finish(wp, wp.faces("<Z"), radius=2.0, stepover=2.0)
-
-
-def test_cadquery_example_runs_as_script_and_under_cq_editor(capsys):
-    import runpy
-
-    example = str(ROOT / "docs" / "examples" / "finish_example.py")
-    shown = {}
-    ns = runpy.run_path(example, init_globals={
-        "show_object": lambda obj, name="", options=None: shown.__setitem__(name, obj)})
-    prog = ns["program"]
-    assert set(shown) == {"part", "cuts", "links"} and prog.complete and prog.cuts
-    runpy.run_path(example, run_name="__main__")
-    assert "finish R" in capsys.readouterr().out

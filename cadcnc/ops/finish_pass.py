@@ -29,28 +29,23 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 from typing import Sequence
-from weakref import WeakKeyDictionary
 
 import numpy as np
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
-from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt
 
-from ..errors import CadcncError, InputError
-from ..geometry.clearance import guard_for
-from ..geometry.face_surface import FaceSurface
+from ..errors import CadcncError
 from ..geometry.part import Part
 from ..interp.cycle import BOUNDARY, COLLISION, END
 from ..interp.stepper import Stepper, Tangency
 from ..job import Job, PairPath
 from ..program.program import STOPPED_SHORT, CutSegment, Skipped
 from ..program.toolpath import Toolpath, toolpath_from_record
-from .finish_crossings import Crossing, FaceEdges, edge_owners
+from .finish_crossings import Crossing
+from .finish_setup import PassSetup, guide_face, pass_setup
 from .finish_polish import polish
-from .finish_transitions import CONCAVE, CONVEX, TANGENT, Transition, transition
+from .finish_transitions import CONCAVE, CONVEX, TANGENT, transition
 
 REACHED = 1e-3
 """mm: a cut stopping on its face's boundary this near the planned exit has reached it."""
-GUIDE_MARGIN = 10.0  # mm beyond the part's bounding box: the guide face's half size
 RESUME_STEPS = 4     # cycles allowed to the run landing back on a clearance's zero
 SHORTEST = 2e-6      # mm: the step of a piece shorter than two steps is a third of it
 
@@ -85,41 +80,6 @@ class PassResult:
     skipped: list[Skipped] = field(default_factory=list)
 
 
-class PassSetup:
-    """What every plane of one finishing job shares: the selected faces, their boundary
-    edges sampled for R' (:class:`~cadcnc.ops.finish_crossings.FaceEdges`) and one guard
-    per face (``guard(face)``: that face followed, every other face a third face)."""
-
-    def __init__(self, part: Part, faces: Sequence[int], job: Job, guarded: bool = True):
-        self.part, self.job = part, job
-        self.faces = tuple(dict.fromkeys(int(f) for f in faces))
-        if not self.faces:
-            raise InputError("a finishing pass needs at least one face")
-        self.surfaces = {f: part.face(f) for f in self.faces}
-        owners = edge_owners(part)
-        self.edges = {f: FaceEdges(part, s, job.tool.offset, owners)
-                      for f, s in self.surfaces.items()}
-        self._guards = {f: guard_for(part, (f,), job) for f in self.faces} if guarded else {}
-        lo, hi = part.bounding_box()
-        self.size = float(np.linalg.norm(hi - lo)) + GUIDE_MARGIN
-
-    def guard(self, face: int):
-        """The guard of cuts on ``face`` (None when the setup is unguarded)."""
-        return self._guards.get(face)
-
-
-_SETUPS: WeakKeyDictionary = WeakKeyDictionary()
-
-
-def pass_setup(part: Part, faces: Sequence[int], job: Job) -> PassSetup:
-    """The :class:`PassSetup` of ``part``, ``faces`` and the job's tool, built once."""
-    key = (tuple(dict.fromkeys(int(f) for f in faces)), job.tool, job.tolerances)
-    per_part = _SETUPS.setdefault(part, {})
-    if key not in per_part:
-        per_part[key] = PassSetup(part, faces, job)
-    return per_part[key]
-
-
 def pass_cuts(part: Part, faces: Sequence[int], plane: GuidePlane, job: Job, *,
               reverse: bool = False, guard=None) -> PassResult:
     """Every cut of one guide plane over the selected ``faces`` (1-based numbers of
@@ -142,15 +102,6 @@ def pass_cuts(part: Part, faces: Sequence[int], plane: GuidePlane, job: Job, *,
         setup = pass_setup(part, faces, job)
         fixed = guard
     return _Pass(setup, plane, job, reverse, fixed).run()
-
-
-def guide_face(plane: GuidePlane, size: float, job: Job) -> FaceSurface:
-    """The guide plane as a square face of half size ``size`` (mm), centred on the
-    plane's point nearest the origin; u along the pass direction."""
-    origin = plane.offset * plane.normal
-    ax = gp_Ax3(gp_Pnt(*origin), gp_Dir(*plane.normal), gp_Dir(*plane.direction))
-    face = BRepBuilderAPI_MakeFace(gp_Pln(ax), -size, size, -size, size).Face()
-    return FaceSurface(face, tol=job.tolerances)
 
 
 class _Pass:

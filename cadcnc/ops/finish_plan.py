@@ -41,9 +41,9 @@ MIN_PER_SIDE = 4
 
 @dataclass
 class FaceSamples:
-    """Samples of the selected faces on a grid of cells in each face's (u, w) box, cells
-    outside the trims dropped: (N, 3) points, normals (outward), r_u, r_w, r_uu, r_uw, r_ww;
-    (N,) face numbers and areas (mm^2, the cell's share of the face); ``spacing`` mm."""
+    """Samples of the selected faces on a grid of nodes over each face's (u, w) box (its
+    edges included), nodes outside the trims dropped: (N, 3) points, normals (outward), r_u, r_w, r_uu, r_uw, r_ww;
+    (N,) face numbers and areas (mm^2, the node's trapezoid share of the face); ``spacing`` mm."""
 
     points: np.ndarray
     normals: np.ndarray
@@ -73,10 +73,11 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
         nu = max(MIN_PER_SIDE, math.ceil(lu / spacing))
         nw = max(MIN_PER_SIDE, math.ceil(lw / spacing))
         (u0, u1), (w0, w1) = s.u_range, s.w_range
-        du, dw = (u1 - u0) / nu, (w1 - w0) / nw
+        us, wu = _nodes(u0, u1, nu)
+        ws, ww = _nodes(w0, w1, nw)
         out = np.empty((6, 3))
-        for u in u0 + du * (np.arange(nu) + 0.5):
-            for w in w0 + dw * (np.arange(nw) + 0.5):
+        for u, du in zip(us, wu):
+            for w, dw in zip(ws, ww):
                 if s.classify(u, w) == OUTSIDE:
                     continue
                 d = s.derivatives_array(u, w, out)
@@ -92,6 +93,13 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
     d = a[:, 2:20].reshape(-1, 6, 3)
     return FaceSamples(d[:, 0], a[:, 20:23], d[:, 1], d[:, 2], d[:, 3], d[:, 4], d[:, 5],
                        a[:, 0].astype(int), a[:, 1], spacing)
+
+
+def _nodes(t0: float, t1: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """n + 1 nodes from t0 to t1 and their trapezoid weights (summing to t1 - t0)."""
+    w = np.full(n + 1, (t1 - t0) / n)
+    w[[0, -1]] *= 0.5
+    return np.linspace(t0, t1, n + 1), w
 
 
 def _extent(s) -> tuple[float, float]:

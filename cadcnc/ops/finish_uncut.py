@@ -18,9 +18,10 @@ against the program's actual cut points (ball centres), with a k-d tree:
   pass leaves. Its reason: the plan's (normals pointing down: ``unreachable``; concave
   tighter than the ball: ``too tight``; a wall within 5 deg of parallel to the planes:
   ``parallel wall``), else the tool at the sample's ideal centre hitting another face or
-  with its shank (``unreachable``), else ``too steep`` where the face is within
-  ``STEEP_DEG`` of vertical (the pass climbs it), else ``missed`` (a pass stopped or
-  failed there: see the passes' own skipped records). Areas mm^2, heights mm.
+  with its shank (``unreachable``), else ``parallel wall`` where the face slopes more
+  across the passes than along them (the planes too far apart on it), else ``too steep``
+  where it is within ``STEEP_DEG`` of vertical (the pass climbs it), else ``missed`` (a
+  pass stopped or failed there: see the passes' own skipped records). Areas mm^2, heights mm.
 """
 
 from __future__ import annotations
@@ -45,7 +46,8 @@ WHY = {
     "unreachable": "normals pointing down: the ball cannot reach it from +Z",
     "collision": "the shank or another face is in the way",
     "too tight": "concave tighter than the ball across the passes",
-    "parallel wall": "a wall within 5 deg of parallel to the guide planes",
+    "parallel wall": "a wall near parallel to the guide planes: the passes are too far "
+                     "apart on it",
     "too steep": "too steep for the pass direction",
     "missed": "passes stopped or failed there (see the passes' skipped records)",
 }
@@ -191,6 +193,10 @@ def _reasons(reason, left, samples, q, part, job, n) -> np.ndarray:
         # every sample takes the verdict of the nearest probed one
         nearest = cKDTree(q[probe]).query(q[idx])[1]
         why[idx[hit[nearest]]] = "collision"
-    steep = np.abs(samples.normals[:, 2]) < math.sin(math.radians(STEEP_DEG))
-    why[open_ & (why == "missed") & steep] = "too steep"
+    nrm = samples.normals
+    facing_across = np.abs(nrm @ n) > np.abs(nrm @ np.cross(n, (0.0, 0.0, 1.0)))
+    steep = np.abs(nrm[:, 2]) < math.sin(math.radians(STEEP_DEG))
+    still = open_ & (why == "missed")
+    why[still & facing_across] = "parallel wall"
+    why[still & ~facing_across & steep] = "too steep"
     return why

@@ -1,7 +1,7 @@
 """Raster finishing inside a CadQuery script: runs under CQ-editor and as a plain script.
 
 A block whose two long top edges are rounded (r 4 mm): a 2 mm ball finishes the top and
-both rounds in zigzag passes across them, 1 mm apart. ``cadcnc.finish`` takes the
+both rounds in zigzag passes along them, 1 mm apart. ``cadcnc.finish`` takes the
 Workplane and a Workplane selection of its faces; ``cadcnc.to_cq`` turns the program
 into wires for ``show_object``. Run: ``python docs/examples/finish_example.py``.
 """
@@ -12,8 +12,7 @@ import cadcnc
 
 block = cq.Workplane("XY").box(30, 20, 10).edges("|X and >Z").fillet(4)
 
-program = cadcnc.finish(block, block.faces(">Z or %CYLINDER"), radius=2.0, stepover=1.0,
-                        angle=90)
+program = cadcnc.finish(block, block.faces(">Z or %CYLINDER"), radius=2.0, stepover=1.0)
 totals = program.totals()
 summary = (f"finish R 2: {totals['cuts']} cuts, {totals['cut_length_mm']:.1f} mm cut, "
            f"{totals['link_length_mm']:.1f} mm of links, {totals['time_at_feed_s']:.1f} s "
