@@ -21,8 +21,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
+
 from ..errors import CadcncError, InputError
-from ..geometry.clearance import guard_for
+from ..geometry.clearance import ClearanceGuard, guard_for
 from ..geometry.part import Part
 from ..job import Job, PairPath, Tool
 from ..program.linking import linked, order_cuts
@@ -98,8 +100,60 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
                                    None if corner.edge is None else corner.edge + 1))
         if progress is not None:
             progress(k, len(todo), f"faces {i} {j}")
-    ordered = order_cuts(cuts, CHAIN_GAP)
-    return Program(job, linked(ordered, safe_height(part, job), join=CHAIN_GAP), skipped)
+    z_safe = safe_height(part, job)
+    ordered, unreachable = reachable_order(part, job, cuts, z_safe)
+    return Program(job, linked(ordered, z_safe, join=CHAIN_GAP), skipped + unreachable)
+
+
+NOT_REACHABLE = "not reachable from +Z"
+
+
+def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float
+                    ) -> tuple[list[CutSegment], list[Skipped]]:
+    """The cuts the tool can reach from above, in linking order (:func:`order_cuts`), and
+    the others skipped as "not reachable from +Z". A chain is entered by a plunge straight
+    down to its first cut's start and left by a retract straight up from its last cut's
+    end (:func:`~cadcnc.program.linking.link`). Such a point is reachable when the ball
+    and a shank from it up to the link height ``z_safe`` (mm) clear the part by R' - 1 um
+    (:class:`ClearanceGuard`, the stepper's guard with a longer shank): not so in a sealed
+    void, or under an overhang higher than the shank. A cut whose entry or exit is
+    blocked is dropped and the rest ordered again (its neighbours may then need one)."""
+    lo, _ = part.bounding_box()
+    shank = max(z_safe - float(lo[2]), job.tool.shank)
+    guards: dict = {}
+    skipped: list[Skipped] = []
+
+    def blocked(cut: CutSegment, which: str, p) -> str | None:
+        faces = cut.path.faces
+        if faces not in guards:
+            guards[faces] = ClearanceGuard(part, faces, job.tool.offset, shank,
+                                           job.tolerances.hit)
+        margin, detail = guards[faces].margin(p)
+        return None if margin >= 0.0 else (
+            f"its {which} ({p[0]:.4f}, {p[1]:.4f}, {p[2]:.4f}): {detail} "
+            f"({-margin:.4g} mm too near) on the way to Z {z_safe:.3f}")
+
+    while True:
+        ordered = order_cuts(cuts, CHAIN_GAP)
+        bad = {}
+        for k, cut in enumerate(ordered):
+            why = []
+            if k == 0 or np.linalg.norm(cut.points[0] - ordered[k - 1].points[-1]) > CHAIN_GAP:
+                why.append(blocked(cut, "start", cut.points[0]))
+            if k == len(ordered) - 1 or np.linalg.norm(
+                    ordered[k + 1].points[0] - cut.points[-1]) > CHAIN_GAP:
+                why.append(blocked(cut, "end", cut.points[-1]))
+            why = [w for w in why if w]
+            if why:
+                bad[id(cut)] = why
+        if not bad:
+            return ordered, skipped
+        for cut in ordered:
+            if id(cut) in bad:
+                skipped.append(Skipped(cut.path.faces, NOT_REACHABLE, (
+                    f"cut of {cut.path.length:.3f} mm: " + "; ".join(bad[id(cut)])),
+                    cut.edge))
+        cuts = [c for c in ordered if id(c) not in bad]
 
 
 def _blend_cut(s1, s2, job: Job, corner, guard) -> CutSegment:

@@ -3,8 +3,8 @@
 A *feasible* ball position of a pair (i, j) is a centre touching both offset surfaces
 (Newton, :func:`~cadcnc.interp.tangency.solve_tangency`) whose feet lie on the trimmed
 faces (inside or on the boundary), where the faces are not tangent, where neither
-contact's concave curvature along the path is tighter than the ball (R' k < 1), and
-where the ball and its shank clear the rest of the part
+contact's concave curvature along the path is tighter than the ball (R' k <= 1, up to
+the spec's 1 um), and where the ball and its shank clear the rest of the part
 (:class:`~cadcnc.geometry.clearance.ClearanceGuard`). A *stretch* is a maximal
 connected piece of the offset intersection curve made of feasible positions.
 
@@ -178,8 +178,11 @@ class Feasibility:
         t = tuple(t / sin)
         for c, s in ((c1, self.s1), (c2, self.s2)):
             k = c.curvature(t)
-            if c.offset * k >= 1.0:
-                return CURVATURE, f"face {s.number}: R' k = {c.offset * k:.4g} >= 1"
+            # R' k = 1 is a tie: the ball fits the face exactly (a hole of its own radius)
+            # and does not cut it; past 1 + gouge / 2 R' it cuts the face deeper than the
+            # spec's 1 um (a cylinder of radius R'/(R'k) is cut by ~2 R'(R'k - 1))
+            if c.offset * k > 1.0 + self.tol.gouge / (2.0 * c.offset):
+                return CURVATURE, f"face {s.number}: R' k = {c.offset * k:.4g} > 1"
         if self.guard is not None:
             m, detail = self.guard.margin(tan.p)
             if m < 0.0:
