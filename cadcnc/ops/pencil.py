@@ -19,6 +19,7 @@ and so do blend corners (from the blend's first seed to its second) in this vers
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 
 import numpy as np
@@ -44,7 +45,7 @@ DEFAULT_PERIOD = 0.004    # s
 def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT_FEED,
            period: float = DEFAULT_PERIOD, faces=None, clearance: float | None = None,
            shank_length: float | None = None, side: str = CLIMB,
-           tol: Tolerances = DEFAULT, progress=None) -> Program:
+           tol: Tolerances = DEFAULT, progress=None, times: dict | None = None) -> Program:
     """The pencil program of ``part`` (a :class:`~cadcnc.geometry.part.Part`, or a CadQuery
     Workplane or Shape, read with :meth:`Part.from_cadquery`) for a ball of radius
     ``radius`` (mm) with ``allowance`` (mm): see the module doc.
@@ -53,7 +54,12 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
     among them); ``clearance``: ball-centre Z of the links (default the part's top + 10
     mm); ``side``: "climb" (default: the material on the right of the travel, for a
     clockwise spindle) or "conventional"; ``progress(done, total, what)`` after each corner.
+    ``times``: a dict to which the seconds spent per stage are added (``edges``: the
+    part's edge classification; ``corners``; ``guards``: building the third-face guards;
+    ``stretches``: the stretch search; ``interpolation``: the stepper along every
+    stretch; ``linking``: reachability from +Z, ordering and links).
     """
+    clock = _Clock(times)
     if side not in (CLIMB, CONVENTIONAL):
         raise InputError(f"side must be {CLIMB!r} or {CONVENTIONAL!r}, got {side!r}")
     if not isinstance(part, Part):
@@ -61,7 +67,10 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
     tool = Tool(radius, allowance, shank_length)
     job = Job(tool, feed, period, PairPath(edge=None), source=part.source,
               clearance=clearance, tolerances=tol)
-    corners = find_corners(part, radius, allowance, faces)
+    with clock("edges"):
+        part.adjacency
+    with clock("corners"):
+        corners = find_corners(part, radius, allowance, faces)
     cuts: list[CutSegment] = []
     skipped: list[Skipped] = [c.skipped() for c in corners if not c.cut]
     todo = [c for c in corners if c.cut]
@@ -71,24 +80,31 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
         cjob = replace(job, operation=PairPath(faces=(i, j), edge=corner.edge))
         try:
             s1, s2 = part.face(i), part.face(j)
-            guard = guard_for(part, (i, j), cjob)
+            with clock("guards"):
+                guard = guard_for(part, (i, j), cjob)
             if corner.kind == EDGE:
-                if (i, j) not in stretches:
-                    stretches[(i, j)] = pair_stretches(s1, s2, cjob, guard)
+                with clock("stretches"):
+                    if (i, j) not in stretches:
+                        stretches[(i, j)] = pair_stretches(s1, s2, cjob, guard)
                 found = [stretches[(i, j)][corner.edge]]
-                new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
+                with clock("interpolation"):
+                    new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
                 cuts += new
                 skipped += why
             elif corner.kind == BLEND and len(corner.rails) == 1:
                 # the ball's stretches anchored on planes normal to the blend's rail on a
-                found = [edge_stretches(Feasibility(s1, s2, cjob, guard), corner.rails[0], 0)]
-                new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
+                with clock("stretches"):
+                    found = [edge_stretches(Feasibility(s1, s2, cjob, guard),
+                                            corner.rails[0], 0)]
+                with clock("interpolation"):
+                    new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
                 cuts += new
                 skipped += [replace(w, detail=f"blend corner over face(s) "
                                     f"{', '.join(map(str, corner.blend_faces))}: {w.detail}")
                             for w in why]
             elif corner.kind == BLEND:
-                cut = _blend_cut(s1, s2, cjob, corner, guard)
+                with clock("interpolation"):
+                    cut = _blend_cut(s1, s2, cjob, corner, guard)
                 if len(cut.points) < 2:
                     skipped.append(Skipped((i, j), cut.path.stop_reason, (
                         f"blend corner over face(s) {', '.join(map(str, corner.blend_faces))}"
@@ -100,9 +116,33 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
                                    None if corner.edge is None else corner.edge + 1))
         if progress is not None:
             progress(k, len(todo), f"faces {i} {j}")
-    z_safe = safe_height(part, job)
-    ordered, unreachable = reachable_order(part, job, cuts, z_safe)
-    return Program(job, linked(ordered, z_safe, join=CHAIN_GAP), skipped + unreachable)
+    with clock("linking"):
+        z_safe = safe_height(part, job)
+        ordered, unreachable = reachable_order(part, job, cuts, z_safe)
+        segments = linked(ordered, z_safe, join=CHAIN_GAP)
+    return Program(job, segments, skipped + unreachable)
+
+
+class _Clock:
+    """``with clock(stage):`` adds the block's wall seconds to ``times[stage]`` (no-op
+    without a dict)."""
+
+    def __init__(self, times: dict | None):
+        self.times = times
+        self.stage = ""
+        self.t0 = 0.0
+
+    def __call__(self, stage: str) -> "_Clock":
+        self.stage = stage
+        return self
+
+    def __enter__(self) -> None:
+        self.t0 = time.perf_counter()
+
+    def __exit__(self, *exc) -> None:
+        if self.times is not None:
+            self.times[self.stage] = self.times.get(self.stage, 0.0) + (
+                time.perf_counter() - self.t0)
 
 
 NOT_REACHABLE = "not reachable from +Z"
