@@ -187,7 +187,7 @@ def table(records: list[dict], notes: list[dict]) -> str:
     """The per-part and total figures as a Markdown table, then refusals by reason."""
     rows = ["| part | R mm | pairs | covered / feasible | % | missed stretches | unreachable "
             "from +Z: covered / all | ball only: covered / feasible | % | paths written | "
-            "silent-bad | crashes |", "|" + "---|" * 12]
+            "silent-bad | crashes | refused runs by reason |", "|" + "---|" * 13]
     reasons = collections.defaultdict(collections.Counter)
     groups = collections.defaultdict(list)
     for r in records:
@@ -211,7 +211,7 @@ def table(records: list[dict], notes: list[dict]) -> str:
         missed = sum(len(r.get("missed", [])) for r in rs)
         rows.append(f"| {part} | {radius} | {len(rs)} | {c} / {f} | {pct(c, f)} | {missed} "
                     f"| {cu} / {u} | {cb} / {fb} | {pct(cb, fb)} | {written} / {len(runs)} "
-                    f"| {bad} | {crashes} |")
+                    f"| {bad} | {crashes} | {_refusals(runs)} |")
     rows.append("")
     for radius, counts in sorted(reasons.items()):
         rows.append(f"R {radius}: runs not written, by reason: "
@@ -225,10 +225,26 @@ def table(records: list[dict], notes: list[dict]) -> str:
     return "\n".join(rows)
 
 
-def print_table(path: str) -> int:
-    """The table of an earlier run's records, refusal reasons re-read from the messages."""
-    with open(path) as fh:
-        data = json.load(fh)
+SHORT = {"no feasible position (stretch finder)": "no feasible position",
+         "ball cuts the part (gouge gate)": "gate"}
+
+
+def _refusals(runs: list[dict]) -> str:
+    """Runs not written, by reason (short names), e.g. "no feasible position 3, gate 1"."""
+    counts = collections.Counter(SHORT.get(r["outcome"], r["outcome"]) for r in runs
+                                 if r["outcome"] != "written")
+    return ", ".join(f"{k} {v}" for k, v in counts.most_common()) or "-"
+
+
+def print_table(paths: list[str]) -> int:
+    """The table of earlier runs' records (several --json files are merged), refusal
+    reasons re-read from the messages."""
+    data = {"records": [], "notes": []}
+    for path in paths:
+        with open(path) as fh:
+            one = json.load(fh)
+        data["records"] += one["records"]
+        data["notes"] += one["notes"]
     for rec in data["records"]:
         for run in rec.get("runs", []):
             if run["outcome"] not in ("written", "crash", "timeout"):
@@ -258,8 +274,9 @@ def main(argv=None) -> int:
                     help="cli: `cadcnc path`; api: the program pipeline (program_for_job, "
                     "gate per cut) through benchmarks/coverage_run_pair.py")
     ap.add_argument("--json", help="write per-pair records here")
-    ap.add_argument("--table", metavar="JSON", help="print the table of an earlier --json "
-                    "file instead of running (refusals re-read with today's reasons)")
+    ap.add_argument("--table", metavar="JSON", nargs="+", help="print the table of earlier "
+                    "--json files (merged) instead of running (refusals re-read with today's "
+                    "reasons)")
     args = ap.parse_args(argv)
     if args.table:
         return print_table(args.table)
