@@ -308,6 +308,7 @@ class Oracle:
     def judge(self, e: Edge, t: float, offset: float, shank: float) -> dict:
         """The verdict at edge parameter t: {"verdict", "face", "p"} (see the module doc)."""
         p, feet = self.centre(e, t, offset)
+        p = np.asarray(p, dtype=float)
         out = {"p": [float(x) for x in p], "face": 0}
         if feet is None:
             return {**out, "verdict": "no_tangency"}
@@ -326,8 +327,9 @@ class Oracle:
         if dist < offset - TOL:
             return {**out, "verdict": "ball", "face": n}
         above = float(self.boxes[:, 5].max()) + offset + 1.0 - p[2]
-        if above > shank:
-            dist, n = self.shank_clearance(p, above, offset)
+        if above > shank:  # the rest of the way up (p .. p + L z is clear)
+            dist, n = self.shank_clearance(p + np.array([0.0, 0.0, shank]), above - shank,
+                                           offset)
             if dist < offset - TOL:
                 return {**out, "verdict": "unreachable", "face": n}
         return {**out, "verdict": "feasible"}
