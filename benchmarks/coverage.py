@@ -33,7 +33,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from coverage_oracle import TOL, Oracle, read_shape  # noqa: E402
-from coverage_judge import covered, judge_pair, missed_runs  # noqa: E402
+from coverage_judge import covered, judge_pair_cached, missed_runs  # noqa: E402
 from coverage_paths import classify, run_faces, run_path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -92,7 +92,7 @@ def run_pair(task: dict) -> dict:
     try:
         o = oracle_for(step)
         offset = radius
-        judged = judge_pair(o, faces, radius, task["max_samples"])
+        judged = judge_pair_cached(step, o, faces, radius, task["max_samples"])
         feasible = [p for e in judged["edges"] for p in e["feasible"]]
         ball = [p for e in judged["edges"] for p in e["ball"]]
         unreachable = [p for e in judged["edges"] for p in e["unreachable"]]

@@ -13,12 +13,45 @@ Lengths mm.
 from __future__ import annotations
 
 import collections
+import json
+import os
+from pathlib import Path
 
 import numpy as np
 
 from coverage_paths import distance_to_polylines
 
 COVERED = 5e-3  # mm: a feasible position within this of a cut polyline is covered
+CACHE_ENV = "COVERAGE_JUDGE_CACHE"
+"""A folder named by this environment variable keeps each pair's verdicts (one JSON file
+per part, radius, pair and cap), so that coverage.py and pencil_coverage.py judge a part
+once. The key holds the file's size and mtime and VERSION."""
+VERSION = 2  # of the judge's verdicts (2: `unreachable`)
+
+
+def _cache_file(step: str, faces, radius: float, cap) -> Path | None:
+    folder = os.environ.get(CACHE_ENV)
+    if not folder:
+        return None
+    st = os.stat(step)
+    name = (f"{Path(step).name}-{st.st_size}-{int(st.st_mtime)}-R{radius:g}-{faces[0]}-"
+            f"{faces[1]}-cap{cap}-v{VERSION}.json")
+    return Path(folder) / name
+
+
+def judge_pair_cached(step: str, o, faces: tuple[int, int], radius: float,
+                      cap: int | None = None) -> dict:
+    """:func:`judge_pair`, read from or written to the cache folder when one is set."""
+    path = _cache_file(step, faces, radius, cap)
+    if path is not None and path.exists():
+        return json.loads(path.read_text())
+    out = judge_pair(o, faces, radius, cap)
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(out))
+        os.replace(tmp, path)
+    return out
 
 
 def judge_pair(o, faces: tuple[int, int], radius: float, cap: int | None = None) -> dict:

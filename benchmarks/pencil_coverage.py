@@ -33,7 +33,7 @@ from pathlib import Path
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from coverage import judge_path, oracle_for, pairs_of  # noqa: E402
-from coverage_judge import covered, judge_pair, missed_runs  # noqa: E402
+from coverage_judge import covered, judge_pair_cached, missed_runs  # noqa: E402
 from coverage_paths import cadcnc_command, classify  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -59,8 +59,8 @@ def run_pencil(step: str, radius: float, timeout: float, tmp: str) -> dict:
         with open(out) as fh:
             data = json.load(fh)
     lines = [x for x in stderr.strip().splitlines() if "pencil: corner " not in x]
-    return {"code": code, "outcome": classify(code, stderr), "message": " ".join(lines[-1:])[:3000],
-            "summary": stdout.strip(), "seconds": round(seconds, 1), "program": data}
+    return {"code": code, "outcome": classify(code, stderr),
+            "message": " ".join(lines[-1:])[:3000], "summary": stdout.strip(), "seconds": round(seconds, 1), "program": data}
 
 
 def measure(step: Path, radius: float, args) -> dict:
@@ -70,7 +70,8 @@ def measure(step: Path, radius: float, args) -> dict:
     pairs, problem = pairs_of(str(step))
     rec["pairs"], rec["problem"] = len(pairs), problem
     o = oracle_for(str(step)) if pairs else None
-    edges = [e for faces in pairs for e in judge_pair(o, faces, radius)["edges"]]
+    edges = [e for faces in pairs
+             for e in judge_pair_cached(str(step), o, faces, radius)["edges"]]
     rec["judge_seconds"] = round(time.perf_counter() - t0, 1)
     with tempfile.TemporaryDirectory(prefix="cadcnc-pencil-cov-") as tmp:
         run = run_pencil(str(step), radius, args.timeout, tmp)

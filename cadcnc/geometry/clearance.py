@@ -32,6 +32,7 @@ or near 0), otherwise a positive lower bound.
 from __future__ import annotations
 
 import math
+import weakref
 
 import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
@@ -68,12 +69,7 @@ class ClearanceGuard:
         self.tol = float(tol)
         self.threshold = self.offset - self.tol   # mm: nearer than this is a hit
         self.reach = max(self.offset, 1.0) if reach is None else float(reach)
-        n = len(part)
-        self._faces = [part.face(k) for k in range(1, n + 1)]
-        self._analytic = [AnalyticFace(f) for f in self._faces]   # closed forms, or kind None
-        boxes = [optimal_box(f.topods, use_triangulation=False) for f in self._faces]
-        self._lo = np.array([b[0] for b in boxes]) - BOX_SLACK     # (n, 3)
-        self._hi = np.array([b[1] for b in boxes]) + BOX_SLACK     # (n, 3)
+        self._faces, self._analytic, self._lo, self._hi = _part_data(part)
         self._own_shapes = TopTools_IndexedMapOfShape()   # edges and vertices of i and j
         for k in self.pair:
             for kind in (TopAbs_EDGE, TopAbs_VERTEX):
@@ -239,6 +235,24 @@ class ClearanceGuard:
         face = self._faces[k - 1].topods
         ext = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(), face)
         return ext.Value() if ext.IsDone() and ext.NbSolution() else -math.inf
+
+
+_PART_DATA: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _part_data(part) -> tuple:
+    """(faces, closed forms, box lows (n, 3), box highs (n, 3)) of every face of a part,
+    computed once per part and shared by its guards (the optimal boxes of a 438-face part
+    took ~1.6 s per guard, and pencil builds one per corner)."""
+    data = _PART_DATA.get(part)
+    if data is None:
+        faces = [part.face(k) for k in range(1, len(part) + 1)]
+        analytic = [AnalyticFace(f) for f in faces]   # closed forms, or kind None
+        boxes = [optimal_box(f.topods, use_triangulation=False) for f in faces]
+        data = (faces, analytic, np.array([b[0] for b in boxes]).reshape(-1, 3) - BOX_SLACK,
+                np.array([b[1] for b in boxes]).reshape(-1, 3) + BOX_SLACK)
+        _PART_DATA[part] = data
+    return data
 
 
 def _needs_own_rule(face) -> bool:

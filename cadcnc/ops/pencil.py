@@ -75,13 +75,15 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
     skipped: list[Skipped] = [c.skipped() for c in corners if not c.cut]
     todo = [c for c in corners if c.cut]
     stretches: dict = {}
+    guards: dict = {}
     for k, corner in enumerate(todo, 1):
         i, j = corner.faces
         cjob = replace(job, operation=PairPath(faces=(i, j), edge=corner.edge))
         try:
             s1, s2 = part.face(i), part.face(j)
-            with clock("guards"):
-                guard = guard_for(part, (i, j), cjob)
+            with clock("guards"):   # one per pair (its cache serves all its corners)
+                guard = guards.get((i, j)) or guards.setdefault(
+                    (i, j), guard_for(part, (i, j), cjob))
             if corner.kind == EDGE:
                 with clock("stretches"):
                     if (i, j) not in stretches:
