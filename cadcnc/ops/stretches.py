@@ -39,6 +39,7 @@ from ..interp.cycle import Contact
 from ..interp.stepper import Tangency
 from ..interp.tangency import solve_tangency
 from ..job import Job
+from ..tolerances import Tolerances
 
 SPACING = 0.4       # mm of edge between samples (refined to MAX_CHORD of centres)
 MIN_SAMPLES = 9     # per edge
@@ -178,16 +179,21 @@ class Feasibility:
         t = tuple(t / sin)
         for c, s in ((c1, self.s1), (c2, self.s2)):
             k = c.curvature(t)
-            # R' k = 1 is a tie: the ball fits the face exactly (a hole of its own radius)
-            # and does not cut it; past 1 + gouge / 2 R' it cuts the face deeper than the
-            # spec's 1 um (a cylinder of radius R'/(R'k) is cut by ~2 R'(R'k - 1))
-            if c.offset * k > 1.0 + self.tol.gouge / (2.0 * c.offset):
+            if too_tight(c.offset * k, c.offset, self.tol):
                 return CURVATURE, f"face {s.number}: R' k = {c.offset * k:.4g} > 1"
         if self.guard is not None:
             m, detail = self.guard.margin(tan.p)
             if m < 0.0:
                 return COLLISION, f"{detail} ({-m:.4g} mm too near)"
         return FEASIBLE, ""
+
+
+def too_tight(rk: float, offset: float, tol: Tolerances) -> bool:
+    """Whether a concave curvature k with R' k = ``rk`` is tighter than a ball of offset
+    R' (mm) can follow. R' k = 1 is a tie: the ball fits the face exactly (a hole of its
+    own radius) and does not cut it; past 1 + gouge / 2 R' it cuts the face deeper than
+    the spec's 1 um (a cylinder of radius R'/(R' k) is cut by ~2 R' (R' k - 1))."""
+    return rk > 1.0 + tol.gouge / (2.0 * offset)
 
 
 def _project(surface, point) -> tuple[float, float]:
