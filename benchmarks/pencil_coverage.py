@@ -34,7 +34,7 @@ from pathlib import Path
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from coverage import judge_path, oracle_for, pairs_of  # noqa: E402
 from coverage_judge import covered, judge_pair_cached, missed_runs  # noqa: E402
-from coverage_paths import cadcnc_command, classify  # noqa: E402
+from coverage_paths import cadcnc_command, classify, distance_to_polylines  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -54,13 +54,39 @@ def run_pencil(step: str, radius: float, timeout: float, tmp: str) -> dict:
     except subprocess.TimeoutExpired:
         code, stdout, stderr = None, "", f"timeout after {timeout} s"
     seconds = time.perf_counter() - t0
-    data = None
+    data, rs = None, None
     if code == 0 and os.path.exists(out):
         with open(out) as fh:
             data = json.load(fh)
+        rs = rs274_check(os.path.join(tmp, "P.ngc"), data)
     lines = [x for x in stderr.strip().splitlines() if "pencil: corner " not in x]
     return {"code": code, "outcome": classify(code, stderr),
-            "message": " ".join(lines[-1:])[:3000], "summary": stdout.strip(), "seconds": round(seconds, 1), "program": data}
+            "message": " ".join(lines[-1:])[:3000], "summary": stdout.strip(),
+            "seconds": round(seconds, 1), "program": data, "rs274": rs}
+
+
+MOVE_RE = re.compile(r"STRAIGHT_(?:FEED|TRAVERSE)\(([^)]*)\)")
+
+
+def rs274_check(ngc: str, program: dict) -> dict:
+    """LinuxCNC's rs274 on the G-code: its exit code, the STRAIGHT_FEED / TRAVERSE points
+    it reads (the first, the machine's home, left out) and their largest distance (mm)
+    to the program's moves (every segment's points in order, as one polyline)."""
+    canon = ngc + ".canon"
+    try:
+        proc = subprocess.run(["rs274", "-g", ngc, canon], capture_output=True, text=True,
+                              timeout=600)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        return {"error": f"{type(exc).__name__}: {exc}"}
+    if proc.returncode != 0 or not os.path.exists(canon):
+        return {"code": proc.returncode, "error": proc.stderr[-300:]}
+    with open(canon) as fh:
+        got = np.array([[float(v) for v in m.group(1).split(",")[:3]]
+                        for m in MOVE_RE.finditer(fh.read())])[1:]
+    moves = np.vstack([np.asarray(s["points"], float).reshape(-1, 3)
+                       for s in program["segments"]])
+    far = float(distance_to_polylines(got, [moves]).max()) if len(got) else 0.0
+    return {"code": 0, "points": len(got), "max_mm": far}
 
 
 def measure(step: Path, radius: float, args) -> dict:
@@ -113,10 +139,20 @@ def times(summary: str) -> str:
     return m.group(1) if m else "-"
 
 
+def _rs(r: dict) -> str:
+    """rs274's reading: "ok (n points, max mm)" or what went wrong."""
+    rs = r["run"].get("rs274")
+    if not rs:
+        return "-"
+    if rs.get("code") != 0:
+        return f"failed: {rs.get('error', '')[:60]}"
+    return f"ok ({rs['points']} pts, {rs['max_mm']:.1e} mm)"
+
+
 def table(records: list[dict]) -> str:
     rows = ["| part | R mm | concave pairs | covered / feasible | % | missed stretches | "
             "unreachable from +Z | cuts | cut mm | link mm | skipped by reason | exit | "
-            "silent-bad | pencil s |", "|" + "---|" * 14]
+            "silent-bad | rs274 | pencil s |", "|" + "---|" * 15]
     for r in records:
         f, c = r["feasible"], r["covered"]
         s = r.get("summary", {})
@@ -127,11 +163,11 @@ def table(records: list[dict]) -> str:
             f"{s.get('link_length_mm', 0):.1f} | "
             f"{', '.join(f'{k} {v}' for k, v in sorted(r['skipped'].items())) or '-'} | "
             f"{r['run']['code']} | {r.get('check', {}).get('bad', '-')} | "
-            f"{r['run']['seconds']} |" if f else
+            f"{_rs(r)} | {r['run']['seconds']} |" if f else
             f"| {r['part']} | {r['radius']} | {r['pairs']} | 0 / 0 | - | 0 | "
             f"{r['unreachable']} | {s.get('cuts', '-')} | - | - | "
             f"{', '.join(f'{k} {v}' for k, v in sorted(r['skipped'].items())) or '-'} | "
-            f"{r['run']['code']} | - | {r['run']['seconds']} |")
+            f"{r['run']['code']} | - | {_rs(r)} | {r['run']['seconds']} |")
     rows.append("")
     for r in records:
         if r["run"]["code"] != 0:
