@@ -93,16 +93,19 @@ def measure(step: Path, radius: float, args) -> dict:
     """Judge every concave edge of ``step`` at R' = radius, run pencil, compare."""
     t0 = time.perf_counter()
     rec = {"part": step.name, "radius": radius}
+    with tempfile.TemporaryDirectory(prefix="cadcnc-pencil-cov-") as tmp:
+        run = run_pencil(str(step), radius, args.timeout, tmp)
+    prog = run.pop("program")
+    rec["run"] = run
+    print(f"pencil_coverage: {step.name} R {radius}: pencil exit {run['code']} in "
+          f"{run['seconds']} s; {times(run['summary'])}", file=sys.stderr, flush=True)
+    t1 = time.perf_counter()
     pairs, problem = pairs_of(str(step))
     rec["pairs"], rec["problem"] = len(pairs), problem
     o = oracle_for(str(step)) if pairs else None
     edges = [e for faces in pairs
              for e in judge_pair_cached(str(step), o, faces, radius)["edges"]]
-    rec["judge_seconds"] = round(time.perf_counter() - t0, 1)
-    with tempfile.TemporaryDirectory(prefix="cadcnc-pencil-cov-") as tmp:
-        run = run_pencil(str(step), radius, args.timeout, tmp)
-    prog = run.pop("program")
-    rec["run"] = run
+    rec["judge_seconds"] = round(time.perf_counter() - t1, 1)
     cuts = [s for s in (prog or {}).get("segments", []) if s.get("kind") == "cut"]
     lines = [np.asarray(s["points"], float).reshape(-1, 3) for s in cuts]
     rec["feasible"] = sum(len(e["feasible"]) for e in edges)
