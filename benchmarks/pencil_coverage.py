@@ -204,7 +204,14 @@ def main(argv=None) -> int:
                     "concave pairs per part, evenly spread in face order (default all; pencil "
                     "still cuts the whole part)")
     ap.add_argument("--json", help="write the records here")
+    ap.add_argument("--table", nargs="+", metavar="JSON", help="print the table of earlier "
+                    "--json files (merged) instead of running")
     args = ap.parse_args(argv)
+    if args.table:
+        records = [r for path in args.table for r in json.loads(Path(path).read_text())[
+            "records"]]
+        print(table(records))
+        return 0
     files = sorted((ROOT / "fixtures").glob("*.step")) if args.fixtures else []
     for p in map(Path, args.paths):
         files += sorted(x for x in p.iterdir() if x.suffix.lower() in (".step", ".stp")) \
