@@ -157,7 +157,8 @@ def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float
     down to its first cut's start and left by a retract straight up from its last cut's
     end (:func:`~cadcnc.program.linking.link`). Such a point is reachable when the ball
     and a shank from it up to the link height ``z_safe`` (mm) clear the part by R' - 1 um
-    (:class:`ClearanceGuard`, the stepper's guard with a longer shank): not so in a sealed
+    less the gate's tolerance (:class:`ClearanceGuard`, the stepper's guard with a longer
+    shank): not so in a sealed
     void, or under an overhang higher than the shank. A cut whose entry or exit is
     blocked is dropped and the rest ordered again (its neighbours may then need one)."""
     lo, _ = part.bounding_box()
@@ -171,7 +172,9 @@ def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float
             guards[faces] = ClearanceGuard(part, faces, job.tool.offset, shank,
                                            job.tolerances.hit)
         margin, detail = guards[faces].margin(p)
-        return None if margin >= 0.0 else (
+        # a cut's end landed on a collision sits at margin ~0 (-1e-8 mm is landing
+        # round-off): only a deeper hit blocks the way; the gate judges every move anyway
+        return None if margin >= -job.tolerances.gouge else (
             f"its {which} ({p[0]:.4f}, {p[1]:.4f}, {p[2]:.4f}): {detail} "
             f"({-margin:.4g} mm too near) on the way to Z {z_safe:.3f}")
 
