@@ -3,11 +3,16 @@
 Per fixture pair (ball 3 mm, f = 0.1 mm): per step (``Stepper.step`` from Python, record
 off; compiled and the plain-Python reference) against two bare OCCT D2 calls from Python
 with their .Coord() calls; per cycle with the loop compiled (``Stepper.run``); the whole
-path (``intersection_path``, planning included) against ``GeomAPI_IntSS`` of the two
-offset surfaces, with the trim-grid build separately; latency p50 / p99 / p99.9 / max over
-``--steps`` steps with GC off; a landing step against the median step; memory per cycle
+path (``intersection_path`` from faces with nothing cached: trim classifier, SurfaceData
+and trim grids built inside) against ``GeomAPI_IntSS`` of the two offset surfaces, best of
+15 interleaved runs each, CPU and wall time, with the trim-grid build separately; latency
+p50 / p99 / p99.9 / max over ``--steps`` steps with GC off, measured five ways
+(benchmarks/latency.py: raw, SCHED_FIFO pinned, kernel-only as the minimum of three
+lockstep replays, CPU time, and this machine's floor); a landing step against the median
+step; memory per cycle
 with the record on, and growth over ``--streamed`` cycles with it off. docs/performance.md
-records a run. Times are minima or percentiles of perf_counter_ns, in microseconds.
+records a run. Times are minima or percentiles of perf_counter_ns (wall) or thread_time_ns
+(CPU), in microseconds; the latency methods are latency.py's.
 
     .venv/bin/python benchmarks/bench_kernel.py [--steps 100000] [--streamed 1000000]
 """
@@ -16,25 +21,36 @@ from __future__ import annotations
 
 import argparse
 import gc
+import sys
 import time
 import tracemalloc
 from pathlib import Path
 
-import numpy as np
-from OCP.BRepAdaptor import BRepAdaptor_Surface
-from OCP.Geom import Geom_OffsetSurface
-from OCP.GeomAPI import GeomAPI_IntSS
-from OCP.gp import gp_Pnt, gp_Vec
+# numba probes for the `coverage` package at import: this folder's coverage.py must not
+# answer (it would break numba's import), so import numba with the folder off the path
+_HERE = Path(__file__).resolve().parent
+_PATH = list(sys.path)
+sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != _HERE]
+import numba  # noqa: E402,F401
+sys.path[:] = _PATH
 
-import cadcnc
-from cadcnc.interp.stepper import Stepper
-from cadcnc.ops.pair_path import pair_job, plan_path
+import numpy as np  # noqa: E402
+from OCP.BRepAdaptor import BRepAdaptor_Surface  # noqa: E402
+from OCP.Geom import Geom_OffsetSurface  # noqa: E402
+from OCP.GeomAPI import GeomAPI_IntSS  # noqa: E402
+from OCP.gp import gp_Pnt, gp_Vec  # noqa: E402
+
+import cadcnc  # noqa: E402
+from cadcnc.interp.stepper import Stepper  # noqa: E402
+from cadcnc.ops.pair_path import pair_job, plan_path  # noqa: E402
+from latency import latency, percentiles  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = [("bspline_boss", 4, 5), ("crossing_cylinders", 1, 2), ("sphere_cylinder", 1, 2),
          ("torus_cone", 1, 2)]
 R, FEED, PERIOD = 3.0, 1500.0, 0.004
 clock = time.perf_counter_ns
+cpu_clock = time.thread_time_ns
 
 
 def plan_of(name: str, i: int, j: int):
@@ -99,33 +115,48 @@ def bare_d2(plan, n: int = 20000) -> float:
     return best / 1000.0
 
 
-def int_ss(plan) -> float:
-    """Time (us) of GeomAPI_IntSS of the two offset surfaces (signed by face normal)."""
+def int_ss(surfaces) -> tuple[float, float]:
+    """(wall us, CPU us) of one GeomAPI_IntSS of the two surfaces at tolerance 1e-7
+    (OCCT's default precision)."""
+    t0, c0 = clock(), cpu_clock()
+    inter = GeomAPI_IntSS(surfaces[0], surfaces[1], 1e-7)
+    cpu, wall = cpu_clock() - c0, clock() - t0
+    assert inter.IsDone() and inter.NbLines() > 0
+    return wall / 1000.0, cpu / 1000.0
+
+
+def whole_path(part, i: int, j: int) -> dict:
+    """One intersection_path from faces with nothing cached (their trim classifier,
+    evaluator data and trim grids are rebuilt inside the timed call: planning includes
+    them): wall and CPU us, the grid builds' share (wall us), points."""
+    fa, fb = part.face(i), part.face(j)
+    for f in (fa, fb):
+        f._kernel = f._classifier = None
+    t0, c0 = clock(), cpu_clock()
+    tp = cadcnc.intersection_path(fa, fb, radius=R, feed=FEED, period=PERIOD)
+    cpu, wall = cpu_clock() - c0, clock() - t0
+    grids = sum(f.kernel[1].stats["build_s"] for f in (fa, fb)) * 1e9
+    return {"wall": wall / 1000.0, "cpu": cpu / 1000.0, "grids": grids / 1000.0,
+            "points": len(tp.points)}
+
+
+def path_vs_intss(part, i: int, j: int, plan, reps: int = 15) -> tuple[dict, dict]:
+    """Best of ``reps`` interleaved runs (each minimum on its own) of the whole path and of
+    GeomAPI_IntSS of the same two offset surfaces (each face's surface offset by its path
+    offset along the outward normal): ({wall, cpu, grids, points}, {wall, cpu})."""
     surfaces = [Geom_OffsetSurface(s.geom_surface, s.normal_sign * off)
                 for s, off in zip((plan.s1, plan.s2), plan.offsets)]
-    best = float("inf")
-    for _ in range(3):
-        t0 = clock()
-        inter = GeomAPI_IntSS(surfaces[0], surfaces[1], 1e-7)
-        best = min(best, clock() - t0)
-        assert inter.IsDone()
-    return best / 1000.0
-
-
-def whole_path(part, i: int, j: int) -> tuple[float, float, int]:
-    """(best time of intersection_path us, of which trim-grid builds us, points)."""
-    best, grids, points = float("inf"), 0.0, 0
-    for _ in range(3):
-        fa, fb = part.face(i), part.face(j)
-        for f in (fa, fb):
-            f._kernel = None   # rebuilt inside the timed call: planning includes it
-        t0 = clock()
-        tp = cadcnc.intersection_path(fa, fb, radius=R, feed=FEED, period=PERIOD)
-        t = clock() - t0
-        if t < best:
-            best, points = t, len(tp.points)
-            grids = sum(f.kernel[1].stats["build_s"] for f in (fa, fb)) * 1e9
-    return best / 1000.0, grids / 1000.0, points
+    whole_path(part, i, j)                                      # warm-up
+    path = {"wall": float("inf"), "cpu": float("inf")}
+    ss = {"wall": float("inf"), "cpu": float("inf")}
+    for _ in range(reps):
+        run = whole_path(part, i, j)
+        if run["cpu"] < path["cpu"]:
+            path.update(cpu=run["cpu"], grids=run["grids"], points=run["points"])
+        path["wall"] = min(path["wall"], run["wall"])
+        wall, cpu = int_ss(surfaces)
+        ss.update(wall=min(ss["wall"], wall), cpu=min(ss["cpu"], cpu))
+    return path, ss
 
 
 def loop_per_cycle(plan, job, cycles: int) -> float:
@@ -173,17 +204,8 @@ def memory(plan, job, cycles: int, streamed: int) -> tuple[float, float, int]:
     return per_cycle, growth, st.cycles
 
 
-def undisturbed(us: np.ndarray) -> tuple[np.ndarray, int]:
-    """The step times without the process's descheduling: each step over 1 ms (another
-    process ran) and the step after it (cold caches) dropped; (times, count dropped)."""
-    bad = np.flatnonzero(us > 1000.0)
-    drop = np.union1d(bad, bad + 1)
-    drop = drop[drop < len(us)]
-    return np.delete(us, drop), len(drop)
-
-
-def exact_calls(st, n: int) -> tuple[np.ndarray, int]:
-    """step_times(st, n) and how many exact trim classifications (FClass2d) it made."""
+def exact_calls(fn):
+    """(fn(), how many exact trim classifications (FClass2d) it made)."""
     from cadcnc.geometry.trim_grid import TrimGrid
     calls, classify = [0], TrimGrid.classify
 
@@ -193,15 +215,26 @@ def exact_calls(st, n: int) -> tuple[np.ndarray, int]:
 
     TrimGrid.classify = counted
     try:
-        return step_times(st, n), calls[0]
+        return fn(), calls[0]
     finally:
         TrimGrid.classify = classify
 
 
-def pct(us: np.ndarray) -> str:
-    p50, p99, p999 = np.percentile(us, [50, 99, 99.9])
-    return (f"p50 {p50:6.2f}  p99 {p99:6.2f}  p99.9 {p999:6.2f}  max {us.max():8.2f}  "
-            f"(p99.9 / p50 {p999 / p50:.2f})")
+METHODS = {"raw": "wall, normal scheduling", "fifo": "wall, SCHED_FIFO pinned",
+           "kernel": "min of 3 lockstep replays, fifo", "cpu": "thread CPU time",
+           "machine": "compiled busy loop of the same median, fifo"}
+
+
+def print_latency(res: dict, steps: int, exact: int) -> None:
+    print(f"  latency over {steps} steps, GC off ({exact} exact trim calls in a run):")
+    for key, what in METHODS.items():
+        us = res[key]
+        if us is None:
+            print(f"    {key:8s} ({what}): not permitted here")
+            continue
+        p50, p99, p999, top = percentiles(us)
+        print(f"    {key:8s} p50 {p50:6.2f}  p99 {p99:6.2f}  p99.9 {p999:7.2f}  max {top:9.1f} "
+              f"us  p99.9/p50 {p999 / p50:5.2f}  ({what})")
 
 
 def main() -> None:
@@ -214,10 +247,10 @@ def main() -> None:
         stepper(plan, job).run()                                   # warm-up (JIT load)
         d2 = bare_d2(plan)
         ref = step_times(stepper(plan, job, compiled=False), 2000)
-        fast, exact = exact_calls(stepper(plan, job, end=False), args.steps)
+        fast = step_times(stepper(plan, job, end=False), 20000)
         per_cycle = loop_per_cycle(plan, job, 200_000)
-        path_us, grid_us, points = whole_path(part, i, j)
-        ss = int_ss(plan)
+        path, ss = path_vs_intss(part, i, j, plan)
+        ss_wall, ss_cpu = ss["wall"], ss["cpu"]
         print(f"{name} faces {i},{j} (f = 0.1 mm)")
         print(f"  two bare OCCT D2 + .Coord() : {d2:6.2f} us (min)")
         print(f"  step, compiled (min / p50)  : {fast.min():6.2f} / {np.median(fast):6.2f} us"
@@ -225,12 +258,13 @@ def main() -> None:
         print(f"  step, reference (min / p50) : {ref.min():6.2f} / {np.median(ref):6.2f} us"
               f"  ({np.median(ref) / np.median(fast):.1f}x the compiled)")
         print(f"  cycle, loop compiled        : {per_cycle:6.3f} us")
-        print(f"  whole path ({points} points)  : {path_us / 1000:8.2f} ms (trim grids "
-              f"{grid_us / 1000:.2f} ms), GeomAPI_IntSS {ss / 1000:8.2f} ms: "
-              f"{ss / path_us:.1f}x faster")
-        print(f"  latency, {len(fast)} steps, GC off: {pct(fast)}; {exact} exact trim calls")
-        calm, dropped = undisturbed(fast)
-        print(f"  the same without descheduling ({dropped} steps dropped): {pct(calm)}")
+        print(f"  whole path ({path['points']} points): CPU {path['cpu'] / 1000:6.2f} ms (trim "
+              f"grids {path['grids'] / 1000:.2f} ms wall), wall {path['wall'] / 1000:6.2f} ms;"
+              f" GeomAPI_IntSS CPU {ss_cpu / 1000:6.2f} ms, wall {ss_wall / 1000:6.2f} ms: "
+              f"{ss_cpu / path['cpu']:.1f}x faster (CPU), {ss_wall / path['wall']:.1f}x (wall)")
+        _, exact = exact_calls(lambda: step_times(stepper(plan, job, end=False), args.steps))
+        res = latency(lambda: stepper(plan, job, end=False), args.steps)
+        print_latency(res, len(res["raw"]), exact)
         if name == CASES[0][0]:
             per, growth, n = memory(plan, job, 100_000, args.streamed)
             print(f"  memory: record on {per:.0f} B/cycle (traced, doubling chunks incl.); "

@@ -58,7 +58,7 @@ def kernel_loop():
     (grid args..., window (4,), u (n,), w (n,), out (n,))."""
     if numba is None:
         return None
-    one, into = numba.njit(lookup), numba.njit(wrap)
+    one, into = lookup, wrap  # compiled already (cadcnc.trim)
 
     @numba.njit
     def run(grid, fine, u0, w0, du, dw, nu, nw, window, us, ws, out):
@@ -134,7 +134,7 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("parts", nargs="+", type=Path)
     ap.add_argument("--points", type=int, default=10_000)
-    ap.add_argument("--max-cells", type=int, default=65536)
+    ap.add_argument("--max-cells", type=int, default=4096)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
     files = sorted(f for p in args.parts for f in (

@@ -31,7 +31,7 @@ _LAZY = {
     "Toolpath": "program.toolpath",
     "VerificationReport": "verification", "verify": "verification",
     "gouge_gate": "verification",
-    "pencil": "ops.pencil", "Program": "program.program",
+    "pencil": "ops.pencil", "finish": "ops.finish", "Program": "program.program",
     "to_cq": "io.program_cq", "to_cq_compound": "io.program_cq",
 }
 

@@ -1,8 +1,8 @@
 """What the user asked for: one typed, validated record per machining job.
 
 A :class:`Job` holds what every operation shares (the part's source, the tool, feed,
-period, clearance height, tolerances) and one operation record (today :class:`PairPath`,
-the path along the intersection of two faces; pencil and finishing add theirs). It is
+period, clearance height, tolerances) and one operation record (:class:`PairPath`, the
+path along the intersection of two faces; :class:`Finish`, raster finishing of faces). It is
 validated once, where it is built; everything downstream (the API, the toolpath, the
 APT-like programs, the CLI, the JSON writer and reader) reads its fields, never string
 keys. Units: lengths mm, feed mm/min, period s.
@@ -161,6 +161,66 @@ class PairPath:
         return tuple(tool.offset if o is None else o for o in self.offsets)
 
 
+FINISH_PATTERNS = ("zigzag", "oneway")
+
+
+@dataclass(frozen=True)
+class Finish:
+    """The ``finish`` operation: raster passes of the ball over the selected ``faces``
+    (1-based numbers), its centre on vertical guide planes at ``angle`` degrees to +X.
+
+    Exactly one of ``stepover`` (mm, the planes' fixed spacing) and ``scallop`` (mm, the
+    largest scallop height the adaptive spacing allows) is given; ``pattern`` "zigzag"
+    (every other pass reversed, staying down where the move is verified clear) or
+    "oneway" (every pass the same way, retracting between passes).
+    """
+
+    faces: tuple[int, ...]
+    stepover: float | None = None
+    scallop: float | None = None
+    angle: float = 0.0
+    pattern: str = "zigzag"
+
+    def __post_init__(self):
+        try:
+            faces = tuple(self.faces)
+        except TypeError:
+            raise InputError(f"faces must be face numbers, got {_show(self.faces)}") from None
+        if not faces:
+            raise InputError("finishing needs at least one face")
+        for n in faces:
+            if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 1:
+                raise InputError(f"face numbers are integers from 1, got {_show(n)}")
+        faces = tuple(dict.fromkeys(int(n) for n in faces))  # each face once, in order
+        object.__setattr__(self, "faces", faces)
+        if (self.stepover is None) == (self.scallop is None):
+            raise InputError("give exactly one of stepover (the planes' spacing, mm) and "
+                             "scallop (the largest scallop height, mm)"
+                             + ("" if self.stepover is None else
+                                f", got stepover {_show(self.stepover)} and scallop "
+                                f"{_show(self.scallop)}"))
+        if self.stepover is not None:
+            object.__setattr__(self, "stepover", check_number("stepover", self.stepover,
+                                                              "mm"))
+        if self.scallop is not None:
+            object.__setattr__(self, "scallop", check_number("scallop", self.scallop, "mm"))
+        a = self.angle
+        if isinstance(a, bool) or not isinstance(a, numbers.Real) or not math.isfinite(a):
+            raise InputError(f"angle must be a finite number of degrees, got {_show(a)}")
+        object.__setattr__(self, "angle", float(a))
+        if self.pattern not in FINISH_PATTERNS:
+            raise InputError(f"pattern must be one of {', '.join(FINISH_PATTERNS)}, got "
+                             f"{_show(self.pattern)}")
+
+    def resolved_offsets(self, tool: Tool) -> tuple[float, float]:
+        """(R', 0): the faces at the tool's offset, the guide plane carrying the centre."""
+        return (tool.offset, 0.0)
+
+    def to_inputs(self) -> dict:
+        return dict(operation="finish", faces=list(self.faces), stepover=self.stepover,
+                    scallop=self.scallop, angle=self.angle, pattern=self.pattern)
+
+
 @dataclass(frozen=True)
 class Job:
     """One machining job: tool, feed (mm/min), period (s), operation, part, tolerances.
@@ -174,7 +234,7 @@ class Job:
     tool: Tool
     feed: float
     period: float
-    operation: PairPath = field(default_factory=PairPath)
+    operation: PairPath | Finish = field(default_factory=PairPath)
     source: str | None = None
     clearance: float | None = None
     tolerances: Tolerances = DEFAULT
@@ -205,13 +265,15 @@ class Job:
     def to_inputs(self) -> dict:
         """The JSON ``inputs`` object (keys of format version 1, plus the newer ones)."""
         op = self.operation
-        return dict(radius=self.tool.radius, allowance=self.tool.allowance, feed=self.feed,
-                    period=self.period, start=None if op.start is None else list(op.start),
-                    end=None if op.end is None else list(op.end),
-                    offsets=list(self.offsets), edge=op.edge, stretch=op.stretch,
-                    source=self.source,
-                    shank_length=self.tool.shank_length, clearance=self.clearance,
-                    flip_material=self.flip_material)
+        common = dict(radius=self.tool.radius, allowance=self.tool.allowance,
+                      feed=self.feed, period=self.period, offsets=list(self.offsets),
+                      source=self.source, shank_length=self.tool.shank_length,
+                      clearance=self.clearance, flip_material=self.flip_material)
+        if isinstance(op, Finish):
+            return {**common, **op.to_inputs()}
+        return {**common, "start": None if op.start is None else list(op.start),
+                "end": None if op.end is None else list(op.end), "edge": op.edge,
+                "stretch": op.stretch}
 
     @classmethod
     def from_inputs(cls, inputs: dict, faces=(None, None)) -> "Job":
@@ -219,6 +281,12 @@ class Job:
         try:
             tool = Tool(inputs["radius"], inputs.get("allowance", 0.0),
                         inputs.get("shank_length"))
+            if inputs.get("operation") == "finish":
+                op = Finish(inputs["faces"], inputs.get("stepover"), inputs.get("scallop"),
+                            inputs.get("angle", 0.0), inputs.get("pattern", "zigzag"))
+                return cls(tool, inputs["feed"], inputs["period"], op, inputs.get("source"),
+                           inputs.get("clearance"),
+                           flip_material=bool(inputs.get("flip_material", False)))
             # offsets are recorded resolved: R' itself means "the tool's offset"
             offsets = tuple(None if o == tool.offset else o
                             for o in (inputs.get("offsets") or (None, None)))

@@ -124,8 +124,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plunge-feed", metavar="F",
                    help="feed of the links' plunge moves, mm/min (default: the feed)")
 
-    from . import pencil  # light: its command imports the library when run
+    from . import finish, pencil  # light: their commands import the library when run
     pencil.add_parser(add, _flip_option, _gouge_options, _gcode_options)
+    finish.add_parser(add, _flip_option, _gouge_options, _gcode_options)
 
     p = add("run", "execute an APT-like part program (PATH = P/[...])",
             "Execute an APT-like part program (grammar: docs/cli.md). Prints a summary per "
@@ -202,9 +203,11 @@ def main(argv: list[str] | None = None) -> int:
         with sigint_deferred():
             from . import commands
 
+            from .finish import finish_command
             from .pencil import pencil_command
 
-        run = pencil_command if args.command == "pencil" else commands.COMMANDS[args.command]
+        run = {"pencil": pencil_command, "finish": finish_command}.get(
+            args.command) or commands.COMMANDS[args.command]
         return int(run(args) or 0)
     except KeyboardInterrupt:
         print("cadcnc: interrupted", file=sys.stderr)

@@ -71,15 +71,9 @@ def program_csv(program) -> str:
 def pencil_command(args) -> int:
     import cadcnc
     from cadcnc.io.output_set import OutputSet
-    from cadcnc.io.program_gcode import program_ngc
-    from cadcnc.io.program_json import program_json
-    from cadcnc.io.program_plot import program_picture_bytes
-    from cadcnc.ops.pair_program import safe_height
     from cadcnc.ops.pencil import CHAIN_GAP, pencil
-    from cadcnc.verification.cut_back import cut_back
 
-    from .options import clearance, program_gcode_options, tolerances
-    from .program_commands import judge_program
+    from .options import clearance, tolerances
 
     outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])
     radius = parse_length(args.radius, "radius", allow_zero=False)
@@ -102,17 +96,38 @@ def pencil_command(args) -> int:
         raise InputError(f"{args.step}: no corner to cut with a {radius:g} mm ball "
                          f"({_skipped_line(program) or 'no concave corner found'})")
     title = f"pencil R {radius:g} of {Path(args.step).name}"
+
+    def summary(p) -> str:   # called once the program is gated: verification time known
+        times["verification"] = time.monotonic() - t0 - t_cut
+        return _summary(p, args.step, time.monotonic() - t0, t_cut, times)
+
+    return gate_and_write(args, program, part, outputs, "pencil", title, CHAIN_GAP, summary)
+
+
+def gate_and_write(args, program, part, outputs, what: str, title: str, join: float,
+                   summary) -> int:
+    """The end of an operation's command: cut gouging cuts back (unless --allow-gouge),
+    gate the whole program as written, print ``summary(program)``, write the outputs by
+    suffix; returns the exit code (0, 5 gouge, 6 partial)."""
+    from cadcnc.io.program_gcode import program_ngc
+    from cadcnc.io.program_json import program_json
+    from cadcnc.io.program_plot import program_picture_bytes
+    from cadcnc.ops.pair_program import safe_height
+    from cadcnc.verification.cut_back import cut_back
+
+    from .options import program_gcode_options
+    from .program_commands import judge_program
+
     gopts = program_gcode_options(args)
     if not args.allow_gouge:  # a gouging cut is cut back and listed, not the program lost
-        program = cut_back(program, part, safe_height(part, program.job), CHAIN_GAP)
+        program = cut_back(program, part, safe_height(part, program.job), join)
         if not program.cuts:
             raise InputError(f"{args.step}: every cut gouges the part: "
                              f"{_skipped_line(program)}")
     ngc = program_ngc(program, title=title, **gopts)
-    write, code = judge_program(args, program, part, "pencil", gopts)
-    times["verification"] = time.monotonic() - t0 - t_cut
+    write, code = judge_program(args, program, part, what, gopts)
     if not args.quiet:
-        print(_summary(program, args.step, time.monotonic() - t0, t_cut, times))
+        print(summary(program))
     if not write:
         return code
     contents = {}

@@ -23,3 +23,19 @@ def test_api_examples_run(monkeypatch):
     assert namespace["stepper"].stop_reason == "closed"
     assert len(sent) == namespace["stepper"].cycles
     assert os.path.exists(ROOT / "fixtures" / "bspline_boss.step")
+
+
+def test_finish_example_runs_as_script_and_under_cq_editor(capsys):
+    """docs/examples/finish_example.py: a Workplane and a selection of its faces in, a
+    complete program out, shown with show_object or summarised."""
+    import runpy
+
+    example = str(ROOT / "docs" / "examples" / "finish_example.py")
+    shown = {}
+    ns = runpy.run_path(example, init_globals={
+        "show_object": lambda obj, name="", options=None: shown.__setitem__(name, obj)})
+    prog = ns["program"]
+    assert set(shown) == {"part", "cuts", "links"} and prog.complete and prog.cuts
+    assert prog.job.operation.faces and len(prog.job.operation.faces) == 3  # top, 2 rounds
+    runpy.run_path(example, run_name="__main__")
+    assert "finish R 2:" in capsys.readouterr().out

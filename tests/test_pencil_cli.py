@@ -58,18 +58,24 @@ def test_outputs_agree(block_run):
     assert png.read_bytes()[:4] == b"\x89PNG"
 
 
-def test_rs274_reads_the_pencil_program(block_run, tmp_path):
+def rs274_moves(ngc, tmp_path) -> np.ndarray:
+    """(M, 3) the STRAIGHT_FEED and STRAIGHT_TRAVERSE end points rs274 reads in ``ngc``
+    (the first is the machine's home); skips the test without rs274."""
     from test_gcode import RS274
 
     if RS274 is None:
         pytest.skip("LinuxCNC rs274 not installed")
-    _, (js, ngc, _, _) = block_run
     canon = tmp_path / "canon.txt"
     run = subprocess.run([RS274, "-g", str(ngc), str(canon)], capture_output=True,
                          text=True, timeout=60)
     assert run.returncode == 0, run.stderr
-    got = np.array([[float(v) for v in m.group(1).split(",")[:3]] for m in re.finditer(
+    return np.array([[float(v) for v in m.group(1).split(",")[:3]] for m in re.finditer(
         r"STRAIGHT_(?:FEED|TRAVERSE)\(([^)]*)\)", canon.read_text())])
+
+
+def test_rs274_reads_the_pencil_program(block_run, tmp_path):
+    _, (js, ngc, _, _) = block_run
+    got = rs274_moves(ngc, tmp_path)
     want = commanded(read_program(js))
     np.testing.assert_allclose(got[1:], want, atol=1e-3)  # got[0]: the machine's home
 

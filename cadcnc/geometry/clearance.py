@@ -54,16 +54,19 @@ BOX_SLACK = 1e-4  # mm added to each face box: OCCT's optimal box is tight, not 
 class ClearanceGuard:
     """The clearance of ball + shank from a part, for the pair of faces ``pair``.
 
+    ``pair`` may also be one face (a 1-tuple: the face a finishing pass follows on a guide
+    plane); every other face of the part is then a third face.
+
     ``offset`` R' (mm), ``shank`` L (mm, 0 for a ball alone), ``tol`` (mm, the 1 µm of
     the spec: a face nearer than R' - tol is a hit). ``reach`` (mm) is the broad phase's
     radius: faces whose box is further than R' + reach from the tool are not looked at
     again until the centre has moved by ``reach``.
     """
 
-    def __init__(self, part, pair: tuple[int, int], offset: float, shank: float,
+    def __init__(self, part, pair: tuple[int, ...], offset: float, shank: float,
                  tol: float = 1e-6, reach: float | None = None):
         self.part = part
-        self.pair = (int(pair[0]), int(pair[1]))
+        self.pair = tuple(int(k) for k in pair)   # two faces, or one (a finishing pass)
         self.offset = float(offset)
         self.shank = float(shank)
         self.tol = float(tol)
@@ -307,7 +310,7 @@ def _dist(a, b) -> float:
     return math.sqrt((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 + (a[2] - b[2]) ** 2)
 
 
-def guard_for(part, pair: tuple[int, int], job, reach: float | None = None) -> ClearanceGuard:
+def guard_for(part, pair: tuple[int, ...], job, reach: float | None = None) -> ClearanceGuard:
     """The guard of a :class:`~cadcnc.job.Job` (its tool's R', shank length and the
     tolerance ``hit``) for faces ``pair`` of ``part``."""
     return ClearanceGuard(part, pair, job.tool.offset, job.tool.shank,

@@ -111,7 +111,7 @@ class FaceSurface:
         where the kernel cannot evaluate this face (OCCT's evaluation is used)."""
         if self._kernel is None:
             data = surface_data(self)
-            self._kernel = (data, TrimGrid.build(self)) if data is not None else ()
+            self._kernel = (data, TrimGrid.build(self, data=data)) if data is not None else ()
         return self._kernel or None
 
     # -- evaluation ---------------------------------------------------------------------

@@ -64,12 +64,14 @@ def pack(surfaces, grids) -> tuple[np.ndarray, np.ndarray]:
         ints.append(np.asarray(iarr, dtype=np.int64))
         ni += len(iarr)
         codes, fine, u0, w0, du, dw, nu, nw = grid.kernel_args
-        head[h + 13], head[h + 14], head[h + 15] = ni, nu, nw  # codes, then their sub-cells
-        ints += [codes.astype(np.int64).ravel(), fine.astype(np.int64)]
-        ni += nu * nw + len(fine)
+        head[h + 13], head[h + 14], head[h + 15] = ni, nu, nw  # the cell codes
+        ints.append(codes.astype(np.int64, copy=False).ravel())
+        ni += nu * nw
+        floats.append(np.asarray(fine, dtype=np.float64))  # MIXED cells' segments
         (umin, _), (wmin, _) = surface.u_range, surface.w_range
-        floats[0][h:h + 13] = (u0, w0, du, dw, *grid.window, umin, surface.u_period or 0.0,
-                               wmin, surface.w_period or 0.0, surface.normal_sign)
+        floats[0][h:h + 14] = (u0, w0, du, dw, *grid.window, umin, surface.u_period or 0.0,
+                               wmin, surface.w_period or 0.0, surface.normal_sign, nf)
+        nf += len(fine)
     return np.concatenate(floats), np.concatenate(ints)
 
 

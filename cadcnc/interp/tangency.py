@@ -7,29 +7,53 @@ a seed point P0 normal to the intersection direction t0 (1 equation). Kernel-fre
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import StartPointError
 from .stepper import Tangency
+from .vec3 import add, axpy, cross, dot, norm, scale, sub
 from ..tolerances import DEFAULT, Tolerances
 
 
 def offset_point_and_jacobian(surface, offset: float, u: float, w: float):
-    """o = r + offset n at (u, w) and its (3, 2) Jacobian d o / d(u, w); also n."""
-    r, ru, rw, ruu, ruw, rww = (np.array(v) for v in surface.derivative_tuples(u, w))
-    c = np.cross(ru, rw)
-    cn = np.linalg.norm(c)
+    """o = r + offset n at (u, w) and its Jacobian d o / d(u, w) as two columns (do/du,
+    do/dw); also n. All float 3-tuples (mm; vec3: no numpy on this path)."""
+    r, ru, rw, ruu, ruw, rww = surface.derivative_tuples(u, w)
+    c = cross(ru, rw)
+    cn = norm(c)
     if cn == 0.0:
         raise StartPointError(f"{surface!r}: singular point at (u={u:.6g}, w={w:.6g})")
-    chat = c / cn
+    chat = scale(c, 1.0 / cn)
     sign = surface.normal_sign
-    n = sign * chat
-    jac = np.empty((3, 2))
-    for col, (base, cd) in enumerate(((ru, np.cross(ruu, rw) + np.cross(ru, ruw)),
-                                      (rw, np.cross(ruw, rw) + np.cross(ru, rww)))):
-        dn = sign * (cd - chat * (chat @ cd)) / cn
-        jac[:, col] = base + offset * dn
-    return r + offset * n, jac, n
+    n = scale(chat, sign)
+    cols = []
+    for base, cd in ((ru, add(cross(ruu, rw), cross(ru, ruw))),
+                     (rw, add(cross(ruw, rw), cross(ru, rww)))):
+        dn = scale(axpy(-dot(chat, cd), chat, cd), sign / cn)
+        cols.append(axpy(offset, dn, base))
+    return axpy(offset, n, r), tuple(cols), n
+
+
+def _solve4(a: list[list[float]], b: list[float]) -> list[float]:
+    """x with a x = b (4 x 4, Gaussian elimination with partial pivoting); the least-squares
+    solution (numpy) where a is (nearly) singular."""
+    m = [row[:] + [v] for row, v in zip(a, b)]
+    size = max(abs(x) for row in a for x in row)
+    for k in range(4):
+        piv = max(range(k, 4), key=lambda i: abs(m[i][k]))
+        if abs(m[piv][k]) <= 1e-13 * size:
+            return np.linalg.lstsq(np.array(a), np.array(b), rcond=None)[0].tolist()
+        m[k], m[piv] = m[piv], m[k]
+        for i in range(k + 1, 4):
+            f = m[i][k] / m[k][k]
+            if f:
+                m[i] = [x - f * y for x, y in zip(m[i], m[k])]
+    x = [0.0] * 4
+    for k in range(3, -1, -1):
+        x[k] = (m[k][4] - sum(m[k][j] * x[j] for j in range(k + 1, 4))) / m[k][k]
+    return x
 
 
 def solve_tangency(s1, s2, offsets: tuple[float, float], seed_uv1, seed_uv2, anchor,
@@ -41,52 +65,55 @@ def solve_tangency(s1, s2, offsets: tuple[float, float], seed_uv1, seed_uv2, anc
     Converges to |o1 - o2| and the plane residual below ``tol.start`` (mm) or raises
     StartPointError naming ``what`` and the anchor.
     """
-    x = np.array([*seed_uv1, *seed_uv2], dtype=float)
-    anchor = np.asarray(anchor, dtype=float)
+    x = [float(v) for v in (*seed_uv1, *seed_uv2)]
+    anchor = tuple(float(v) for v in anchor)
+    label = tuple(np.round(anchor, 4))
 
     def residual(x):
         o1, j1, n1 = offset_point_and_jacobian(s1, offsets[0], x[0], x[1])
         o2, j2, n2 = offset_point_and_jacobian(s2, offsets[1], x[2], x[3])
         return o1, o2, j1, j2, n1, n2
 
+    def equations(o1, o2) -> list[float]:
+        mid = scale(add(o1, o2), 0.5)
+        return [*sub(o1, o2), dot(sub(mid, anchor), t0)]
+
     o1, o2, j1, j2, n1, n2 = residual(x)
-    t0 = np.cross(n1, n2) if direction is None else np.asarray(direction, dtype=float)
-    if np.linalg.norm(t0) < tol.tangent_sin:
-        raise StartPointError(f"{what}: the faces are tangent near {tuple(anchor.round(4))}: "
+    t0 = cross(n1, n2) if direction is None else tuple(float(v) for v in direction)
+    if norm(t0) < tol.tangent_sin:
+        raise StartPointError(f"{what}: the faces are tangent near {label}: "
                               "no intersection direction")
-    t0 = t0 / np.linalg.norm(t0)
-    err = np.inf
+    t0 = scale(t0, 1.0 / norm(t0))
+    err = math.inf
     for _ in range(max_iter):
-        F = np.concatenate([o1 - o2, [(0.5 * (o1 + o2) - anchor) @ t0]])
-        err = float(np.abs(F).max())
+        F = equations(o1, o2)
+        err = max(abs(v) for v in F)
         if err < tol.start:
-            p = 0.5 * (o1 + o2)
+            p = scale(add(o1, o2), 0.5)
             u1, w1 = s1.wrap(x[0], x[1])
             u2, w2 = s2.wrap(x[2], x[3])
-            return Tangency(tuple(map(float, p)), (float(u1), float(w1)), (float(u2), float(w2)))
-        J = np.zeros((4, 4))
-        J[:3, :2], J[:3, 2:] = j1, -j2
-        J[3, :2], J[3, 2:] = 0.5 * (t0 @ j1), 0.5 * (t0 @ j2)
+            return Tangency(p, (float(u1), float(w1)), (float(u2), float(w2)))
+        J = [[j1[0][i], j1[1][i], -j2[0][i], -j2[1][i]] for i in range(3)]
+        J.append([0.5 * dot(t0, j1[0]), 0.5 * dot(t0, j1[1]),
+                  0.5 * dot(t0, j2[0]), 0.5 * dot(t0, j2[1])])
         try:
-            dx = np.linalg.lstsq(J, -F, rcond=None)[0]
+            dx = _solve4(J, [-v for v in F])
         except np.linalg.LinAlgError as exc:
-            raise StartPointError(f"{what}: singular tangency system near "
-                                  f"{tuple(anchor.round(4))}") from exc
+            raise StartPointError(f"{what}: singular tangency system near {label}") from exc
         # damped step: halve until the residual decreases
         lam = 1.0
         for _ in range(30):
+            xt = [a + lam * d for a, d in zip(x, dx)]
             try:
-                trial = residual(x + lam * dx)
+                trial = residual(xt)
             except StartPointError:
                 lam *= 0.5
                 continue
-            Ft = np.concatenate([trial[0] - trial[1],
-                                 [(0.5 * (trial[0] + trial[1]) - anchor) @ t0]])
-            if np.abs(Ft).max() < err or lam < 1e-6:
+            if max(abs(v) for v in equations(trial[0], trial[1])) < err or lam < 1e-6:
                 break
             lam *= 0.5
-        x = x + lam * dx
+        x = [a + lam * d for a, d in zip(x, dx)]
         o1, o2, j1, j2, n1, n2 = trial
     raise StartPointError(
         f"{what}: no cutter position touching both surfaces found near "
-        f"{tuple(anchor.round(4))} (residual {err:.3g} mm after {max_iter} Newton steps)")
+        f"{label} (residual {err:.3g} mm after {max_iter} Newton steps)")

@@ -69,18 +69,21 @@ def retract(a: np.ndarray, z_safe: float) -> LinkSegment:
 
 
 def linked(cuts: list[CutSegment], z_safe: float, approach_mm: float = APPROACH,
-           join: float = 0.0) -> list:
+           join: float = 0.0, stay_down=None) -> list:
     """``cuts`` in order with an approach before the first, a link between each two, and a
     retract after the last: the segments of a program. Two cuts whose gap is at most
     ``join`` mm (a chain: the next starts where the last stopped, both located to within
-    their limits' accuracy) are joined by one straight feed move instead of a lift."""
+    their limits' accuracy) are joined by one straight feed move instead of a lift, and so
+    are two cuts for which ``stay_down(a, b)`` (the end of one and the start of the next,
+    (3,) mm) says that straight move is verified clear (a zigzag's pass ends)."""
     if not cuts:
         return []
     out: list = [approach(cuts[0].points[0], z_safe, approach_mm)]
     for k, cut in enumerate(cuts):
         a = cuts[k - 1].points[-1] if k else cut.points[0]
         gap = float(np.linalg.norm(cut.points[0] - a))
-        if JOINED < gap <= join:
+        if gap > JOINED and (gap <= join or (stay_down is not None
+                                             and stay_down(a, cut.points[0]))):
             out.append(LinkSegment(np.array([a, cut.points[0]]), np.array([False])))
         elif gap > JOINED:
             out.append(link(a, cut.points[0], z_safe, approach_mm))

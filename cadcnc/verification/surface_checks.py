@@ -34,13 +34,16 @@ def resolve_part(toolpath, part):
 
 def prepare(toolpath, part, tol: Tolerances):
     """(part, probes): the part (see :func:`resolve_part`) and an OCCT probe for each face
-    of the pair, by face number. InputError for an empty path or unnamed faces."""
+    of the pair, by face number. InputError for an empty path or unnamed faces. A guide
+    surface (offset 0, no face: a finishing pass on its plane) is not a face of the part
+    and has no probe."""
     if len(toolpath) == 0:
         raise InputError("verify: the toolpath has no points")
     part = resolve_part(toolpath, part)
-    if None in toolpath.faces:
+    named = [n for n, o in zip(toolpath.faces, toolpath.offsets) if n is not None or o != 0]
+    if None in named or not named:
         raise InputError("verify: the toolpath does not name its two faces")
-    return part, {n: FaceProbe(part.face(n).topods, tol) for n in toolpath.faces}
+    return part, {n: FaceProbe(part.face(n).topods, tol) for n in named}
 
 
 def check_pair(toolpath, probes: dict[int, FaceProbe], tol: Tolerances, n_unseeded: int,
@@ -48,6 +51,8 @@ def check_pair(toolpath, probes: dict[int, FaceProbe], tol: Tolerances, n_unseed
     """Both faces of the pair, each against its own offset."""
     out = []
     for side, n in enumerate(toolpath.faces):
+        if n is None:  # a guide surface: the centres lie on it by construction
+            continue
         if progress:
             progress("surfaces", side, 2)
         tick = None

@@ -92,6 +92,15 @@ def test_a_very_long_output_name_is_a_clear_error(tmp_path):
     one_line(run, 4, "file name too long")
 
 
+@pytest.fixture(scope="module")
+def boss_program(tmp_path_factory) -> str:
+    """The program JSON text ``cadcnc path`` writes for the boss's faces 4 5 (computed once:
+    the malformed-file tests each edit a copy)."""
+    saved = tmp_path_factory.mktemp("boss") / "p.json"
+    cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", saved, "--quiet", check=0)
+    return saved.read_text()
+
+
 def _cut(d: dict) -> dict:
     """The first cut segment of a program dict (version 2)."""
     return next(s for s in d["segments"] if s["kind"] == "cut")
@@ -107,11 +116,9 @@ def _cut(d: dict) -> dict:
     (lambda d: d["job"].update(radius="NaN"), "radius"),
     (lambda d: d["segments"][0]["points"][0].__setitem__(2, "NaN"), "non-finite"),
 ])
-def test_malformed_path_json_is_refused_quickly(tmp_path, edit, needle):
+def test_malformed_path_json_is_refused_quickly(tmp_path, boss_program, edit, needle):
     """Program JSON (version 2) with a bad cut, job or link is refused with the reason."""
-    saved = tmp_path / "p.json"
-    cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", saved, "--quiet", check=0)
-    data = json.loads(saved.read_text())
+    data = json.loads(boss_program)
     edit(data)
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps(data))

@@ -5,7 +5,7 @@ Mirrors ``Stepper.step`` of cadcnc/interp/stepper.py (the reference) on flat arr
 - ``F`` float64 / ``I`` int64: both surfaces packed by ``cadcnc.interp.compiled.pack``
   (evaluator arrays, trim grid, wrap); per surface s a header I[16 s : 16 s + 16]
   (kind, offsets and lengths into F / I) and F[16 s : 16 s + 16] (grid origin, cell
-  size, window, wrap ranges and periods, normal sign).
+  size, window, wrap ranges and periods, normal sign, offset of the grid's ``fine``).
 - ``S`` float64 (STATE_SIZE,): the state (centre, direction, contacts c1 c2, spares n1 n2,
   the kept landing trial, counters, tolerances) and scratch; offsets below.
 - ``R`` (capacity, 46): the record's rows (PathRecord layout), written at commit when
@@ -33,8 +33,8 @@ from . import trim_lookup
 from .trim_lookup import CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
-lookup = _jit(trim_lookup.lookup)
-wrap = _jit(trim_lookup.wrap)
+lookup = trim_lookup.lookup   # numba-compiled already (cadcnc.trim)
+wrap = trim_lookup.wrap
 
 # statuses
 DONE, TANGENT, CURVATURE, SINGULAR, DIVERGED, BOUNDARY, EVAL_FAIL, MOVE_UNDEFINED = range(8)
@@ -93,7 +93,7 @@ def trim_cell(F: np.ndarray, I: np.ndarray, s: int, u: float, w: float) -> int:
     g = I[h + 13]
     nu = I[h + 14]
     nw = I[h + 15]
-    return lookup(I[g:g + nu * nw].reshape((nu, nw)), I[g + nu * nw:], F[h], F[h + 1],
+    return lookup(I[g:g + nu * nw].reshape((nu, nw)), F[int(F[h + 13]):], F[h], F[h + 1],
                   F[h + 2], F[h + 3], nu, nw, wrap(u, F[h + 4], F[h + 5]),
                   wrap(w, F[h + 6], F[h + 7]))
 
