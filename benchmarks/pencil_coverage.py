@@ -25,6 +25,7 @@ import collections
 import json
 import os
 import re
+import resource
 import subprocess
 import sys
 import tempfile
@@ -41,6 +42,12 @@ import numpy as np  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def _children_cpu() -> float:
+    """User + system CPU seconds of this process's finished children."""
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
+
+
 def run_pencil(step: str, radius: float, timeout: float, tmp: str) -> dict:
     """One ``cadcnc pencil`` run writing P.json and P.ngc: exit code, outcome, message,
     stdout summary, seconds, and the program JSON (None when nothing was written)."""
@@ -48,12 +55,14 @@ def run_pencil(step: str, radius: float, timeout: float, tmp: str) -> dict:
     cmd = [*cadcnc_command(), "pencil", step, "--radius", repr(radius), "--feed", "1500",
            "--period", "4ms", "-o", out, "-o", os.path.join(tmp, "P.ngc")]
     t0 = time.perf_counter()
+    cpu0 = _children_cpu()
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
         code, stdout, stderr = proc.returncode, proc.stdout, proc.stderr
     except subprocess.TimeoutExpired:
         code, stdout, stderr = None, "", f"timeout after {timeout} s"
     seconds = time.perf_counter() - t0
+    cpu = _children_cpu() - cpu0
     data, rs = None, None
     if code == 0 and os.path.exists(out):
         with open(out) as fh:
@@ -62,7 +71,8 @@ def run_pencil(step: str, radius: float, timeout: float, tmp: str) -> dict:
     lines = [x for x in stderr.strip().splitlines() if "pencil: corner " not in x]
     return {"code": code, "outcome": classify(code, stderr),
             "message": " ".join(lines[-1:])[:3000], "summary": stdout.strip(),
-            "seconds": round(seconds, 1), "program": data, "rs274": rs}
+            "seconds": round(seconds, 1), "cpu_seconds": round(cpu, 1), "program": data,
+            "rs274": rs}
 
 
 MOVE_RE = re.compile(r"STRAIGHT_(?:FEED|TRAVERSE)\(([^)]*)\)")
@@ -98,7 +108,8 @@ def measure(step: Path, radius: float, args) -> dict:
     prog = run.pop("program")
     rec["run"] = run
     print(f"pencil_coverage: {step.name} R {radius}: pencil exit {run['code']} in "
-          f"{run['seconds']} s; {times(run['summary'])}", file=sys.stderr, flush=True)
+          f"{run['seconds']} s ({run['cpu_seconds']} s CPU); {times(run['summary'])}",
+          file=sys.stderr, flush=True)
     t1 = time.perf_counter()
     pairs, problem = pairs_of(str(step))
     rec["pairs"], rec["problem"] = len(pairs), problem
