@@ -64,13 +64,16 @@ class ClearanceGuard:
     """
 
     def __init__(self, part, pair: tuple[int, ...], offset: float, shank: float,
-                 tol: float = 1e-6, reach: float | None = None):
+                 tol: float = 1e-6, reach: float | None = None, own_tol: float = 1e-3):
         self.part = part
         self.pair = tuple(int(k) for k in pair)   # two faces, or one (a finishing pass)
         self.offset = float(offset)
         self.shank = float(shank)
         self.tol = float(tol)
         self.threshold = self.offset - self.tol   # mm: nearer than this is a hit
+        # the ball against its own faces' edges: the spec's 1 um (the path touches its own
+        # faces at R' up to its own error, so the third faces' 1 nm would fire on noise)
+        self.own_threshold = self.offset - float(own_tol)
         self.reach = max(self.offset, 1.0) if reach is None else float(reach)
         self._faces, self._analytic, self._lo, self._hi = _part_data(part)
         self._own_shapes = TopTools_IndexedMapOfShape()   # edges and vertices of i and j
@@ -211,14 +214,14 @@ class ClearanceGuard:
         return ext.Value(), own
 
     def _own_edge_margin(self, k: int, p) -> float:
-        """The ball's margin from the edges of own face k: the ball touches face k at R'
-        at its foot by construction, but near the face's boundary the nearest point of the
+        """The ball's margin (mm, against R' - own_tol) from the edges of own face k: the
+        ball touches face k at R' at its foot by construction, but near the face's boundary the nearest point of the
         trimmed face can be an edge nearer than the foot (a B-spline face curving towards
         the ball past a convex edge: bug32596_abc_0_13 faces 4/67 were cut 12 um deep
         there). Lipschitz-cached apart from the face's own bound (slope 1)."""
         p0, d0 = self._edge_bound.get(k, (None, None))
-        if p0 is not None and d0 - _dist(p, p0) - self.threshold >= 0.0:
-            return d0 - _dist(p, p0) - self.threshold
+        if p0 is not None and d0 - _dist(p, p0) - self.own_threshold >= 0.0:
+            return d0 - _dist(p, p0) - self.own_threshold
         if k not in self._own_edges:
             edges = TopTools_IndexedMapOfShape()
             TopExp.MapShapes_s(self._faces[k - 1].topods, TopAbs_EDGE, edges)
@@ -232,7 +235,7 @@ class ClearanceGuard:
                                          self._own_edges[k])
         d = ext.Value() if ext.IsDone() and ext.NbSolution() else -math.inf
         self._edge_bound[k] = (p, d)
-        return d - self.threshold
+        return d - self.own_threshold
 
     def _own_bound(self, k: int, p) -> float | None:
         """A lower bound of own face k's margin in closed form (a torus: the segment's
@@ -314,4 +317,4 @@ def guard_for(part, pair: tuple[int, ...], job, reach: float | None = None) -> C
     """The guard of a :class:`~cadcnc.job.Job` (its tool's R', shank length and the
     tolerance ``hit``) for faces ``pair`` of ``part``."""
     return ClearanceGuard(part, pair, job.tool.offset, job.tool.shank,
-                          job.tolerances.hit, reach)
+                          job.tolerances.hit, reach, job.tolerances.gouge)
