@@ -33,10 +33,10 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from coverage_oracle import TOL, Oracle, read_shape  # noqa: E402
-from coverage_paths import classify, distance_to_polylines, run_faces, run_path  # noqa: E402
+from coverage_judge import covered, judge_pair_cached, missed_runs  # noqa: E402
+from coverage_paths import classify, run_faces, run_path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-COVERED = 5e-3  # mm: a feasible position within this of a cut polyline is covered
 
 _ORACLES: dict[str, Oracle] = {}
 
@@ -91,20 +91,14 @@ def run_pair(task: dict) -> dict:
            "runs": [], "feasible": 0, "feasible_ball": 0, "covered": 0, "covered_ball": 0}
     try:
         o = oracle_for(step)
-        offset, shank = radius, 10.0 * radius
-        edges = [e for e in o.concave_edges() if e.faces == faces]
-        feasible, ball = [], []
-        for e in edges:
-            counts = collections.Counter()
-            for t in o.samples(e, task["max_samples"]):
-                v = o.judge(e, t, offset, shank)
-                counts[v["verdict"] if not v["face"] else f"{v['verdict']} {v['face']}"] += 1
-                if v["verdict"] in ("feasible", "ball"):
-                    ball.append(v["p"])
-                if v["verdict"] == "feasible":
-                    feasible.append(v["p"])
-            rec["edges"].append({"edge": e.index, "length_mm": round(e.length, 4),
-                                 "verdicts": dict(counts)})
+        offset = radius
+        judged = judge_pair_cached(step, o, faces, radius, task["max_samples"])
+        feasible = [p for e in judged["edges"] for p in e["feasible"]]
+        ball = [p for e in judged["edges"] for p in e["ball"]]
+        unreachable = [p for e in judged["edges"] for p in e["unreachable"]]
+        rec["edges"] = [{k: e[k] for k in ("edge", "length_mm", "verdicts")}
+                        for e in judged["edges"]]
+        edges = judged["edges"]
         via = task.get("via", "cli")
         runs = [run_path(step, faces, radius, task["feed"], task["period"], task["timeout"],
                          via=via)]
@@ -116,16 +110,13 @@ def run_pair(task: dict) -> dict:
         refused = polylines + [line for r in runs for line in r["refused_polylines"]]
         for name, pts, lines in (("covered", feasible, polylines),
                                  ("covered_ball", ball, polylines),
+                                 ("covered_unreachable", unreachable, polylines),
                                  ("covered_ungated", feasible, refused)):
-            if pts and lines:
-                d = distance_to_polylines(np.asarray(pts), lines)
-                rec[name] = int(np.count_nonzero(d <= COVERED))
-        if feasible:  # a few feasible positions left uncovered, for follow-up
-            d = (distance_to_polylines(np.asarray(feasible), polylines) if polylines
-                 else np.full(len(feasible), np.inf))
-            rec["uncovered"] = [[round(float(x), 6) for x in feasible[k]]
-                                for k in np.flatnonzero(d > COVERED)[::7][:6]]
+            rec[name] = int(np.count_nonzero(covered(pts, lines)))
+        rec["missed"] = [dict(run, edge=e["edge"]) for e in edges for run in missed_runs(
+            e["feasible"], e["index"], covered(e["feasible"], polylines))]
         rec["feasible"], rec["feasible_ball"] = len(feasible), len(ball)
+        rec["unreachable"] = len(unreachable)
         if polylines:
             rec["path_check"] = judge_path(o, faces, polylines, offset, task["check_points"])
         rec["runs"] = [{k: v for k, v in r.items() if k not in ("polylines", "refused_polylines")}
@@ -149,8 +140,9 @@ def tasks_for(args) -> tuple[list[dict], list[dict]]:
     if args.fixtures:
         files += sorted((ROOT / "fixtures").glob("*.step"))
     if args.parts:
-        files += sorted(p for p in Path(args.parts).iterdir()
-                        if p.suffix.lower() in (".step", ".stp"))
+        where = Path(args.parts)
+        files += [where] if where.is_file() else sorted(
+            p for p in where.iterdir() if p.suffix.lower() in (".step", ".stp"))
     tasks, notes = [], []
     for f in files:
         pairs, problem = pairs_of(str(f))
@@ -193,8 +185,9 @@ def program_notes(records: list[dict], radius: float) -> list[str]:
 
 def table(records: list[dict], notes: list[dict]) -> str:
     """The per-part and total figures as a Markdown table, then refusals by reason."""
-    rows = ["| part | R mm | pairs | covered / feasible | % | ball only: covered / feasible "
-            "| % | paths written | silent-bad | crashes |", "|" + "---|" * 10]
+    rows = ["| part | R mm | pairs | covered / feasible | % | missed stretches | unreachable "
+            "from +Z: covered / all | ball only: covered / feasible | % | paths written | "
+            "silent-bad | crashes | refused runs by reason |", "|" + "---|" * 13]
     reasons = collections.defaultdict(collections.Counter)
     groups = collections.defaultdict(list)
     for r in records:
@@ -214,8 +207,11 @@ def table(records: list[dict], notes: list[dict]) -> str:
         bad = sum(bool(r.get("path_check", {}).get("bad")) for r in rs)
         crashes = sum(run["outcome"] in ("crash", "timeout") for run in runs)
         pct = lambda a, b: f"{100.0 * a / b:.0f}" if b else "-"  # noqa: E731
-        rows.append(f"| {part} | {radius} | {len(rs)} | {c} / {f} | {pct(c, f)} | {cb} / {fb} "
-                    f"| {pct(cb, fb)} | {written} / {len(runs)} | {bad} | {crashes} |")
+        cu, u = (sum(r.get(k, 0) for r in rs) for k in ("covered_unreachable", "unreachable"))
+        missed = sum(len(r.get("missed", [])) for r in rs)
+        rows.append(f"| {part} | {radius} | {len(rs)} | {c} / {f} | {pct(c, f)} | {missed} "
+                    f"| {cu} / {u} | {cb} / {fb} | {pct(cb, fb)} | {written} / {len(runs)} "
+                    f"| {bad} | {crashes} | {_refusals(runs)} |")
     rows.append("")
     for radius, counts in sorted(reasons.items()):
         rows.append(f"R {radius}: runs not written, by reason: "
@@ -229,10 +225,26 @@ def table(records: list[dict], notes: list[dict]) -> str:
     return "\n".join(rows)
 
 
-def print_table(path: str) -> int:
-    """The table of an earlier run's records, refusal reasons re-read from the messages."""
-    with open(path) as fh:
-        data = json.load(fh)
+SHORT = {"no feasible position (stretch finder)": "no feasible position",
+         "ball cuts the part (gouge gate)": "gate"}
+
+
+def _refusals(runs: list[dict]) -> str:
+    """Runs not written, by reason (short names), e.g. "no feasible position 3, gate 1"."""
+    counts = collections.Counter(SHORT.get(r["outcome"], r["outcome"]) for r in runs
+                                 if r["outcome"] != "written")
+    return ", ".join(f"{k} {v}" for k, v in counts.most_common()) or "-"
+
+
+def print_table(paths: list[str]) -> int:
+    """The table of earlier runs' records (several --json files are merged), refusal
+    reasons re-read from the messages."""
+    data = {"records": [], "notes": []}
+    for path in paths:
+        with open(path) as fh:
+            one = json.load(fh)
+        data["records"] += one["records"]
+        data["notes"] += one["notes"]
     for rec in data["records"]:
         for run in rec.get("runs", []):
             if run["outcome"] not in ("written", "crash", "timeout"):
@@ -244,13 +256,15 @@ def print_table(path: str) -> int:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--fixtures", action="store_true", help="judge fixtures/*.step")
-    ap.add_argument("--parts", help="a folder of STEP parts to judge as well")
+    ap.add_argument("--parts", help="a folder of STEP parts (or one STEP file) to judge "
+                    "as well")
     ap.add_argument("--radius", type=float, action="append", help="ball radius, mm (repeatable)")
     ap.add_argument("--feed", type=float, default=1500.0, help="mm/min")
     ap.add_argument("--period", default="4ms")
     ap.add_argument("--timeout", type=float, default=120.0, help="per cadcnc run, s")
-    ap.add_argument("--max-samples", type=int, default=60, help="samples per edge at most "
-                    "(the 0.2 mm spacing is widened on longer edges)")
+    ap.add_argument("--max-samples", type=int, default=None, help="samples per edge at "
+                    "most (default none: every 0.2 mm; a cap widens the spacing on longer "
+                    "edges)")
     ap.add_argument("--max-pairs", type=int, default=None, help="pairs per part at most, "
                     "evenly spread (default all)")
     ap.add_argument("--check-points", type=int, default=100,
@@ -260,8 +274,9 @@ def main(argv=None) -> int:
                     help="cli: `cadcnc path`; api: the program pipeline (program_for_job, "
                     "gate per cut) through benchmarks/coverage_run_pair.py")
     ap.add_argument("--json", help="write per-pair records here")
-    ap.add_argument("--table", metavar="JSON", help="print the table of an earlier --json "
-                    "file instead of running (refusals re-read with today's reasons)")
+    ap.add_argument("--table", metavar="JSON", nargs="+", help="print the table of earlier "
+                    "--json files (merged) instead of running (refusals re-read with today's "
+                    "reasons)")
     args = ap.parse_args(argv)
     if args.table:
         return print_table(args.table)

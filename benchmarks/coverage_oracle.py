@@ -17,6 +17,12 @@ to both offset surfaces in the plane through the sample normal to the edge, and 
 Lengths in mm. Verdicts: ``feasible`` (all four rules), ``ball`` (the ball fits, the
 shank hits ``face``), or a reason: ``no_tangency``, ``off_face`` (face), ``nearer``
 (face), ``inside`` (the ball on the material side).
+
+One more verdict, beyond the four rules: ``unreachable`` (face), a position feasible by
+the spec's shank of length L whose shank, continued straight up to R' + 1 mm above the
+part's top, meets the part: a corner in a sealed void taller than L, or under an
+overhang higher than L. No plunge from above reaches it (issue 12: "not reachable from
++Z", left out of coverage); it is counted apart from ``feasible``.
 """
 
 from __future__ import annotations
@@ -220,10 +226,13 @@ class Oracle:
         theta = math.degrees(math.atan2(np.linalg.norm(np.cross(d1, d2)), d1 @ d2))
         return 360.0 - theta if d2 @ n1 > 0 else theta
 
-    def samples(self, e: Edge, cap: int) -> list[float]:
-        """Edge parameters every SPACING mm by arc length, ends included, >= MIN_SAMPLES."""
+    def samples(self, e: Edge, cap: int | None = None) -> list[float]:
+        """Edge parameters every SPACING mm by arc length, ends included, >= MIN_SAMPLES
+        (at most ``cap`` when given: the spacing is then widened on long edges)."""
         curve = BRepAdaptor_Curve(e.edge)
-        n = min(max(MIN_SAMPLES, int(math.ceil(e.length / SPACING)) + 1), max(cap, MIN_SAMPLES))
+        n = max(MIN_SAMPLES, int(math.ceil(e.length / SPACING)) + 1)
+        if cap is not None:
+            n = min(n, max(cap, MIN_SAMPLES))
         t0, t1 = curve.FirstParameter(), curve.LastParameter()
         ua = GCPnts_UniformAbscissa(curve, n, t0, t1, 1e-9)
         if ua.IsDone() and ua.NbPoints() == n:
@@ -299,6 +308,7 @@ class Oracle:
     def judge(self, e: Edge, t: float, offset: float, shank: float) -> dict:
         """The verdict at edge parameter t: {"verdict", "face", "p"} (see the module doc)."""
         p, feet = self.centre(e, t, offset)
+        p = np.asarray(p, dtype=float)
         out = {"p": [float(x) for x in p], "face": 0}
         if feet is None:
             return {**out, "verdict": "no_tangency"}
@@ -316,6 +326,12 @@ class Oracle:
         dist, n = self.shank_clearance(p, shank, offset)
         if dist < offset - TOL:
             return {**out, "verdict": "ball", "face": n}
+        above = float(self.boxes[:, 5].max()) + offset + 1.0 - p[2]
+        if above > shank:  # the rest of the way up (p .. p + L z is clear)
+            dist, n = self.shank_clearance(p + np.array([0.0, 0.0, shank]), above - shank,
+                                           offset)
+            if dist < offset - TOL:
+                return {**out, "verdict": "unreachable", "face": n}
         return {**out, "verdict": "feasible"}
 
     def clearance(self, p: np.ndarray, reach: float) -> tuple[float, int]:

@@ -31,12 +31,12 @@ from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
 from OCP.GCPnts import GCPnts_UniformAbscissa
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED
+from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopExp import TopExp_Explorer
-from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS
 from scipy.spatial import cKDTree
 
+from cadcnc.geometry.mesh import face_triangles
 from cadcnc.trim import INSIDE
 from cadcnc.verification.probe import FaceProbe
 
@@ -53,15 +53,7 @@ def tessellate(faces, tolerance: float, angular: float = ANGULAR) -> tuple[np.nd
         t0 = time.perf_counter()
         BRepMesh_IncrementalMesh(copy, tolerance, False, angular, False)
         seconds += time.perf_counter() - t0
-        loc = TopLoc_Location()
-        poly = BRep_Tool.Triangulation_s(copy, loc)
-        trsf = loc.Transformation()
-        nodes = np.array([poly.Node(i).Transformed(trsf).Coord()
-                          for i in range(1, poly.NbNodes() + 1)])
-        idx = np.array([poly.Triangle(i).Get() for i in range(1, poly.NbTriangles() + 1)]) - 1
-        if copy.Orientation() == TopAbs_REVERSED:
-            idx = idx[:, ::-1]
-        tris.append(nodes[idx])
+        tris.append(face_triangles(copy))
     return np.concatenate(tris), seconds
 
 

@@ -1,23 +1,25 @@
 """Guide-surface finishing against OpenCAMLib's drop-cutter (issue 13, docs/finishing_vs_ocl.md).
 
-The same faces, the same pass lines (vertical planes at ``--angle``, ``--stepover`` apart),
-the same point spacing (``--spacing``, cadcnc's step f = F Ts): cadcnc's ball centres
-against OCL's BatchDropCutter on OCCT tessellations of the faces at ``--tol`` (1e-2 and
-1e-3 mm), one OCL thread, in a subprocess (benchmarks/ocl_worker.py). Every ball centre's
-true deviation from the exact offset of the faces is measured with OCCT
-(benchmarks/finish_bench_tools.py): max, p50, p99 of |distance - R'|, gouge side and
-leave side, counted where the ball lies wholly over a face (its nearest point inside the
-face, the ball grown by ``--margin`` clear of the face's boundary). Time per point: OCL's
-with its tessellation (BRepMesh, building the STLSurf, appending the points, the run);
-cadcnc's with its planning (reading the part, planes, starts, trim grids, stepping) and
-without the verification gate, which is timed separately.
+The same faces, the same pass lines (cadcnc's planes: angle 0, stepover 1 mm), the same
+point spacing (cadcnc's step f = F Ts = 0.1 mm; OCL's points 0.1 mm apart along each
+line), ball R = 3 mm: cadcnc's ball centres against OCL's BatchDropCutter on OCCT
+tessellations of the faces at ``--tol`` (1e-2 and 1e-3 mm), one OCL thread, in a
+subprocess (benchmarks/ocl_worker.py). Every ball centre's true deviation from the exact
+offset of the faces is measured with OCCT (benchmarks/finish_bench_tools.py): max, p50,
+p99 of |distance - R'|, gouge side and leave side, and the worst chord midpoint, counted
+where the ball lies wholly over a face (its nearest point inside the face, the ball grown
+by 0.5 mm clear of the face's boundary). Time per point: OCL's with its tessellation
+(BRepMesh, building the STLSurf, appending the points, the run); cadcnc's with its
+planning (reading the part, planes, passes, links, uncut report) and without the gouge
+gate, which is timed separately; where cadcnc's time goes is timed inside it.
 
     python benchmarks/finish_vs_ocl.py [--slab] [--fixtures [NAME ...]] [--tol 1e-2 1e-3]
         [--json OUT] [--png docs/img/finish_vs_ocl.png]
 
 ``--slab`` (default when neither is given): the held-out-like free-form slab of
-benchmarks/freeform_slab.py, 80 x 60 mm, 60 passes. ``--fixtures``: every
-fixtures/finish_*.step named in fixtures/finish_fixtures.json, on its selected faces.
+benchmarks/freeform_slab.py, 80 x 60 mm, and its picture. ``--fixtures``: the
+fixtures/finish_*.step named in fixtures/finish_fixtures.json (all, or the NAMEs), on
+their selected faces. Needs ``pip install -e '.[bench]'`` (opencamlib).
 """
 
 from __future__ import annotations
@@ -76,7 +78,12 @@ class Stopwatch:
 
     WATCHED = [("cadcnc.ops.finish", "plan_for_job", "planning (planes, face sampling)"),
                ("cadcnc.ops.finish", "uncut_report", "uncut report"),
+               ("cadcnc.ops.finish_uncut", "_reasons",
+                "of which reasons (guard on samples)"),
                ("cadcnc.ops.finish", "linked", "linking (zigzag links verified)"),
+               ("cadcnc.geometry.move_clearance", "MoveClearance.distance",
+                "of which stay-down checks (OCCT)"),
+               ("cadcnc.ops.finish", "pass_cuts", "passes (stepping, guard, exact step)"),
                ("cadcnc.ops.finish_pass", "_Pass.exact", "points onto the exact offset"),
                ("cadcnc.geometry.clearance", "ClearanceGuard.margin",
                 "clearance guard (every face, ball and shank)"),

@@ -82,20 +82,26 @@ def pencil_command(args) -> int:
     tol = tolerances(args)
     t0 = time.monotonic()
     part = cadcnc.load_step(args.step, flip_material=args.flip_material)
+    times = {"load": time.monotonic() - t0}
     for n in args.faces or ():
         part.face(n)  # face numbers checked before anything is computed
     report = None if args.quiet else (
         lambda done, total, what: say_error(f"cadcnc: pencil: corner {done}/{total} ({what})"))
     program = pencil(part, radius=radius, allowance=allowance, feed=feed, period=period,
                      faces=None if args.faces is None else set(args.faces),
-                     clearance=clearance(args), side=args.side, tol=tol, progress=report)
+                     clearance=clearance(args), side=args.side, tol=tol, progress=report,
+                     times=times)
     t_cut = time.monotonic() - t0
     if not program.cuts:
         raise InputError(f"{args.step}: no corner to cut with a {radius:g} mm ball "
                          f"({_skipped_line(program) or 'no concave corner found'})")
     title = f"pencil R {radius:g} of {Path(args.step).name}"
-    return gate_and_write(args, program, part, outputs, "pencil", title, CHAIN_GAP,
-                          lambda p: _summary(p, args.step, time.monotonic() - t0, t_cut))
+
+    def summary(p) -> str:   # called once the program is gated: verification time known
+        times["verification"] = time.monotonic() - t0 - t_cut
+        return _summary(p, args.step, time.monotonic() - t0, t_cut, times)
+
+    return gate_and_write(args, program, part, outputs, "pencil", title, CHAIN_GAP, summary)
 
 
 def gate_and_write(args, program, part, outputs, what: str, title: str, join: float,
@@ -143,7 +149,7 @@ def _skipped_line(program) -> str:
     return ", ".join(f"{n} {r}" for r, n in sorted(counts.items()))
 
 
-def _summary(program, step: str, seconds: float, t_cut: float) -> str:
+def _summary(program, step: str, seconds: float, t_cut: float, times: dict) -> str:
     job = program.job
     segs = program.segments
     chains = sum(1 for a, b in zip(segs, segs[1:])  # a lift (rapid) before a cut
@@ -159,4 +165,5 @@ def _summary(program, step: str, seconds: float, t_cut: float) -> str:
         f"time at feed {t['time_at_feed_s']:.1f} s",
         f"  status     {'complete' if program.complete else 'partial'}; computed in "
         f"{t_cut:.1f} s, gated and written in {seconds - t_cut:.1f} s",
+        "  times      " + ", ".join(f"{k} {v:.1f} s" for k, v in times.items()),
     ])

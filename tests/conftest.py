@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import importlib.util
 import json
+import sys
 from pathlib import Path
 
 import pytest
@@ -16,6 +18,16 @@ CONCAVE_PAIRS = [(name, *p["faces"]) for name in FIXTURE_NAMES
                  for p in SIDECAR[name]["pairs"] if p["class"] == "concave"]
 
 _parts: dict = {}
+
+
+def load_benchmark(name: str):
+    """A benchmarks/ module by file path: benchmarks/ is not put on sys.path, where its
+    coverage.py would shadow the ``coverage`` package that numba looks for."""
+    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
 
 
 def load_fixture(name: str):

@@ -7,28 +7,18 @@ x = -30: every feasible centre sits at R' from both planes, (-30 + R', y, 15 + R
 Planes and offsets come from fixtures/fixtures.json, not from this file.
 """
 
-import importlib.util
 import json
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from conftest import load_benchmark
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _load(name: str):
-    """A benchmarks/ module by file path: benchmarks/ is not put on sys.path, where its
-    coverage.py would shadow the ``coverage`` package that numba looks for."""
-    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-_oracle, _paths = _load("coverage_oracle"), _load("coverage_paths")
+_oracle, _paths = load_benchmark("coverage_oracle"), load_benchmark("coverage_paths")
 Oracle, read_shape = _oracle.Oracle, _oracle.read_shape
 classify, cut_polylines = _paths.classify, _paths.cut_polylines
 distance_to_polylines = _paths.distance_to_polylines

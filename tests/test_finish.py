@@ -171,13 +171,13 @@ def test_cylinder_lower_half_is_unreachable_and_scallop_reported():
     import cadquery as cq
 
     wp = cq.Workplane("YZ").circle(10).extrude(40)
-    prog = finish(wp, wp.faces("%CYLINDER"), radius=R, scallop=0.02)
+    prog = finish(wp, wp.faces("%CYLINDER"), radius=R, scallop=0.05)
     part = cadcnc.Part.from_cadquery(wp)
     plan, samples = plan_for_job(part, prog.job)
     rep = uncut_report(prog, part, samples, plan)
     half = math.pi * 10 * 40
     assert rep.by_reason()["unreachable"] == pytest.approx(half, rel=0.02)
-    assert rep.max_scallop <= 0.02 * 1.02
+    assert rep.max_scallop <= 0.05 * 1.02
     assert any("largest scallop" in n for n in prog.notes)
 
 

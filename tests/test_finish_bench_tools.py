@@ -7,30 +7,16 @@ with its sign (gouge side negative) and applies the "ball wholly over the face" 
 the distance it states, and the tessellation's vertices lie on the face.
 """
 
-import importlib.util
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 import cadcnc
+from conftest import load_benchmark
 
-ROOT = Path(__file__).resolve().parents[1]
 R = 3.0
 
 
-def _load(name: str):
-    """A benchmarks/ module by file path: benchmarks/ is not put on sys.path, where its
-    coverage.py would shadow the ``coverage`` package that numba looks for."""
-    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-slab, tools = _load("freeform_slab"), _load("finish_bench_tools")
+slab, tools = load_benchmark("freeform_slab"), load_benchmark("finish_bench_tools")
 
 
 @pytest.fixture(scope="module")

@@ -131,3 +131,16 @@ def test_blend_corners_are_cut_by_stretches_between_their_limits():
         np.testing.assert_allclose(got, np.array(pts, float), atol=1e-3, err_msg=str(pair))
     assert not any(s.faces in ((10, 23), (12, 23)) for s in prog.skipped)
     assert prog.complete
+
+
+def test_a_hole_of_the_balls_radius_is_cut_by_a_plunge():
+    """narrow_slot's flat-bottom hole r 2 with a 2 mm ball: R' k = 1 is a tie, not a
+    face tighter than the ball; its corner is one position (10, 10, 17), a point cut,
+    and the program (links included) clears the part."""
+    part = cadcnc.load_step(FIXTURES / "narrow_slot.step")
+    prog = pencil(part, radius=2.0)
+    (point,) = [c for c in prog.cuts if len(c.points) == 1]
+    np.testing.assert_allclose(point.points[0], (10.0, 10.0, 17.0), atol=1e-6)
+    assert point.path.faces == (11, 12) and prog.complete and not prog.skipped
+    gate = gouge_gate(point.path, part, moves=prog.all_moves())
+    assert gate.ok, gate.message

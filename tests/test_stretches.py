@@ -185,3 +185,26 @@ def test_a_stretch_across_the_seam_of_a_closed_edge_is_one_stretch():
     # 2.6 mm of arc on a circle of radius 10 / 2 pi (not 7.4 mm the other way round):
     # the polyline of 0.2 mm chords is shorter by about 13 x 0.2^3 / (24 r^2) = 2e-3 mm
     assert 2.6 - 3e-3 < st.length <= 2.6
+
+
+def test_a_hole_of_the_balls_radius_is_one_position_cut_as_a_point():
+    """narrow_slot's flat-bottom hole r 2 at (10, 10), floor z 15, with a ball R' = 2:
+    the ball fits the hole exactly (R' k = 1, a tie, not a gouge: every point of the wall
+    and floor is R' from the centre), so the whole bottom edge is one feasible position,
+    the closed form (10, 10, 17), and its program is a single-point cut."""
+    from cadcnc.job import Job, PairPath
+    from cadcnc.ops.pair_program import program_for_job
+
+    part = cadcnc.load_step(FIXTURES / "narrow_slot.step")
+    job = Job(Tool(2.0), 1500.0, 0.004, PairPath(faces=(11, 12), edge=None))
+    (edge,) = pair_stretches(part.face(11), part.face(12), job)
+    (st,) = edge.stretches
+    assert st.length < 1e-6 and st.start.p == pytest.approx((10.0, 10.0, 17.0), abs=UM)
+    assert all(x.ok for x in edge.samples)
+    (cut,) = program_for_job(part, job).cuts
+    assert cut.points.shape == (1, 3) and cut.complete
+    np.testing.assert_allclose(cut.points[0], (10.0, 10.0, 17.0), atol=UM)
+    # a ball 2 um larger than the hole would cut its wall by ~4 um > 1 um: refused
+    feas = Feasibility(part.face(11), part.face(12),
+                       replace(job, tool=Tool(2.0 + 2e-3)), None)
+    assert feas.judge(st.start.tangency)[0] == "curvature"

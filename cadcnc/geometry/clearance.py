@@ -32,6 +32,7 @@ or near 0), otherwise a positive lower bound.
 from __future__ import annotations
 
 import math
+import weakref
 
 import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
@@ -63,26 +64,26 @@ class ClearanceGuard:
     """
 
     def __init__(self, part, pair: tuple[int, ...], offset: float, shank: float,
-                 tol: float = 1e-6, reach: float | None = None):
+                 tol: float = 1e-6, reach: float | None = None, own_tol: float = 1e-3):
         self.part = part
         self.pair = tuple(int(k) for k in pair)   # two faces, or one (a finishing pass)
         self.offset = float(offset)
         self.shank = float(shank)
         self.tol = float(tol)
         self.threshold = self.offset - self.tol   # mm: nearer than this is a hit
+        # the ball against its own faces' edges: the spec's 1 um (the path touches its own
+        # faces at R' up to its own error, so the third faces' 1 nm would fire on noise)
+        self.own_threshold = self.offset - float(own_tol)
         self.reach = max(self.offset, 1.0) if reach is None else float(reach)
-        n = len(part)
-        self._faces = [part.face(k) for k in range(1, n + 1)]
-        self._analytic = [AnalyticFace(f) for f in self._faces]   # closed forms, or kind None
-        boxes = [optimal_box(f.topods, use_triangulation=False) for f in self._faces]
-        self._lo = np.array([b[0] for b in boxes]) - BOX_SLACK     # (n, 3)
-        self._hi = np.array([b[1] for b in boxes]) + BOX_SLACK     # (n, 3)
+        self._faces, self._analytic, self._lo, self._hi = _part_data(part)
         self._own_shapes = TopTools_IndexedMapOfShape()   # edges and vertices of i and j
         for k in self.pair:
             for kind in (TopAbs_EDGE, TopAbs_VERTEX):
                 TopExp.MapShapes_s(self._faces[k - 1].topods, kind, self._own_shapes)
         self._own_rule = {k: _needs_own_rule(self._faces[k - 1]) for k in self.pair}
         self._edges: dict = {}              # face -> compound of its free edges (planes)
+        self._own_edges: dict = {}          # own face -> compound of all its edges
+        self._edge_bound: dict = {}         # own face -> (p0, distance to its edges at p0)
         self._broad_at: tuple[float, float, float] | None = None
         self._near: list[int] = []          # face numbers within reach at _broad_at
         self._bound: dict[int, tuple] = {}  # face -> (p0, lower bound of the margin at p0, slope)
@@ -153,14 +154,19 @@ class ClearanceGuard:
         """
         below = self._hi[k - 1][2] - BOX_SLACK <= p[2]
         own = k in self.pair
-        if own and below:
-            m = self.tol
-        elif own:
-            m = self._own_bound(k, p)
-            if m is None or m < 0.0:
-                d_seg, d_p = self._segment_distance(k, p)[0], self._point_distance(k, p)
-                # an unknown distance fails closed (-inf is a hit, never an inf margin)
-                m = d_seg - (d_p - self.tol) if math.isfinite(d_seg + d_p) else -math.inf
+        if own:
+            if below:
+                m = self.tol
+            else:
+                m = self._own_bound(k, p)
+                if m is None or m < 0.0:
+                    d_seg, d_p = self._segment_distance(k, p)[0], self._point_distance(k, p)
+                    # an unknown distance fails closed (-inf is a hit, never an inf margin)
+                    m = d_seg - (d_p - self.tol) if math.isfinite(d_seg + d_p) else -math.inf
+            m_edge = self._own_edge_margin(k, p)
+            if m_edge < min(m, 0.0):   # the ball cuts the own face's boundary
+                self._bound[k] = (p, m_edge, 2.0)
+                return m_edge, "ball"
         else:
             d, own_edge = self._segment_distance(k, p, 0.0 if below else self.shank)
             m = d - self.threshold
@@ -207,6 +213,30 @@ class ClearanceGuard:
                   for n in range(1, ext.NbSolution() + 1))
         return ext.Value(), own
 
+    def _own_edge_margin(self, k: int, p) -> float:
+        """The ball's margin (mm, against R' - own_tol) from the edges of own face k: the
+        ball touches face k at R' at its foot by construction, but near the face's boundary the nearest point of the
+        trimmed face can be an edge nearer than the foot (a B-spline face curving towards
+        the ball past a convex edge: bug32596_abc_0_13 faces 4/67 were cut 12 um deep
+        there). Lipschitz-cached apart from the face's own bound (slope 1)."""
+        p0, d0 = self._edge_bound.get(k, (None, None))
+        if p0 is not None and d0 - _dist(p, p0) - self.own_threshold >= 0.0:
+            return d0 - _dist(p, p0) - self.own_threshold
+        if k not in self._own_edges:
+            edges = TopTools_IndexedMapOfShape()
+            TopExp.MapShapes_s(self._faces[k - 1].topods, TopAbs_EDGE, edges)
+            comp, builder = TopoDS_Compound(), BRep_Builder()
+            builder.MakeCompound(comp)
+            for e in range(1, edges.Extent() + 1):
+                builder.Add(comp, edges.FindKey(e))
+            self._own_edges[k] = comp
+        self.exact_calls += 1
+        ext = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(),
+                                         self._own_edges[k])
+        d = ext.Value() if ext.IsDone() and ext.NbSolution() else -math.inf
+        self._edge_bound[k] = (p, d)
+        return d - self.own_threshold
+
     def _own_bound(self, k: int, p) -> float | None:
         """A lower bound of own face k's margin in closed form (a torus: the segment's
         distance to the whole torus, the ball's to the face), or None."""
@@ -244,6 +274,24 @@ class ClearanceGuard:
         return ext.Value() if ext.IsDone() and ext.NbSolution() else -math.inf
 
 
+_PART_DATA: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _part_data(part) -> tuple:
+    """(faces, closed forms, box lows (n, 3), box highs (n, 3)) of every face of a part,
+    computed once per part and shared by its guards (the optimal boxes of a 438-face part
+    took ~1.6 s per guard, and pencil builds one per corner)."""
+    data = _PART_DATA.get(part)
+    if data is None:
+        faces = [part.face(k) for k in range(1, len(part) + 1)]
+        analytic = [AnalyticFace(f) for f in faces]   # closed forms, or kind None
+        boxes = [optimal_box(f.topods, use_triangulation=False) for f in faces]
+        data = (faces, analytic, np.array([b[0] for b in boxes]).reshape(-1, 3) - BOX_SLACK,
+                np.array([b[1] for b in boxes]).reshape(-1, 3) + BOX_SLACK)
+        _PART_DATA[part] = data
+    return data
+
+
 def _needs_own_rule(face) -> bool:
     """False where a shank above the ball can never come nearer to this face than the
     ball's own contact: a plane whose outward normal has n_z >= 0, or a cylinder whose
@@ -269,4 +317,4 @@ def guard_for(part, pair: tuple[int, ...], job, reach: float | None = None) -> C
     """The guard of a :class:`~cadcnc.job.Job` (its tool's R', shank length and the
     tolerance ``hit``) for faces ``pair`` of ``part``."""
     return ClearanceGuard(part, pair, job.tool.offset, job.tool.shank,
-                          job.tolerances.hit, reach)
+                          job.tolerances.hit, reach, job.tolerances.gouge)

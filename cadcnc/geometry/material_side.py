@@ -29,12 +29,12 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid
 from OCP.BRepClass3d import BRepClass3d_SolidClassifier
 from OCP.BRepLib import BRepLib
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
-from OCP.TopAbs import TopAbs_FACE, TopAbs_IN, TopAbs_REVERSED, TopAbs_SHELL, TopAbs_VERTEX
+from OCP.TopAbs import TopAbs_FACE, TopAbs_IN, TopAbs_SHELL, TopAbs_VERTEX
 from OCP.TopExp import TopExp, TopExp_Explorer
-from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Compound
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
+from .mesh import face_triangles
 from .sewing import Sewn
 
 SOLID = "solid"
@@ -95,19 +95,11 @@ def flux_z(shell) -> tuple[float, float]:
     flux = area = 0.0
     exp = TopExp_Explorer(shell, TopAbs_FACE)
     while exp.More():
-        face = TopoDS.Face_s(exp.Current())
-        loc = TopLoc_Location()
-        tri = BRep_Tool.Triangulation_s(face, loc)
+        tris = face_triangles(TopoDS.Face_s(exp.Current()))
         exp.Next()
-        if tri is None:
+        if tris is None:
             continue
-        trsf = loc.Transformation()
-        nodes = np.array([tri.Node(i).Transformed(trsf).Coord()
-                          for i in range(1, tri.NbNodes() + 1)])
-        idx = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)]) - 1
-        if face.Orientation() == TopAbs_REVERSED:
-            idx = idx[:, ::-1]
-        a, b, c = nodes[idx[:, 0]], nodes[idx[:, 1]], nodes[idx[:, 2]]
+        a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
         cross = np.cross(b - a, c - a)
         flux += 0.5 * float(cross[:, 2].sum())
         area += 0.5 * float(np.linalg.norm(cross, axis=1).sum())

@@ -27,6 +27,8 @@ from ..geometry.blends import Blend, find_blends
 from ..geometry.part import CONCAVE, MIXED, TANGENT, Part
 from ..job import Tool
 from ..program.program import Skipped
+from ..tolerances import DEFAULT
+from .stretches import too_tight
 
 EDGE, BLEND = "edge", "blend"
 TANGENT_FACES, MIXED_EDGE, BLEND_ROLLS = "tangent", "mixed", "blend_rolls"
@@ -87,7 +89,7 @@ def find_corners(part: Part, radius: float, allowance: float = 0.0,
     rp = Tool(radius, allowance).offset
     blends, kranges = find_blends(part)
     # faces concave tighter than the ball at every sample: {face: least k_max, 1/mm}
-    tight = {n: klo for n, (klo, _) in kranges.items() if klo * rp >= 1.0}
+    tight = {n: klo for n, (klo, _) in kranges.items() if too_tight(klo * rp, rp, DEFAULT)}
     corners = _blend_corners(part, blends, tight, rp)
     corners += _edge_corners(part, blends, tight, rp)
     if faces is not None:

@@ -161,6 +161,10 @@ def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
                 continue
             cjob = _cut_job(job, st, k)
             plan = replace(plan_for_stretch(s1, s2, cjob, st), job=cjob)
+            if st.length <= POINT_STRETCH:
+                cuts.append(CutSegment(_point_cut(plan), edge=e.edge + 1, stretch=k,
+                                       at_limit=True))
+                continue
             tp = _run(plan, guard, max_cycles, progress)
             at_limit = _reached_limit(tp, st)
             if side is not None and at_limit and len(tp) > 2:
@@ -176,6 +180,22 @@ def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
                     f"the stretch ({tp.length:.3f} of {st.length:.3f} mm cut) is not cut"),
                     e.edge + 1))
     return cuts, skipped
+
+
+POINT_STRETCH = 2e-3
+"""mm: a stretch this short is one ball position (the ball fits a hole or a sphere of its
+own radius, R' k = 1: every feasible position of the corner is the same centre), cut as a
+single point reached by the plunge."""
+
+
+def _point_cut(plan: PathPlan) -> Toolpath:
+    """The cut of a one-position stretch: its start point alone (no step is possible:
+    the offset intersection curve is a point, the stepper's curvature rule refuses it)."""
+    stepper = stepper_for(plan, 0, True, check_cycles=False)
+    stepper.run(None)
+    return toolpath_from_record(stepper.record, plan.job, "point", (
+        "a single ball position (the ball fits the face's curvature exactly, R' k = 1): "
+        "reached by the plunge"), plan.edge_length)
 
 
 def _from_start(part, job, s1, s2, guard, max_cycles, progress) -> Program:

@@ -19,10 +19,13 @@ and so do blend corners (from the blend's first seed to its second) in this vers
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 
+import numpy as np
+
 from ..errors import CadcncError, InputError
-from ..geometry.clearance import guard_for
+from ..geometry.clearance import ClearanceGuard, guard_for
 from ..geometry.part import Part
 from ..job import Job, PairPath, Tool
 from ..program.linking import linked, order_cuts
@@ -42,7 +45,7 @@ DEFAULT_PERIOD = 0.004    # s
 def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT_FEED,
            period: float = DEFAULT_PERIOD, faces=None, clearance: float | None = None,
            shank_length: float | None = None, side: str = CLIMB,
-           tol: Tolerances = DEFAULT, progress=None) -> Program:
+           tol: Tolerances = DEFAULT, progress=None, times: dict | None = None) -> Program:
     """The pencil program of ``part`` (a :class:`~cadcnc.geometry.part.Part`, or a CadQuery
     Workplane or Shape, read with :meth:`Part.from_cadquery`) for a ball of radius
     ``radius`` (mm) with ``allowance`` (mm): see the module doc.
@@ -51,7 +54,12 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
     among them); ``clearance``: ball-centre Z of the links (default the part's top + 10
     mm); ``side``: "climb" (default: the material on the right of the travel, for a
     clockwise spindle) or "conventional"; ``progress(done, total, what)`` after each corner.
+    ``times``: a dict to which the seconds spent per stage are added (``edges``: the
+    part's edge classification; ``corners``; ``guards``: building the third-face guards;
+    ``stretches``: the stretch search; ``interpolation``: the stepper along every
+    stretch; ``linking``: reachability from +Z, ordering and links).
     """
+    clock = _Clock(times)
     if side not in (CLIMB, CONVENTIONAL):
         raise InputError(f"side must be {CLIMB!r} or {CONVENTIONAL!r}, got {side!r}")
     if not isinstance(part, Part):
@@ -59,34 +67,46 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
     tool = Tool(radius, allowance, shank_length)
     job = Job(tool, feed, period, PairPath(edge=None), source=part.source,
               clearance=clearance, tolerances=tol)
-    corners = find_corners(part, radius, allowance, faces)
+    with clock("edges"):
+        part.adjacency
+    with clock("corners"):
+        corners = find_corners(part, radius, allowance, faces)
     cuts: list[CutSegment] = []
     skipped: list[Skipped] = [c.skipped() for c in corners if not c.cut]
     todo = [c for c in corners if c.cut]
     stretches: dict = {}
+    guards: dict = {}
     for k, corner in enumerate(todo, 1):
         i, j = corner.faces
         cjob = replace(job, operation=PairPath(faces=(i, j), edge=corner.edge))
         try:
             s1, s2 = part.face(i), part.face(j)
-            guard = guard_for(part, (i, j), cjob)
+            with clock("guards"):   # one per pair (its cache serves all its corners)
+                guard = guards.get((i, j)) or guards.setdefault(
+                    (i, j), guard_for(part, (i, j), cjob))
             if corner.kind == EDGE:
-                if (i, j) not in stretches:
-                    stretches[(i, j)] = pair_stretches(s1, s2, cjob, guard)
+                with clock("stretches"):
+                    if (i, j) not in stretches:
+                        stretches[(i, j)] = pair_stretches(s1, s2, cjob, guard)
                 found = [stretches[(i, j)][corner.edge]]
-                new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
+                with clock("interpolation"):
+                    new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
                 cuts += new
                 skipped += why
             elif corner.kind == BLEND and len(corner.rails) == 1:
                 # the ball's stretches anchored on planes normal to the blend's rail on a
-                found = [edge_stretches(Feasibility(s1, s2, cjob, guard), corner.rails[0], 0)]
-                new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
+                with clock("stretches"):
+                    found = [edge_stretches(Feasibility(s1, s2, cjob, guard),
+                                            corner.rails[0], 0)]
+                with clock("interpolation"):
+                    new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
                 cuts += new
                 skipped += [replace(w, detail=f"blend corner over face(s) "
                                     f"{', '.join(map(str, corner.blend_faces))}: {w.detail}")
                             for w in why]
             elif corner.kind == BLEND:
-                cut = _blend_cut(s1, s2, cjob, corner, guard)
+                with clock("interpolation"):
+                    cut = _blend_cut(s1, s2, cjob, corner, guard)
                 if len(cut.points) < 2:
                     skipped.append(Skipped((i, j), cut.path.stop_reason, (
                         f"blend corner over face(s) {', '.join(map(str, corner.blend_faces))}"
@@ -98,8 +118,87 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
                                    None if corner.edge is None else corner.edge + 1))
         if progress is not None:
             progress(k, len(todo), f"faces {i} {j}")
-    ordered = order_cuts(cuts, CHAIN_GAP)
-    return Program(job, linked(ordered, safe_height(part, job), join=CHAIN_GAP), skipped)
+    with clock("linking"):
+        z_safe = safe_height(part, job)
+        ordered, unreachable = reachable_order(part, job, cuts, z_safe)
+        segments = linked(ordered, z_safe, join=CHAIN_GAP)
+    return Program(job, segments, skipped + unreachable)
+
+
+class _Clock:
+    """``with clock(stage):`` adds the block's wall seconds to ``times[stage]`` (no-op
+    without a dict)."""
+
+    def __init__(self, times: dict | None):
+        self.times = times
+        self.stage = ""
+        self.t0 = 0.0
+
+    def __call__(self, stage: str) -> "_Clock":
+        self.stage = stage
+        return self
+
+    def __enter__(self) -> None:
+        self.t0 = time.perf_counter()
+
+    def __exit__(self, *exc) -> None:
+        if self.times is not None:
+            self.times[self.stage] = self.times.get(self.stage, 0.0) + (
+                time.perf_counter() - self.t0)
+
+
+NOT_REACHABLE = "not reachable from +Z"
+
+
+def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float
+                    ) -> tuple[list[CutSegment], list[Skipped]]:
+    """The cuts the tool can reach from above, in linking order (:func:`order_cuts`), and
+    the others skipped as "not reachable from +Z". A chain is entered by a plunge straight
+    down to its first cut's start and left by a retract straight up from its last cut's
+    end (:func:`~cadcnc.program.linking.link`). Such a point is reachable when the ball
+    and a shank from it up to the link height ``z_safe`` (mm) clear the part by R' - 1 um
+    less the gate's tolerance (:class:`ClearanceGuard`, the stepper's guard with a longer
+    shank): not so in a sealed
+    void, or under an overhang higher than the shank. A cut whose entry or exit is
+    blocked is dropped and the rest ordered again (its neighbours may then need one)."""
+    lo, _ = part.bounding_box()
+    shank = max(z_safe - float(lo[2]), job.tool.shank)
+    guards: dict = {}
+    skipped: list[Skipped] = []
+
+    def blocked(cut: CutSegment, which: str, p) -> str | None:
+        faces = cut.path.faces
+        if faces not in guards:
+            guards[faces] = ClearanceGuard(part, faces, job.tool.offset, shank,
+                                           job.tolerances.hit)
+        margin, detail = guards[faces].margin(p)
+        # a cut's end landed on a collision sits at margin ~0 (-1e-8 mm is landing
+        # round-off): only a deeper hit blocks the way; the gate judges every move anyway
+        return None if margin >= -job.tolerances.gouge else (
+            f"its {which} ({p[0]:.4f}, {p[1]:.4f}, {p[2]:.4f}): {detail} "
+            f"({-margin:.4g} mm too near) on the way to Z {z_safe:.3f}")
+
+    while True:
+        ordered = order_cuts(cuts, CHAIN_GAP)
+        bad = {}
+        for k, cut in enumerate(ordered):
+            why = []
+            if k == 0 or np.linalg.norm(cut.points[0] - ordered[k - 1].points[-1]) > CHAIN_GAP:
+                why.append(blocked(cut, "start", cut.points[0]))
+            if k == len(ordered) - 1 or np.linalg.norm(
+                    ordered[k + 1].points[0] - cut.points[-1]) > CHAIN_GAP:
+                why.append(blocked(cut, "end", cut.points[-1]))
+            why = [w for w in why if w]
+            if why:
+                bad[id(cut)] = why
+        if not bad:
+            return ordered, skipped
+        for cut in ordered:
+            if id(cut) in bad:
+                skipped.append(Skipped(cut.path.faces, NOT_REACHABLE, (
+                    f"cut of {cut.path.length:.3f} mm: " + "; ".join(bad[id(cut)])),
+                    cut.edge))
+        cuts = [c for c in ordered if id(c) not in bad]
 
 
 def _blend_cut(s1, s2, job: Job, corner, guard) -> CutSegment:

@@ -3,8 +3,8 @@
 A *feasible* ball position of a pair (i, j) is a centre touching both offset surfaces
 (Newton, :func:`~cadcnc.interp.tangency.solve_tangency`) whose feet lie on the trimmed
 faces (inside or on the boundary), where the faces are not tangent, where neither
-contact's concave curvature along the path is tighter than the ball (R' k < 1), and
-where the ball and its shank clear the rest of the part
+contact's concave curvature along the path is tighter than the ball (R' k <= 1, up to
+the spec's 1 um), and where the ball and its shank clear the rest of the part
 (:class:`~cadcnc.geometry.clearance.ClearanceGuard`). A *stretch* is a maximal
 connected piece of the offset intersection curve made of feasible positions.
 
@@ -39,6 +39,7 @@ from ..interp.cycle import Contact
 from ..interp.stepper import Tangency
 from ..interp.tangency import solve_tangency
 from ..job import Job
+from ..tolerances import Tolerances
 
 SPACING = 0.4       # mm of edge between samples (refined to MAX_CHORD of centres)
 MIN_SAMPLES = 9     # per edge
@@ -178,13 +179,21 @@ class Feasibility:
         t = tuple(t / sin)
         for c, s in ((c1, self.s1), (c2, self.s2)):
             k = c.curvature(t)
-            if c.offset * k >= 1.0:
-                return CURVATURE, f"face {s.number}: R' k = {c.offset * k:.4g} >= 1"
+            if too_tight(c.offset * k, c.offset, self.tol):
+                return CURVATURE, f"face {s.number}: R' k = {c.offset * k:.4g} > 1"
         if self.guard is not None:
             m, detail = self.guard.margin(tan.p)
             if m < 0.0:
                 return COLLISION, f"{detail} ({-m:.4g} mm too near)"
         return FEASIBLE, ""
+
+
+def too_tight(rk: float, offset: float, tol: Tolerances) -> bool:
+    """Whether a concave curvature k with R' k = ``rk`` is tighter than a ball of offset
+    R' (mm) can follow. R' k = 1 is a tie: the ball fits the face exactly (a hole of its
+    own radius) and does not cut it; past 1 + gouge / 2 R' it cuts the face deeper than
+    the spec's 1 um (a cylinder of radius R'/(R' k) is cut by ~2 R' (R' k - 1))."""
+    return rk > 1.0 + tol.gouge / (2.0 * offset)
 
 
 def _project(surface, point) -> tuple[float, float]:
@@ -253,7 +262,10 @@ def _refine(feas, curve, samples: list[Sample], out: EdgeStretches) -> list[Samp
                     out.missed += 1
             elif np.linalg.norm(np.subtract(a.tangency.p, b.tangency.p)) > MAX_CHORD:
                 if b.s - a.s > floor:
-                    stack.append(_at(feas, curve, 0.5 * (a.s + b.s), a if a.ok else None))
+                    # seeded from a's tangency, feasible or not, as the grid is: from the
+                    # anchor alone Newton may land on another branch of the curve (15 mm
+                    # off on r0901_ec 67/377), and every halving would land there again
+                    stack.append(_at(feas, curve, 0.5 * (a.s + b.s), a))
                     continue
                 out.missed += 1
             result.append(stack.pop())
