@@ -46,10 +46,11 @@ def _curvatures(ff: np.ndarray, ru: np.ndarray, rw: np.ndarray, t: np.ndarray) -
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def pair_bounds(R: np.ndarray, points: np.ndarray, contacts: np.ndarray, normals: np.ndarray,
                 ru: np.ndarray, rw: np.ndarray, forms: np.ndarray, t: np.ndarray,
-                f: np.ndarray) -> np.ndarray:
+                f: np.ndarray, limit: float = PAPER_INVERSE_LIMIT) -> np.ndarray:
     """(2, FIELDS, N): both surfaces' bounds. ``R`` (2,) offsets (mm); ``points`` (N, 3);
     ``contacts``, ``normals``, ``ru``, ``rw`` (N, 2, 3); ``forms`` (N, 2, 6); ``t`` (N, 3);
-    ``f`` (N,) (mm)."""
+    ``f`` (N,) (mm); ``limit``: cycle.PAPER_INVERSE_LIMIT (an argument, not a global: numba's
+    cache would keep a global's value from another file)."""
     n_pts = points.shape[0]
     out = np.empty((2, FIELDS, n_pts))
     for j in range(n_pts):
@@ -97,7 +98,7 @@ def pair_bounds(R: np.ndarray, points: np.ndarray, contacts: np.ndarray, normals
             eq16 = coeff / (2.0 * one * ss_den) * fj * fj if ss_den > 0 else math.inf
             a, b = abs(kmax - k), abs(kmin - k)
             rho = r * (a if a >= b or math.isnan(a) else b) / abs(1.0 - r * k)
-            if rho > PAPER_INVERSE_LIMIT:  # the exact inverse moved it: eq. 12 from eps
+            if rho > limit:  # the exact inverse moved it: eq. 12 from eps
                 eps_ss, eq16 = eps, eq12
             row = out[i]
             row[0, j], row[1, j], row[2, j], row[3, j], row[4, j] = eps, k, kmax, kmin, tau

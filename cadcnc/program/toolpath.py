@@ -14,7 +14,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from ..interp.cycle import CLOSED, END
+from ..interp.cycle import CLOSED, END, PAPER_INVERSE_LIMIT
 from ..interp.bounds_compiled import pair_bounds
 from ..interp.error_bounds import SurfaceBounds
 from ..interp.record import PathRecord
@@ -144,7 +144,7 @@ def compute_bounds(path: Toolpath, ru: np.ndarray, rw: np.ndarray,
     """
     f = np.append(path.commanded[1:], path.commanded[-1] if len(path) > 1 else 0.0)
     out = pair_bounds(np.asarray(path.offsets, dtype=float), path.points, path.contacts,
-                      path.normals, ru, rw, forms, path.tangents, f)
+                      path.normals, ru, rw, forms, path.tangents, f, PAPER_INVERSE_LIMIT)
     return SurfaceBounds(*out[0]), SurfaceBounds(*out[1])
 
 
