@@ -8,12 +8,8 @@ test_cli_smoke.py.
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
-import os
 import shutil
-from dataclasses import dataclass
 
 import numpy as np
 import pytest
@@ -22,43 +18,12 @@ import cadcnc
 from cadcnc.cli.app import main
 from cadcnc.io import read_csv, read_json
 
-from conftest import FIXTURES, fixture_path, load_fixture
+from conftest import FIXTURES, _cwd, cadcnc_cli, fixture_path, load_fixture
 
 BOSS = str(FIXTURES / "bspline_boss.step")
 SADDLE = str(FIXTURES / "crossing_cylinders.step")
 POCKET = str(FIXTURES / "pocket.step")
 JOB = ["--radius", "3", "--feed", "1500", "--period", "4ms"]
-
-
-@dataclass
-class Run:
-    returncode: int
-    stdout: str
-    stderr: str
-
-
-@contextlib.contextmanager
-def _cwd(path):
-    old = os.getcwd()
-    os.chdir(path or old)
-    try:
-        yield
-    finally:
-        os.chdir(old)
-
-
-def cadcnc_cli(*args, cwd=None, check=None) -> Run:
-    """Run ``cadcnc ARGS`` in this process; returns its exit code, stdout and stderr."""
-    out, err = io.StringIO(), io.StringIO()
-    with _cwd(cwd), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = main([str(a) for a in args])
-        except SystemExit as e:  # argparse: --help, usage errors
-            code = e.code
-    run = Run(code, out.getvalue(), err.getvalue())
-    if check is not None:
-        assert run.returncode == check, (run.returncode, run.stdout, run.stderr)
-    return run
 
 
 # -- help and faces ----------------------------------------------------------------------------
@@ -91,11 +56,9 @@ def test_faces_json_agrees_with_the_part():
 
 # -- path --------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
-def boss_outputs(tmp_path_factory):
-    d = tmp_path_factory.mktemp("path")
-    run = cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", d / "p.json",
-                     "-o", d / "p.csv", "-o", d / "p.ngc", check=0)
-    return d, run
+def boss_outputs(boss_cli_outputs):
+    """``cadcnc path`` BOSS 4 5 with JOB to p.json, p.csv and p.ngc (conftest: run once)."""
+    return boss_cli_outputs
 
 
 @pytest.fixture(scope="module")

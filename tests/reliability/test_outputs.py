@@ -15,8 +15,7 @@ import time
 
 import pytest
 
-from conftest import FIXTURES
-from test_cli import cadcnc_cli
+from conftest import FIXTURES, cadcnc_cli
 
 BOSS = FIXTURES / "bspline_boss.step"
 POCKET = FIXTURES / "pocket.step"  # faces 10 17: a straight edge, a program in ~0.2 s
@@ -98,12 +97,10 @@ def test_a_very_long_output_name_is_a_clear_error(tmp_path):
 
 
 @pytest.fixture(scope="module")
-def boss_program(tmp_path_factory) -> str:
-    """The program JSON text ``cadcnc path`` writes for the boss's faces 4 5 (computed once:
-    the malformed-file tests each edit a copy)."""
-    saved = tmp_path_factory.mktemp("boss") / "p.json"
-    cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", saved, "--quiet", check=0)
-    return saved.read_text()
+def boss_program(boss_cli_outputs) -> str:
+    """The program JSON text ``cadcnc path`` writes for the boss's faces 4 5 (computed once
+    per session, conftest: the malformed-file tests each edit a copy)."""
+    return (boss_cli_outputs[0] / "p.json").read_text()
 
 
 def _cut(d: dict) -> dict:
