@@ -62,7 +62,7 @@ def boundary_points(face, rng, per_edge: int = 24) -> np.ndarray:
     return base + radius[:, None] * np.column_stack([np.cos(angle), np.sin(angle)])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(nogil=True)  # not cached: a cached caller keeps its copy of lookup when it changes
 def lookup_many(codes, fine, u0, w0, du, dw, nu, nw, u, w):  # pragma: no cover (compiled)
     """``lookup`` (the kernel's reader, which ``TrimGrid.cell`` calls) at each of the (n,)
     window points (u, w): (n,) int64 cell labels, compiled so that the 10^4-point sweep
