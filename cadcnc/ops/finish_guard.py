@@ -33,6 +33,7 @@ import numpy as np
 
 from ..geometry.clearance import BOX_SLACK, ClearanceGuard, _dist
 from .finish_cells import BOUNDED_KINDS, CELL_MM, HeightCells, _Boxes, _cells
+from .finish_walls import WallProof, hangs_from
 
 __all__ = ["BoxTree", "FinishGuard", "HeightCells", "_Boxes", "finish_guard"]
 
@@ -40,8 +41,6 @@ DEPTH = 5
 """Halvings of a BoxTree cell at most (1 mm cells down to about 0.03 mm)."""
 VISITS = 400
 """Boxes a BoxTree query halves, at most (then the boxes left count as they are)."""
-WANT = 0.0
-"""mm beyond R' - tol that a third face's bound aims for (its budget)."""
 
 
 def _segment_box(p, length: float, b) -> float:
@@ -116,14 +115,31 @@ class FinishGuard(ClearanceGuard):
         self._cells = {k: HeightCells(part.face(k)) for k in self.pair
                        if self._own_rule[k] and part.face(k).kind in BOUNDED_KINDS}
         self._trees: dict = {}
+        self._walls: dict = {}
         self.proven_calls = 0
+
+    def _wall(self, k: int) -> WallProof | None:
+        """The proof of third face k when it hangs from the followed face, else None."""
+        if k not in self._walls:
+            self._walls[k] = WallProof(self._faces[k - 1], self.threshold) \
+                if hangs_from(self._faces[k - 1], self._own_shapes) else None
+        return self._walls[k]
+
+    def _exact(self, k: int, p) -> tuple[float, str]:
+        if k not in self.pair:
+            wall = self._wall(k)
+            if wall is not None and wall.budget(p) >= 0.0:
+                self.proven_calls += 1
+                self._bound[k] = (p, 0.0, 1.0)
+                return 0.0, "tool"
+        return super()._exact(k, p)
 
     def _segment_distance(self, k: int, p, length: float | None = None):
         if k not in self.pair and self._faces[k - 1].kind in BOUNDED_KINDS:
             if k not in self._trees:
                 self._trees[k] = BoxTree(self._faces[k - 1])
             lb = self._trees[k].lower_bound(p, self.shank if length is None else length,
-                                            self.threshold, self.threshold + WANT)
+                                            self.threshold)
             if lb is not None:
                 self.proven_calls += 1
                 return lb, False
@@ -160,6 +176,8 @@ class FinishGuard(ClearanceGuard):
                     mine = max(mine, self._cells[k].budget(p))
                 e0, d0 = self._edge_bound.get(k, (None, None))
                 mine = min(mine, -1.0 if e0 is None else d0 - _dist(p, e0) - self.own_threshold)
+            elif self._walls.get(k) is not None:
+                mine = max(mine, self._walls[k].budget(p))
             room = min(room, mine)
         return max(room, 0.0)
 
