@@ -77,3 +77,103 @@ def test_box_tree_bounds_the_distance_from_below(slab):
         lb = tree.lower_bound(p, 0.0, 1.0)
         if lb is not None:
             assert lb <= shape_distances(side.topods, p[None])[0] + 1e-9
+
+
+def test_grid_boxes_are_the_cells_own_boxes(slab):
+    """One knot refinement gives each cell the box of its own Segment's control points."""
+    from cadcnc.ops.finish_cells import _cells
+    f = slab.face(5)
+    boxes = _Boxes(f)
+    us, ws = _cells(f, 2.0)
+    grid = boxes.grid(us, ws)
+    for i in range(0, len(us) - 1, 3):
+        for j in range(0, len(ws) - 1, 3):
+            assert np.allclose(grid[i, j], boxes.box(us[i], us[i + 1], ws[j], ws[j + 1]),
+                               rtol=0, atol=1e-12)
+
+
+def test_the_walls_hang_from_the_top_and_the_top_does_not(slab):
+    from cadcnc.ops.finish_walls import hangs_from
+    guard = FinishGuard(slab, (5,), 3.0, 40.0, 1e-6)
+    assert all(hangs_from(slab.face(k), guard._own_shapes) for k in (1, 2, 3, 4))
+    assert not hangs_from(slab.face(6), guard._own_shapes)    # the bottom: a B-spline
+    other = FinishGuard(slab, (6,), 3.0, 40.0, 1e-6)           # walls do not hang from it
+    assert not any(hangs_from(slab.face(k), other._own_shapes) for k in (1, 2, 3, 4))
+
+
+def _near_the_rim(top, rng, n):
+    """Ball centres about the top's offset near its boundary (within 4 mm of an edge),
+    some pushed out over the edge, sideways or down."""
+    (u0, u1), (w0, w1) = top.u_range, top.w_range
+    out = []
+    while len(out) < n:
+        u, w = rng.uniform(u0, u1), rng.uniform(w0, w1)
+        if min(u - u0, u1 - u, w - w0, w1 - w) > 4.0:
+            continue
+        p = top.point(u, w) + (3.0 + rng.choice([0.0, -0.3, 0.2, -1e-3])) * top.normal(u, w)
+        p[:2] += rng.normal(0.0, 1.0, 2) * rng.choice([0.0, 1.0])
+        p[2] -= rng.choice([0.0, 0.0, 0.5, 2.0])
+        out.append(p)
+    return out
+
+
+def test_the_wall_proof_never_clears_a_hit(slab):
+    """Centres near the rim, where the walls are within R': the finishing guard (walls
+    proven in closed form) agrees in sign with the exact guard (OCCT distances)."""
+    exact = ClearanceGuard(slab, (5,), 3.0, 40.0, 1e-6)
+    fast = FinishGuard(slab, (5,), 3.0, 40.0, 1e-6)
+    rng = np.random.default_rng(4)
+    hits = 0
+    for p in _near_the_rim(slab.face(5), rng, 120):
+        m_fast, m_exact = fast.margin(p)[0], exact.margin(p)[0]
+        assert not (m_fast >= 0.0 > m_exact), (p, m_fast, m_exact)
+        hits += m_exact < 0.0
+    assert hits > 5                                            # the test sees hits too
+    assert sum(w.cells.searches for w in fast._walls.values() if w is not None) > 20
+
+
+def test_every_centre_within_the_budget_is_clear(slab):
+    """After a clear margin, every centre within the budget is clear for the exact guard
+    (random points on spheres of the budget's radius and inside)."""
+    exact = ClearanceGuard(slab, (5,), 3.0, 40.0, 1e-6)
+    fast = FinishGuard(slab, (5,), 3.0, 40.0, 1e-6)
+    top = slab.face(5)
+    rng = np.random.default_rng(5)
+    budgets = []
+    centres = _near_the_rim(top, rng, 40)
+    for _ in range(40):
+        u, w = rng.uniform(*top.u_range), rng.uniform(*top.w_range)
+        centres.append(top.point(u, w) + 3.0 * top.normal(u, w))
+    for p in centres:
+        if fast.margin(p)[0] < 0.0:
+            continue
+        b = fast.budget(p)
+        budgets.append(b)
+        if b <= 0.0:
+            continue
+        for r in (b * 0.999, b * 0.5):
+            d = rng.normal(size=(4, 3))
+            for q in p + r * d / np.linalg.norm(d, axis=1)[:, None]:
+                assert exact.margin(q)[0] >= 0.0, (p, b, q)
+    assert np.count_nonzero(np.array(budgets) > 0.2) > 20
+
+
+def test_height_cell_budget_is_a_ball_of_proofs(slab):
+    """HeightCells.budget(p) = B: the proof holds afresh (a new HeightCells, no cache) at
+    centres within B of p."""
+    top = slab.face(5)
+    cells = HeightCells(top)
+    rng = np.random.default_rng(6)
+    checked = 0
+    for _ in range(60):
+        u, w = rng.uniform(*top.u_range), rng.uniform(*top.w_range)
+        p = top.point(u, w) + 3.0 * top.normal(u, w)
+        b = cells.budget(p)
+        if b <= 0.0:
+            continue
+        for q in p + b * 0.999 * np.vstack([np.eye(3), -np.eye(3)]):
+            fresh = HeightCells.__new__(HeightCells)
+            fresh.__dict__.update(cells.__dict__, _proof=None)
+            assert fresh.budget(q) >= 0.0
+            checked += 1
+    assert checked > 60
