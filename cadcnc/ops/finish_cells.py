@@ -226,7 +226,8 @@ class HeightCells:
         us, ws = _cells(face, cell_mm)
         self.boxes = np.ascontiguousarray(_Boxes(face).grid(us, ws).reshape(-1, 6))
         uc, wc = 0.5 * (us[1:] + us[:-1]), 0.5 * (ws[1:] + ws[:-1])
-        inside = [face.point(u, w) for u in uc for w in wc if face.classify(u, w) != OUTSIDE]
+        self.uv = np.array([(u, w) for u in uc for w in wc if face.classify(u, w) != OUTSIDE])
+        inside = [face.point(u, w) for u, w in self.uv.tolist()]
         self.points = np.array(inside) if inside else np.zeros((0, 3))
         self.tree = cKDTree(self.points) if inside else None
         self._bucket()

@@ -118,6 +118,10 @@ class FinishGuard(ClearanceGuard):
         self._walls: dict = {}
         self.proven_calls = 0
 
+    def height_cells(self, k: int) -> HeightCells | None:
+        """The height cells of followed face k (None when it has none)."""
+        return self._cells.get(k)
+
     def _wall(self, k: int) -> WallProof | None:
         """The proof of third face k when it hangs from the followed face, else None."""
         if k not in self._walls:
