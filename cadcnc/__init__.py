@@ -33,6 +33,7 @@ _LAZY = {
     "gouge_gate": "verification",
     "pencil": "ops.pencil", "finish": "ops.finish", "Program": "program.program",
     "to_cq": "io.program_cq", "to_cq_compound": "io.program_cq",
+    "show_program": "io.program_cq",
 }
 
 __all__ = [

@@ -17,6 +17,8 @@ from importlib.metadata import version
 from cadcnc.errors import CadcncError  # light: the package loads OCCT lazily
 from cadcnc.interrupts import sigint_deferred
 
+from .operation import DEFAULT_FEED, DEFAULT_PERIOD
+
 UNITS = "Units: lengths mm, feed mm/min, period with a unit (4ms, 0.004s, 250us)."
 
 
@@ -37,9 +39,11 @@ def _job_options(p, required: bool) -> None:
     p.add_argument("--radius", required=required, metavar="R", help="ball radius, mm")
     p.add_argument("--allowance", default="0", metavar="C",
                    help="stock allowance left on both faces, mm (default 0)")
-    p.add_argument("--feed", required=required, metavar="F", help="feed, mm/min")
-    p.add_argument("--period", required=required, metavar="T",
-                   help="interpolation period with its unit: 4ms, 0.004s or 250us")
+    p.add_argument("--feed", default=DEFAULT_FEED, metavar="F",
+                   help=f"feed, mm/min (default {DEFAULT_FEED})")
+    p.add_argument("--period", default=DEFAULT_PERIOD, metavar="T",
+                   help=f"interpolation period with its unit: 4ms, 0.004s or 250us (default "
+                        f"{DEFAULT_PERIOD}: a 0.1 mm step at {DEFAULT_FEED} mm/min)")
     p.add_argument("--start", metavar="X,Y,Z",
                    help="start point near the intersection, mm (default: the shared "
                         "concave edge's start)")
@@ -157,7 +161,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = add("verify", "check a path against OCCT (gouge gate for pipelines)",
             "Verify a path against geometry computed independently by OCCT: either compute it "
-            "(PART.step --faces I J --radius R --feed F --period T) or read it (PATH.json "
+            "(PART.step --faces I J --radius R [--feed F --period T]) or read it (PATH.json "
             "[--part PART.step]). Exit 5 when the ball cuts the part deeper than "
             "--gouge-tolerance.")
     p.add_argument("input", metavar="PART.step|PATH.json")

@@ -16,7 +16,7 @@ from cadcnc.errors import InputError  # light: OCCT is imported in finish_comman
 from cadcnc.units import parse_duration, parse_feed, parse_length
 
 from .feedback import say_error
-from .pencil import DEFAULT_FEED, DEFAULT_PERIOD, SUFFIXES, _skipped_line, gate_and_write
+from .operation import SUFFIXES, add_operation_options, gate_and_write, skipped_line
 
 PROGRESS_EVERY_S = 1.0  # s between two progress lines on stderr
 
@@ -46,17 +46,7 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
                    help="zigzag (default: every other pass reversed, staying down where the "
                         "move is verified clear) or oneway (every pass the same way, "
                         "retracting between)")
-    p.add_argument("--allowance", default="0", metavar="C",
-                   help="stock allowance left on the faces, mm (default 0)")
-    p.add_argument("--feed", default=DEFAULT_FEED, metavar="F",
-                   help=f"feed, mm/min (default {DEFAULT_FEED})")
-    p.add_argument("--period", default=DEFAULT_PERIOD, metavar="T",
-                   help=f"interpolation period with its unit (default {DEFAULT_PERIOD}: "
-                        "a 0.1 mm step at 1500 mm/min)")
-    p.add_argument("--plunge-feed", metavar="F",
-                   help="feed of the plunges in the links, mm/min (default: --feed)")
-    p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
-                   help="output: .json, .ngc, .csv, .png or .glb; repeat for several")
+    add_operation_options(p, "stock allowance left on the faces")
     job_flip(p)
     gouge(p)
     gcode(p)
@@ -95,7 +85,7 @@ def finish_command(args) -> int:
     t_cut = time.monotonic() - t0
     if not program.cuts:
         raise InputError(f"{args.step}: no pass cuts faces {' '.join(map(str, args.faces))}"
-                         f" with a {radius:g} mm ball ({_skipped_line(program) or 'nothing'})")
+                         f" with a {radius:g} mm ball ({skipped_line(program) or 'nothing'})")
     title = f"finish R {radius:g} of {Path(args.step).name}"
     return gate_and_write(args, program, part, outputs, "finish", title, JOIN,
                           lambda p: _summary(p, args.step, time.monotonic() - t0, t_cut))
@@ -132,7 +122,7 @@ def _summary(program, step: str, seconds: float, t_cut: float) -> str:
         f"{job.period * 1000:g} ms (step {job.step:.3g} mm)",
         f"  passes     {len(program.cuts)} cuts; {down} links between them stay down, "
         f"{len(links) - down} retract; skipped {len(program.skipped)}"
-        + (f" ({_skipped_line(program)})" if program.skipped else ""),
+        + (f" ({skipped_line(program)})" if program.skipped else ""),
         *[f"  {n}" for n in program.notes],
         f"  lengths    cut {t['cut_length_mm']:.1f} mm, links {t['link_length_mm']:.1f} mm; "
         f"time at feed {t['time_at_feed_s']:.1f} s",

@@ -12,7 +12,7 @@ from cadcnc.job import Job, PairPath, Tool, check_number
 from cadcnc.tolerances import DEFAULT, Tolerances
 from cadcnc.units import parse_duration, parse_feed, parse_length, parse_point
 
-JOB_OPTIONS = ("faces", "radius", "feed", "period")
+JOB_OPTIONS = ("faces", "radius")  # feed and period have defaults (cli/operation.py)
 
 
 def tolerances(args) -> Tolerances:

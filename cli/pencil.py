@@ -8,8 +8,6 @@ then every move of the whole program, links included, as written), 5 a gouge, 6 
 
 from __future__ import annotations
 
-import csv
-import io
 import time
 from pathlib import Path
 
@@ -17,10 +15,7 @@ from cadcnc.errors import InputError  # light: OCCT is imported in pencil_comman
 from cadcnc.units import parse_duration, parse_feed, parse_length
 
 from .feedback import say_error
-
-SUFFIXES = (".json", ".ngc", ".csv", ".png", ".glb")
-DEFAULT_FEED = "1500"  # mm/min; equal to cadcnc.ops.pencil.DEFAULT_FEED (a test checks)
-DEFAULT_PERIOD = "4ms"  # equal to cadcnc.ops.pencil.DEFAULT_PERIOD (a test checks)
+from .operation import SUFFIXES, add_operation_options, gate_and_write, skipped_line
 
 
 def add_parser(add, job_flip, gouge, gcode) -> None:
@@ -33,39 +28,15 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
             "(program), .ngc, .csv (a row per cut point), .png or .glb (picture).")
     p.add_argument("step", metavar="PART.step", help="the part (STEP file, mm)")
     p.add_argument("--radius", required=True, metavar="R", help="ball radius, mm")
-    p.add_argument("--allowance", default="0", metavar="C",
-                   help="stock allowance left on every face, mm (default 0)")
-    p.add_argument("--feed", default=DEFAULT_FEED, metavar="F",
-                   help=f"feed, mm/min (default {DEFAULT_FEED})")
-    p.add_argument("--period", default=DEFAULT_PERIOD, metavar="T",
-                   help=f"interpolation period with its unit (default {DEFAULT_PERIOD}: "
-                        "a 0.1 mm step at 1500 mm/min)")
+    add_operation_options(p, "stock allowance left on every face")
     p.add_argument("--faces", nargs="+", type=int, metavar="N",
                    help="only corners whose two faces are among these (default: all)")
     p.add_argument("--side", choices=("climb", "conventional"), default="climb",
                    help="direction along the corners (default climb: material on the "
                         "right of the travel, clockwise spindle)")
-    p.add_argument("--plunge-feed", metavar="F",
-                   help="feed of the plunges in the links, mm/min (default: --feed)")
-    p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
-                   help="output: .json, .ngc, .csv, .png or .glb; repeat for several")
     job_flip(p)
     gouge(p)
     gcode(p)
-
-
-def program_csv(program) -> str:
-    """One row per cut point: segment number (1-based among all segments), faces, x y z."""
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["segment", "face_i", "face_j", "x_mm", "y_mm", "z_mm"])
-    for k, seg in enumerate(program.segments, 1):
-        if seg.kind != "cut":
-            continue
-        i, j = seg.path.faces
-        for p in seg.points:
-            w.writerow([k, i, j, f"{p[0]:.6f}", f"{p[1]:.6f}", f"{p[2]:.6f}"])
-    return buf.getvalue()
 
 
 def pencil_command(args) -> int:
@@ -94,7 +65,7 @@ def pencil_command(args) -> int:
     t_cut = time.monotonic() - t0
     if not program.cuts:
         raise InputError(f"{args.step}: no corner to cut with a {radius:g} mm ball "
-                         f"({_skipped_line(program) or 'no concave corner found'})")
+                         f"({skipped_line(program) or 'no concave corner found'})")
     title = f"pencil R {radius:g} of {Path(args.step).name}"
 
     def summary(p) -> str:   # called once the program is gated: verification time known
@@ -102,51 +73,6 @@ def pencil_command(args) -> int:
         return _summary(p, args.step, time.monotonic() - t0, t_cut, times)
 
     return gate_and_write(args, program, part, outputs, "pencil", title, CHAIN_GAP, summary)
-
-
-def gate_and_write(args, program, part, outputs, what: str, title: str, join: float,
-                   summary) -> int:
-    """The end of an operation's command: cut gouging cuts back (unless --allow-gouge),
-    gate the whole program as written, print ``summary(program)``, write the outputs by
-    suffix; returns the exit code (0, 5 gouge, 6 partial)."""
-    from cadcnc.io.program_gcode import program_ngc
-    from cadcnc.io.program_json import program_json
-    from cadcnc.io.program_plot import program_picture_bytes
-    from cadcnc.ops.pair_program import safe_height
-    from cadcnc.verification.cut_back import cut_back
-
-    from .options import program_gcode_options
-    from .program_commands import judge_program
-
-    gopts = program_gcode_options(args)
-    if not args.allow_gouge:  # a gouging cut is cut back and listed, not the program lost
-        program = cut_back(program, part, safe_height(part, program.job), join)
-        if not program.cuts:
-            raise InputError(f"{args.step}: every cut gouges the part: "
-                             f"{_skipped_line(program)}")
-    ngc = program_ngc(program, title=title, **gopts)
-    write, code = judge_program(args, program, part, what, gopts)
-    if not args.quiet:
-        print(summary(program))
-    if not write:
-        return code
-    contents = {}
-    for out in args.output:
-        suffix = Path(out).suffix.lower()
-        contents[out] = (program_json(program) if suffix == ".json" else ngc
-                         if suffix == ".ngc" else program_csv(program) if suffix == ".csv"
-                         else program_picture_bytes(program, part, out, title))
-    outputs.write(contents)
-    if not args.quiet:
-        print(f"  wrote      {', '.join(args.output)}")
-    return code
-
-
-def _skipped_line(program) -> str:
-    counts: dict[str, int] = {}
-    for s in program.skipped:
-        counts[s.reason] = counts.get(s.reason, 0) + 1
-    return ", ".join(f"{n} {r}" for r, n in sorted(counts.items()))
 
 
 def _summary(program, step: str, seconds: float, t_cut: float, times: dict) -> str:
@@ -160,7 +86,7 @@ def _summary(program, step: str, seconds: float, t_cut: float, times: dict) -> s
         f"{job.tool.allowance:g} mm, feed {job.feed:g} mm/min, period "
         f"{job.period * 1000:g} ms (step {job.feed / 60 * job.period:.3g} mm)",
         f"  corners    {len(program.cuts)} cuts in {chains} chains; skipped "
-        f"{len(program.skipped)}" + (f" ({_skipped_line(program)})" if program.skipped else ""),
+        f"{len(program.skipped)}" + (f" ({skipped_line(program)})" if program.skipped else ""),
         f"  lengths    cut {t['cut_length_mm']:.1f} mm, links {t['link_length_mm']:.1f} mm; "
         f"time at feed {t['time_at_feed_s']:.1f} s",
         f"  status     {'complete' if program.complete else 'partial'}; computed in "

@@ -11,7 +11,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from cadcnc.cli import pencil as pencil_cli
+from cadcnc.cli import operation as operation_cli
 from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_json import read_program
 from cadcnc.ops import pencil as pencil_op
@@ -38,8 +38,8 @@ def commanded(prog) -> np.ndarray:
 
 
 def test_defaults_are_the_operations():
-    assert parse_feed(pencil_cli.DEFAULT_FEED) == pencil_op.DEFAULT_FEED
-    assert parse_duration(pencil_cli.DEFAULT_PERIOD) == pencil_op.DEFAULT_PERIOD
+    assert parse_feed(operation_cli.DEFAULT_FEED) == pencil_op.DEFAULT_FEED
+    assert parse_duration(operation_cli.DEFAULT_PERIOD) == pencil_op.DEFAULT_PERIOD
 
 
 def test_outputs_agree(block_run):

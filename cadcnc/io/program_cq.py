@@ -46,3 +46,17 @@ def to_cq_compound(program: Program, cuts: bool = True, links: bool = True):
     import cadquery as cq
 
     return cq.Compound.makeCompound(to_cq(program, cuts, links))
+
+
+def show_program(show, program: Program, part=None) -> None:
+    """Show a program in CQ-editor: ``show`` is its ``show_object``; the part (a Workplane,
+    Shape or Part, optional) translucent, the cuts in red, the links in blue."""
+    if part is not None:
+        shape = getattr(part, "tol", None) and part.shape   # a cadcnc Part: its OCCT shape
+        if shape is not None:
+            import cadquery as cq
+            part = cq.Shape.cast(shape)
+        show(part, name="part", options={"alpha": 0.6})
+    show(to_cq_compound(program, links=False), name="cuts", options={"color": "red"})
+    if program.links:
+        show(to_cq_compound(program, cuts=False), name="links", options={"color": "blue"})

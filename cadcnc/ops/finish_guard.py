@@ -28,6 +28,7 @@ compiled stepper then commits the steps inside it without asking. Lengths mm.
 from __future__ import annotations
 
 import math
+import weakref
 
 import numpy as np
 
@@ -110,9 +111,9 @@ class FinishGuard(ClearanceGuard):
     face rule is proven by :class:`HeightCells` where it can (module doc)."""
 
     def __init__(self, part, pair, offset: float, shank: float, tol: float = 1e-6,
-                 reach: float | None = None):
-        super().__init__(part, pair, offset, shank, tol, reach)
-        self._cells = {k: HeightCells(part.face(k)) for k in self.pair
+                 reach: float | None = None, own_tol: float = 1e-3):
+        super().__init__(part, pair, offset, shank, tol, reach, own_tol)
+        self._cells = {k: _shared(HeightCells, part.face(k)) for k in self.pair
                        if self._own_rule[k] and part.face(k).kind in BOUNDED_KINDS}
         self._trees: dict = {}
         self._walls: dict = {}
@@ -141,7 +142,7 @@ class FinishGuard(ClearanceGuard):
     def _segment_distance(self, k: int, p, length: float | None = None):
         if k not in self.pair and self._faces[k - 1].kind in BOUNDED_KINDS:
             if k not in self._trees:
-                self._trees[k] = BoxTree(self._faces[k - 1])
+                self._trees[k] = _shared(BoxTree, self._faces[k - 1])
             lb = self._trees[k].lower_bound(p, self.shank if length is None else length,
                                             self.threshold)
             if lb is not None:
@@ -184,6 +185,18 @@ class FinishGuard(ClearanceGuard):
                 mine = max(mine, self._walls[k].budget(p))
             room = min(room, mine)
         return max(room, 0.0)
+
+
+_SHARED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _shared(kind, face):
+    """The ``kind`` (HeightCells or BoxTree) of a face, built once and shared by every guard
+    of its part (pencil builds a guard per pair; a face is in several pairs)."""
+    per_face = _SHARED.setdefault(face, {})
+    if kind not in per_face:
+        per_face[kind] = kind(face)
+    return per_face[kind]
 
 
 def finish_guard(part, face: int, job) -> FinishGuard:

@@ -19,13 +19,13 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import GeometryError, InputError, StartPointError
-from ..geometry.clearance import guard_for
 from ..interp.cycle import BOUNDARY, COLLISION
 from ..interp.stepper import Tangency
 from ..job import Job
 from ..program.linking import linked
 from ..program.program import STOPPED_SHORT, CutSegment, Program, Skipped
 from ..program.toolpath import Toolpath, toolpath_from_record
+from .guard import operation_guard
 from .pair_path import PathPlan, plan_path, shared_edge_for, stepper_for
 from .stretch_paths import nearest_start, plan_for_stretch, refuse_without_stretch
 from .stretches import FEASIBLE, Feasibility, Stretch, pair_stretches
@@ -86,7 +86,7 @@ def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000, progress=Non
     if i is None or j is None:
         raise InputError("the job names no faces: give the two face numbers")
     s1, s2 = part.face(i), part.face(j)
-    guard = guard_for(part, (i, j), job)
+    guard = operation_guard(part, (i, j), job)
     if op.start is not None:
         return _from_start(part, job, s1, s2, guard, max_cycles, progress)
     shared_edge_for(s1, s2)  # FacePairError unless they share a concave edge

@@ -25,13 +25,13 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import CadcncError, InputError
-from ..geometry.clearance import ClearanceGuard, guard_for
 from ..geometry.part import Part
 from ..job import Job, PairPath, Tool
 from ..program.linking import linked, order_cuts
 from ..program.program import CutSegment, Program, Skipped
 from ..tolerances import DEFAULT, Tolerances
 from .corners import BLEND, EDGE, find_corners
+from .guard import operation_guard
 from .pair_program import CLIMB, CONVENTIONAL, _run, safe_height, stretch_cuts
 from .pair_path import plan_path
 from .stretches import Feasibility, edge_stretches, pair_stretches
@@ -83,7 +83,7 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
             s1, s2 = part.face(i), part.face(j)
             with clock("guards"):   # one per pair (its cache serves all its corners)
                 guard = guards.get((i, j)) or guards.setdefault(
-                    (i, j), guard_for(part, (i, j), cjob))
+                    (i, j), operation_guard(part, (i, j), cjob))
             if corner.kind == EDGE:
                 with clock("stretches"):
                     if (i, j) not in stretches:
@@ -157,7 +157,7 @@ def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float
     down to its first cut's start and left by a retract straight up from its last cut's
     end (:func:`~cadcnc.program.linking.link`). Such a point is reachable when the ball
     and a shank from it up to the link height ``z_safe`` (mm) clear the part by R' - 1 um
-    less the gate's tolerance (:class:`ClearanceGuard`, the stepper's guard with a longer
+    less the gate's tolerance (:func:`.guard.operation_guard`, the stepper's guard with a longer
     shank): not so in a sealed
     void, or under an overhang higher than the shank. A cut whose entry or exit is
     blocked is dropped and the rest ordered again (its neighbours may then need one)."""
@@ -169,8 +169,7 @@ def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float
     def blocked(cut: CutSegment, which: str, p) -> str | None:
         faces = cut.path.faces
         if faces not in guards:
-            guards[faces] = ClearanceGuard(part, faces, job.tool.offset, shank,
-                                           job.tolerances.hit)
+            guards[faces] = operation_guard(part, faces, job, shank=shank)
         margin, detail = guards[faces].margin(p)
         # a cut's end landed on a collision sits at margin ~0 (-1e-8 mm is landing
         # round-off): only a deeper hit blocks the way; the gate judges every move anyway

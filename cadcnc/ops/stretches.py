@@ -32,7 +32,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import GeometryError, StartPointError
-from ..geometry.clearance import ClearanceGuard, guard_for
+from ..geometry.clearance import ClearanceGuard
 from ..geometry.edge_curve import EdgeCurve
 from ..geometry.part import CONCAVE
 from ..interp.cycle import Contact
@@ -40,6 +40,7 @@ from ..interp.stepper import Tangency
 from ..interp.tangency import solve_tangency
 from ..job import Job
 from ..tolerances import Tolerances
+from .guard import operation_guard
 
 SPACING = 0.4       # mm of edge between samples (refined to MAX_CHORD of centres)
 MIN_SAMPLES = 9     # per edge
@@ -352,7 +353,7 @@ def pair_stretches(s1, s2, job: Job, guard: ClearanceGuard | None = None,
     part = s1.part
     edges = [e for e in part.shared_edges(s1.number, s2.number) if e.edge_class == CONCAVE]
     if guard is None:
-        guard = guard_for(part, (s1.number, s2.number), job)
+        guard = operation_guard(part, (s1.number, s2.number), job)
     feas = Feasibility(s1, s2, job, guard)
     return [edge_stretches(feas, e, k, spacing, (not _continued(e.start, e, edges),
                                                  not _continued(e.end, e, edges)))

@@ -2,8 +2,9 @@
 
 A block whose two long top edges are rounded (r 4 mm): a 2 mm ball finishes the top and
 both rounds in zigzag passes along them, 1 mm apart. ``cadcnc.finish`` takes the
-Workplane and a Workplane selection of its faces; ``cadcnc.to_cq`` turns the program
-into wires for ``show_object``. Run: ``python docs/examples/finish_example.py``.
+Workplane and a Workplane selection of its faces; ``cadcnc.show_program`` shows the
+program with ``show_object`` (``cadcnc.to_cq`` gives its wires). Run:
+``python docs/examples/finish_example.py``.
 """
 
 import cadquery as cq
@@ -18,12 +19,8 @@ summary = (f"finish R 2: {totals['cuts']} cuts, {totals['cut_length_mm']:.1f} mm
            f"{totals['link_length_mm']:.1f} mm of links, {totals['time_at_feed_s']:.1f} s "
            f"at feed")
 
-if "show_object" in globals():  # CQ-editor
-    show_object(block, name="part", options={"alpha": 0.6})  # noqa: F821
-    show_object(cadcnc.to_cq_compound(program, links=False), name="cuts",  # noqa: F821
-                options={"color": "red"})
-    show_object(cadcnc.to_cq_compound(program, cuts=False), name="links",  # noqa: F821
-                options={"color": "blue"})
+if "show_object" in globals():  # CQ-editor: the part, the cuts (red), the links (blue)
+    cadcnc.show_program(show_object, program, block)  # noqa: F821
 else:
     print(summary)
     for note in program.notes:

@@ -1,8 +1,10 @@
 """Pencil milling inside a CadQuery script: runs under CQ-editor and as a plain script.
 
 A block with a round pocket (r 8 mm, 5 deep) and a step along one side: a 2 mm ball
-cleans the pocket's floor-to-wall corner (one closed loop) and the step's corner. ``cadcnc.pencil`` takes the Workplane itself; ``cadcnc.to_cq`` turns the
-program into wires for ``show_object``. Run: ``python docs/examples/pencil_example.py``.
+cleans the pocket's floor-to-wall corner (one closed loop) and the step's corner.
+``cadcnc.pencil`` takes the Workplane itself; ``cadcnc.show_program`` shows the program
+with ``show_object`` (``cadcnc.to_cq`` gives its wires). Run:
+``python docs/examples/pencil_example.py``.
 """
 
 import cadquery as cq
@@ -19,12 +21,8 @@ summary = (f"pencil R 2: {totals['cuts']} cuts, {totals['cut_length_mm']:.1f} mm
            f"{totals['link_length_mm']:.1f} mm of links, {totals['time_at_feed_s']:.1f} s "
            f"at feed; {len(program.skipped)} corners skipped")
 
-if "show_object" in globals():  # CQ-editor
-    show_object(block, name="part", options={"alpha": 0.6})  # noqa: F821
-    show_object(cadcnc.to_cq_compound(program, links=False), name="cuts",  # noqa: F821
-                options={"color": "red"})
-    show_object(cadcnc.to_cq_compound(program, cuts=False), name="links",  # noqa: F821
-                options={"color": "blue"})
+if "show_object" in globals():  # CQ-editor: the part, the cuts (red), the links (blue)
+    cadcnc.show_program(show_object, program, block)  # noqa: F821
 else:
     print(summary)
     for s in program.skipped:
