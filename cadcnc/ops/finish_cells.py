@@ -33,6 +33,7 @@ check runs. Lengths mm.
 from __future__ import annotations
 
 import math
+import weakref
 
 import numba
 import numpy as np
@@ -297,6 +298,18 @@ class HeightCells:
         """Whether the shank above the ball centre ``p`` provably comes no nearer to the
         face than the ball does (module doc)."""
         return self.budget(p) >= 0.0
+
+
+_SHARED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def shared(kind, face):
+    """The ``kind`` (HeightCells or BoxTree) of a face, built once and shared by every guard
+    of its part (pencil builds a guard per pair; a face is in several pairs)."""
+    per_face = _SHARED.setdefault(face, {})
+    if kind not in per_face:
+        per_face[kind] = kind(face)
+    return per_face[kind]
 
 
 def _dist(a, b) -> float:

@@ -28,12 +28,12 @@ compiled stepper then commits the steps inside it without asking. Lengths mm.
 from __future__ import annotations
 
 import math
-import weakref
 
 import numpy as np
 
 from ..geometry.clearance import BOX_SLACK, ClearanceGuard, _dist
 from .finish_cells import BOUNDED_KINDS, CELL_MM, HeightCells, _Boxes, _cells
+from .finish_cells import shared as _shared
 from .finish_walls import WallProof, hangs_from
 
 __all__ = ["BoxTree", "FinishGuard", "HeightCells", "_Boxes", "finish_guard"]
@@ -185,18 +185,6 @@ class FinishGuard(ClearanceGuard):
                 mine = max(mine, self._walls[k].budget(p))
             room = min(room, mine)
         return max(room, 0.0)
-
-
-_SHARED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
-def _shared(kind, face):
-    """The ``kind`` (HeightCells or BoxTree) of a face, built once and shared by every guard
-    of its part (pencil builds a guard per pair; a face is in several pairs)."""
-    per_face = _SHARED.setdefault(face, {})
-    if kind not in per_face:
-        per_face[kind] = kind(face)
-    return per_face[kind]
 
 
 def finish_guard(part, face: int, job) -> FinishGuard:

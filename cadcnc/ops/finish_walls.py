@@ -39,7 +39,7 @@ from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.TopoDS import TopoDS
 
 from ..trim import INSIDE, OUTSIDE
-from .finish_cells import DROPS, REUSE, SEARCH, HeightCells
+from .finish_cells import DROPS, REUSE, SEARCH, HeightCells, shared
 
 VERTICAL = 1e-12   # |1 - |d_z|| below this: a direction is vertical
 PROBE = 1e-4       # the classification's step off an edge, as a fraction of the v range
@@ -109,7 +109,7 @@ class WallProof:
     """The cached proof that a wall hanging from the followed face is clear (module doc)."""
 
     def __init__(self, face, need: float):
-        self.cells = HeightCells(face)
+        self.cells = shared(HeightCells, face)
         self.need = float(need)       # R' - tol
         self._proof: tuple | None = None   # (x0, y0, z0, rho0)
 
