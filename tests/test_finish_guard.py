@@ -177,3 +177,52 @@ def test_height_cell_budget_is_a_ball_of_proofs(slab):
             assert fresh.budget(q) >= 0.0
             checked += 1
     assert checked > 60
+
+
+@pytest.fixture(scope="module")
+def stepped():
+    """A 40 x 30 x 10 box with a 10 x 10 x 5 block on its top: planar walls hang from the
+    top's outer edges; the block's walls rise from it."""
+    import cadquery as cq
+    base = cq.Workplane().box(40, 30, 10)
+    shape = base.union(cq.Workplane().box(10, 10, 5).translate((0, 0, 7.5))).val().wrapped
+    part = cadcnc.Part(shape, source="stepped box")
+    top = [k for k in range(1, len(part) + 1) if part.face(k).kind == "plane"
+           and abs(part.face(k).point(*[np.mean(r) for r in (part.face(k).u_range,
+                                                            part.face(k).w_range)])[2] - 5.0)
+           < 1e-9]
+    return part, top[0]
+
+
+def test_planar_walls_hang_from_the_top_and_rising_ones_do_not(stepped):
+    from cadcnc.ops.finish_walls import hangs_from
+    part, top = stepped
+    guard = FinishGuard(part, (top,), 3.0, 40.0, 1e-6)
+    answers = {}
+    for k in range(1, len(part) + 1):
+        f = part.face(k)
+        if k == top or f.kind != "plane":
+            continue
+        lo, hi = f.u_range, f.w_range
+        z = [f.point(u, w)[2] for u in lo for w in hi]
+        answers[k] = (min(z), max(z), hangs_from(f, guard._own_shapes))
+    hanging = [k for k, (z0, z1, h) in answers.items() if h]
+    assert len(hanging) == 4 and all(answers[k][1] == 5.0 for k in hanging)   # the sides
+    rising = [k for k, (z0, z1, h) in answers.items() if z0 == 5.0 and z1 == 10.0]
+    assert len(rising) == 4 and not any(answers[k][2] for k in rising)          # the block's
+
+
+def test_planar_wall_proof_never_clears_a_hit(stepped):
+    part, top = stepped
+    exact = ClearanceGuard(part, (top,), 3.0, 40.0, 1e-6)
+    fast = FinishGuard(part, (top,), 3.0, 40.0, 1e-6)
+    rng = np.random.default_rng(7)
+    hits = 0
+    for _ in range(150):
+        p = np.array([rng.uniform(-23, 23), rng.uniform(-18, 18),
+                      8.0 + rng.choice([0.0, -1e-3, -0.5, 0.3, -3.0])])
+        m_fast, m_exact = fast.margin(p)[0], exact.margin(p)[0]
+        assert not (m_fast >= 0.0 > m_exact), (p, m_fast, m_exact)
+        hits += m_exact < 0.0
+    assert hits > 5
+    assert sum(w.cells.searches for w in fast._walls.values() if w is not None) > 20

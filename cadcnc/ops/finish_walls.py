@@ -6,13 +6,13 @@ E), so a box bound cannot clear the wall and OCCT's distance ran at every step t
 the guard's rule counts it clear because the wall's nearest points are on E (a contact
 on an edge of F belongs to F's own rules).
 
-**The structure** (checked once per wall K by :func:`hangs_from`): K is an extrusion
-along Z (its generators vertical), and the top of every vertical run of K lies on an
-edge or vertex of F: every other edge of K is either a vertical generator whose top
-vertex is one of F's, or a lower boundary (K lies above it), its pcurve a graph over the
-curve parameter u (a line not parallel to v, or a B-spline whose poles' u are strictly
-monotone: a monotone control polygon gives a monotone curve) classified once just above
-and below.
+**The structure** (checked once per wall K by :func:`hangs_from`): K's generators are
+vertical (an extrusion along Z, a vertical plane), and the top of every vertical run of K
+lies on an edge or vertex of F: every other edge of K is either a vertical generator
+whose top vertex is one of F's, or a lower boundary (K lies above it), its pcurve a graph
+across the generators (a line not along them, or a B-spline whose poles run strictly one
+way: a monotone control polygon gives a monotone curve) classified once just above and
+below.
 
 **The proof at a centre p** (segment S from p up to p + L z), with z0 <= p_z and rho0
 the least horizontal distance from p to K's cell boxes topping z0
@@ -45,25 +45,42 @@ VERTICAL = 1e-12   # |1 - |d_z|| below this: a direction is vertical
 PROBE = 1e-4       # the classification's step off an edge, as a fraction of the v range
 
 
+def _frame(face) -> tuple[np.ndarray, np.ndarray] | None:
+    """(up, across) unit directions in the face's (u, w) parameters when its surface's
+    generators are vertical lines (u, w) + t up mapped to p + t z: an extrusion along Z,
+    or a vertical plane; else None."""
+    if face.kind == "extrusion":
+        dz = face._adaptor.Direction().Z()
+        if abs(abs(dz) - 1.0) > VERTICAL:
+            return None
+        return np.array([0.0, dz]), np.array([1.0, 0.0])
+    if face.kind == "plane":
+        pos = face._adaptor.Plane().Position()
+        up = np.array([pos.XDirection().Z(), pos.YDirection().Z()])
+        if abs(np.linalg.norm(up) - 1.0) > VERTICAL:
+            return None
+        return up, np.array([up[1], -up[0]])
+    return None
+
+
 def hangs_from(face, own_shapes) -> bool:
-    """Whether ``face`` is an extrusion along Z whose every vertical run tops out on one of
-    ``own_shapes`` (a TopTools_IndexedMapOfShape of the followed face's edges and vertices;
-    module doc). Anything unusual answers False (no proof: the exact check runs)."""
-    if face.kind != "extrusion":
-        return False
-    up = face._adaptor.Direction().Z()
-    if abs(abs(up) - 1.0) > VERTICAL:
+    """Whether ``face``'s generators are vertical (an extrusion along Z, a vertical plane)
+    and its every vertical run tops out on one of ``own_shapes`` (a
+    TopTools_IndexedMapOfShape of the followed faces' edges and vertices; module doc).
+    Anything unusual answers False (no proof: the exact check runs)."""
+    frame = _frame(face)
+    if frame is None:
         return False
     edges = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(face.topods, TopAbs_EDGE, edges)
-    (_, _), (w0, w1) = face.u_range, face.w_range
-    step = PROBE * (w1 - w0)
+    (u0, u1), (w0, w1) = face.u_range, face.w_range
+    step = PROBE * max(u1 - u0, w1 - w0)
     try:
         for n in range(1, edges.Extent() + 1):
             edge = TopoDS.Edge_s(edges.FindKey(n))
             if own_shapes.Contains(edge):
                 continue
-            if BRep_Tool.Degenerated_s(edge) or not _lower_or_vertical(face, edge, up, step,
+            if BRep_Tool.Degenerated_s(edge) or not _lower_or_vertical(face, edge, frame, step,
                                                                         own_shapes):
                 return False
     except Exception:   # noqa: BLE001 - any trouble reading the topology: no proof
@@ -71,9 +88,9 @@ def hangs_from(face, own_shapes) -> bool:
     return True
 
 
-def _lower_or_vertical(face, edge, up: float, step: float, own_shapes) -> bool:
+def _lower_or_vertical(face, edge, frame, step: float, own_shapes) -> bool:
     """Whether a (not own) edge of the wall is a vertical generator whose top vertex is
-    own, or a lower boundary whose pcurve is a graph over u (module doc)."""
+    own, or a lower boundary whose pcurve is a graph across the generators (module doc)."""
     curve = BRepAdaptor_Curve(edge)
     if curve.GetType() == GeomAbs_Line and abs(abs(curve.Line().Direction().Z()) - 1.0) \
             <= VERTICAL:
@@ -82,26 +99,29 @@ def _lower_or_vertical(face, edge, up: float, step: float, own_shapes) -> bool:
         tops = [verts.FindKey(k) for k in range(1, verts.Extent() + 1)]
         z = [BRep_Tool.Pnt_s(TopoDS.Vertex_s(v)).Z() for v in tops]
         return own_shapes.Contains(tops[int(np.argmax(z))])
+    up, across = frame
     pcurve = BRepAdaptor_Curve2d(edge, face.topods)
-    if not _monotone_in_u(pcurve):
+    if not _monotone(pcurve, across):
         return False
     mid = pcurve.Value(0.5 * (pcurve.FirstParameter() + pcurve.LastParameter()))
     u, v = mid.X(), mid.Y()
     # the wall lies above a lower boundary: inside one probe up, outside one probe down
-    return face.classify(u, v + up * step) == INSIDE and \
-        face.classify(u, v - up * step) == OUTSIDE
+    return face.classify(u + step * up[0], v + step * up[1]) == INSIDE and \
+        face.classify(u - step * up[0], v - step * up[1]) == OUTSIDE
 
 
-def _monotone_in_u(pcurve) -> bool:
-    """Whether a pcurve's u is strictly monotone (a line not along v, or a B-spline whose
-    poles' u are)."""
+def _monotone(pcurve, across: np.ndarray) -> bool:
+    """Whether a pcurve runs strictly one way ``across`` the generators (a line not along
+    them, or a B-spline whose poles do: a monotone control polygon, a monotone curve)."""
     kind = pcurve.GetType()
     if kind == GeomAbs_Line:
-        return abs(pcurve.Line().Direction().X()) > VERTICAL
+        d = pcurve.Line().Direction()
+        return abs(d.X() * across[0] + d.Y() * across[1]) > VERTICAL
     if kind == GeomAbs_BSplineCurve:
         poles = pcurve.BSpline().Poles()
-        u = np.diff([poles.Value(k).X() for k in range(poles.Lower(), poles.Upper() + 1)])
-        return bool((u > 0).all() or (u < 0).all())
+        h = np.diff([poles.Value(k).X() * across[0] + poles.Value(k).Y() * across[1]
+                     for k in range(poles.Lower(), poles.Upper() + 1)])
+        return bool((h > 0).all() or (h < 0).all())
     return False
 
 
