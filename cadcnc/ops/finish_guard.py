@@ -140,7 +140,12 @@ class FinishGuard(ClearanceGuard):
         return super()._exact(k, p)
 
     def _segment_distance(self, k: int, p, length: float | None = None):
+        """As ClearanceGuard's, with a third face's box tree between its closed forms
+        (first: exact and cheaper) and OCCT's distance."""
         if k not in self.pair and self._faces[k - 1].kind in BOUNDED_KINDS:
+            d = self._closed_segment_distance(k, p, self.shank if length is None else length)
+            if d is not None:
+                return d, False
             if k not in self._trees:
                 self._trees[k] = _shared(BoxTree, self._faces[k - 1])
             lb = self._trees[k].lower_bound(p, self.shank if length is None else length,
