@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 import cadcnc
-from cadcnc.ops.finish_polish import _derivatives
+from cadcnc.ops.finish_polish import face_derivatives
 
 from conftest import FIXTURES
 
@@ -16,7 +16,7 @@ def test_compiled_derivatives_are_occts():
         face = part.face(k)
         rng = np.random.default_rng(k)
         uv = np.c_[rng.uniform(*face.u_range, 200), rng.uniform(*face.w_range, 200)]
-        got = _derivatives(face, uv)
+        got = face_derivatives(face, uv)
         want = np.array([face.derivative_tuples(u, w) for u, w in uv]).reshape(-1, 6, 3)
         assert face.kernel is not None
         assert np.abs(got - want).max() < 1e-9

@@ -33,7 +33,7 @@ def _d2_points(kind: int, params: np.ndarray, ints: np.ndarray, knots_u: np.ndar
     return True
 
 
-def _derivatives(surface, uv: np.ndarray) -> np.ndarray:
+def face_derivatives(surface, uv: np.ndarray) -> np.ndarray:
     """(N, 6, 3) r, r_u, r_w, r_uu, r_uw, r_ww at uv (N, 2): compiled where the face has
     the kernel's data (the same numbers as OCCT's D2), else OCCT's, point by point."""
     data = getattr(surface, "kernel", None)
@@ -52,7 +52,7 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _offset_points(surface, offset: float, uv: np.ndarray):
     """(c (N, 3), Jacobian columns c_u, c_w (N, 3) each, r (N, 3), n (N, 3)) at uv (N, 2)."""
-    d = _derivatives(surface, uv)
+    d = face_derivatives(surface, uv)
     r, ru, rw, ruu, ruw, rww = (d[:, k] for k in range(6))
     m = _cross(ru, rw)
     mn = np.linalg.norm(m, axis=1)[:, None]
