@@ -3,9 +3,11 @@
 Per fixture pair (ball 3 mm, f = 0.1 mm): per step (``Stepper.step`` from Python, record
 off; compiled and the plain-Python reference) against two bare OCCT D2 calls from Python
 with their .Coord() calls; per cycle with the loop compiled (``Stepper.run``); the whole
-path (``intersection_path`` from faces with nothing cached: trim classifier, SurfaceData
-and trim grids built inside) against ``GeomAPI_IntSS`` of the two offset surfaces, best of
-15 interleaved runs each, CPU and wall time, with the trim-grid build separately; latency
+path (``intersection_path``) cold (the faces' caches emptied by ``clear_caches``: trim
+classifier, SurfaceData, trim grids and projectors built inside the timed call) and warm
+(kept from the previous path on the same faces) against ``GeomAPI_IntSS`` of the two
+offset surfaces, best of 15 interleaved runs each, CPU and wall time, with the trim-grid
+build separately (``--whole``: only this); latency
 p50 / p99 / p99.9 / max over ``--steps`` steps with GC off, measured five ways
 (benchmarks/latency.py: raw, SCHED_FIFO pinned, kernel-only as the minimum of three
 lockstep replays, CPU time, and this machine's floor); a landing step against the median
@@ -15,6 +17,7 @@ records a run. Times are minima or percentiles of perf_counter_ns (wall) or thre
 (CPU), in microseconds; the latency methods are latency.py's.
 
     .venv/bin/python benchmarks/bench_kernel.py [--steps 100000] [--streamed 1000000]
+    .venv/bin/python benchmarks/bench_kernel.py --whole
 """
 
 from __future__ import annotations
@@ -115,48 +118,49 @@ def bare_d2(plan, n: int = 20000) -> float:
     return best / 1000.0
 
 
-def int_ss(surfaces) -> tuple[float, float]:
-    """(wall us, CPU us) of one GeomAPI_IntSS of the two surfaces at tolerance 1e-7
-    (OCCT's default precision)."""
+def int_ss(surfaces) -> dict:
+    """{wall, cpu} (us) of one GeomAPI_IntSS of the two surfaces at tolerance 1e-7 (OCCT's
+    default precision)."""
     t0, c0 = clock(), cpu_clock()
     inter = GeomAPI_IntSS(surfaces[0], surfaces[1], 1e-7)
     cpu, wall = cpu_clock() - c0, clock() - t0
     assert inter.IsDone() and inter.NbLines() > 0
-    return wall / 1000.0, cpu / 1000.0
+    return {"wall": wall / 1000.0, "cpu": cpu / 1000.0}
 
 
-def whole_path(part, i: int, j: int) -> dict:
-    """One intersection_path from faces with nothing cached (their trim classifier,
-    evaluator data and trim grids are rebuilt inside the timed call: planning includes
-    them): wall and CPU us, the grid builds' share (wall us), points."""
+def whole_path(part, i: int, j: int, cold: bool = True) -> dict:
+    """One intersection_path: wall and CPU us, the grid builds' share (wall us, cold only),
+    points. ``cold``: the faces' caches emptied first (``FaceSurface.clear_caches``: trim
+    classifier, SurfaceData, trim grids and point projectors rebuilt inside the timed call,
+    as on the first path of a freshly loaded part); warm: kept from the previous path.
+    The part's adjacency (its edges classified once per part) is built before, in both."""
     fa, fb = part.face(i), part.face(j)
-    for f in (fa, fb):
-        f._kernel = f._classifier = None
+    if cold:
+        for f in (fa, fb):
+            f.clear_caches()
     t0, c0 = clock(), cpu_clock()
     tp = cadcnc.intersection_path(fa, fb, radius=R, feed=FEED, period=PERIOD)
     cpu, wall = cpu_clock() - c0, clock() - t0
-    grids = sum(f.kernel[1].stats["build_s"] for f in (fa, fb)) * 1e9
+    grids = sum(f.kernel[1].stats["build_s"] for f in (fa, fb)) * 1e9 if cold else 0.0
     return {"wall": wall / 1000.0, "cpu": cpu / 1000.0, "grids": grids / 1000.0,
             "points": len(tp.points)}
 
 
-def path_vs_intss(part, i: int, j: int, plan, reps: int = 15) -> tuple[dict, dict]:
-    """Best of ``reps`` interleaved runs (each minimum on its own) of the whole path and of
-    GeomAPI_IntSS of the same two offset surfaces (each face's surface offset by its path
-    offset along the outward normal): ({wall, cpu, grids, points}, {wall, cpu})."""
+def path_vs_intss(part, i: int, j: int, plan, reps: int = 15) -> tuple[dict, dict, dict]:
+    """Best of ``reps`` interleaved runs (each minimum on its own) of the whole path cold
+    and warm and of GeomAPI_IntSS of the same two offset surfaces (each face's surface
+    offset by its path offset along the outward normal): ({wall, cpu, grids, points} cold,
+    the same warm, {wall, cpu}); each figure is its own minimum over the runs."""
     surfaces = [Geom_OffsetSurface(s.geom_surface, s.normal_sign * off)
                 for s, off in zip((plan.s1, plan.s2), plan.offsets)]
     whole_path(part, i, j)                                      # warm-up
-    path = {"wall": float("inf"), "cpu": float("inf")}
-    ss = {"wall": float("inf"), "cpu": float("inf")}
+    best = [{"wall": float("inf"), "cpu": float("inf")} for _ in range(3)]
     for _ in range(reps):
-        run = whole_path(part, i, j)
-        if run["cpu"] < path["cpu"]:
-            path.update(cpu=run["cpu"], grids=run["grids"], points=run["points"])
-        path["wall"] = min(path["wall"], run["wall"])
-        wall, cpu = int_ss(surfaces)
-        ss.update(wall=min(ss["wall"], wall), cpu=min(ss["cpu"], cpu))
-    return path, ss
+        runs = whole_path(part, i, j), whole_path(part, i, j, cold=False), int_ss(surfaces)
+        for b, run in zip(best, runs):
+            for key, value in run.items():   # each figure's own minimum
+                b[key] = min(b.get(key, float("inf")), value)
+    return best[0], best[1], best[2]
 
 
 def loop_per_cycle(plan, job, cycles: int) -> float:
@@ -237,20 +241,36 @@ def print_latency(res: dict, steps: int, exact: int) -> None:
               f"us  p99.9/p50 {p999 / p50:5.2f}  ({what})")
 
 
+def print_whole(cold: dict, warm: dict, ss: dict) -> None:
+    """The whole path cold and warm against GeomAPI_IntSS (ms, and the speed-ups)."""
+    print(f"  GeomAPI_IntSS of the offset surfaces: CPU {ss['cpu'] / 1000:6.2f} ms, wall "
+          f"{ss['wall'] / 1000:6.2f} ms")
+    for label, run in (("cold", cold), ("warm", warm)):
+        grids = f" (trim grids, min {run['grids'] / 1000:.2f} ms wall)" if run["grids"] else ""
+        print(f"  whole path {label} ({run['points']} points): CPU {run['cpu'] / 1000:6.2f} ms"
+              f"{grids}, wall {run['wall'] / 1000:6.2f} ms: {ss['cpu'] / run['cpu']:.1f}x "
+              f"faster than IntSS (CPU), {ss['wall'] / run['wall']:.1f}x (wall)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=100_000)
     ap.add_argument("--streamed", type=int, default=1_000_000)
+    ap.add_argument("--whole", action="store_true",
+                    help="only the whole path (cold and warm) against GeomAPI_IntSS")
     args = ap.parse_args()
     for name, i, j in CASES:
         part, plan, job = plan_of(name, i, j)
         stepper(plan, job).run()                                   # warm-up (JIT load)
+        if args.whole:
+            print(f"{name} faces {i},{j}")
+            print_whole(*path_vs_intss(part, i, j, plan))
+            continue
         d2 = bare_d2(plan)
         ref = step_times(stepper(plan, job, compiled=False), 2000)
         fast = step_times(stepper(plan, job, end=False), 20000)
         per_cycle = loop_per_cycle(plan, job, 200_000)
-        path, ss = path_vs_intss(part, i, j, plan)
-        ss_wall, ss_cpu = ss["wall"], ss["cpu"]
+        cold, warm, ss = path_vs_intss(part, i, j, plan)
         print(f"{name} faces {i},{j} (f = 0.1 mm)")
         print(f"  two bare OCCT D2 + .Coord() : {d2:6.2f} us (min)")
         print(f"  step, compiled (min / p50)  : {fast.min():6.2f} / {np.median(fast):6.2f} us"
@@ -258,10 +278,7 @@ def main() -> None:
         print(f"  step, reference (min / p50) : {ref.min():6.2f} / {np.median(ref):6.2f} us"
               f"  ({np.median(ref) / np.median(fast):.1f}x the compiled)")
         print(f"  cycle, loop compiled        : {per_cycle:6.3f} us")
-        print(f"  whole path ({path['points']} points): CPU {path['cpu'] / 1000:6.2f} ms (trim "
-              f"grids {path['grids'] / 1000:.2f} ms wall), wall {path['wall'] / 1000:6.2f} ms;"
-              f" GeomAPI_IntSS CPU {ss_cpu / 1000:6.2f} ms, wall {ss_wall / 1000:6.2f} ms: "
-              f"{ss_cpu / path['cpu']:.1f}x faster (CPU), {ss_wall / path['wall']:.1f}x (wall)")
+        print_whole(cold, warm, ss)
         _, exact = exact_calls(lambda: step_times(stepper(plan, job, end=False), args.steps))
         res = latency(lambda: stepper(plan, job, end=False), args.steps)
         print_latency(res, len(res["raw"]), exact)
@@ -269,7 +286,7 @@ def main() -> None:
             per, growth, n = memory(plan, job, 100_000, args.streamed)
             print(f"  memory: record on {per:.0f} B/cycle (traced, doubling chunks incl.); "
                   f"record off: {growth} B growth over {n} streamed cycles")
-    for name, i, j, guard in LANDINGS:
+    for name, i, j, guard in [] if args.whole else LANDINGS:
         _, plan, job = plan_of(name, i, j)
         land, median, reason, trials = landing(plan, job, guard)
         print(f"landing {name} faces {i},{j}: {reason} in {trials} trial cycles, "

@@ -26,7 +26,7 @@ CELL_MIXED = 2
 
 # -- Reading a trim grid: cadcnc.geometry.trim_grid builds it; the compiled kernel
 # (cadcnc.interp.kernel) and TrimGrid.cell both read it with these numba functions.
-_jit = numba.njit(cache=True, nogil=True)
+_jit = numba.njit(cache=True, nogil=True, _nrt=False)
 _FAR = 1e15  # |index| beyond this (or NaN/inf): no cell, ask the exact classifier
 SEGMENTS = -1.0
 """Marker (first word of a MIXED cell's block in ``fine``) of a segment list."""

@@ -21,6 +21,7 @@ from OCP.BRepTools import BRepTools
 from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
+from OCP.Precision import Precision
 from OCP.GProp import GProp_GProps
 from OCP.ShapeAnalysis import ShapeAnalysis_Surface
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
@@ -65,8 +66,7 @@ class FaceSurface:
         self.w_range = (wmin, wmax)
         self.u_period = self._adaptor.UPeriod() if self._adaptor.IsUPeriodic() else None
         self.w_period = self._adaptor.VPeriod() if self._adaptor.IsVPeriodic() else None
-        self._classifier = None
-        self._kernel: tuple | None = None
+        self.clear_caches()
         # scratch objects reused by every evaluation (keeps allocation out of hot loops)
         self._p = gp_Pnt()
         self._v = [gp_Vec() for _ in range(9)]
@@ -74,6 +74,13 @@ class FaceSurface:
     def __repr__(self) -> str:
         name = f"Face{self.number}" if self.number else "face"
         return f"<FaceSurface {name} {self.kind}{' reversed' if self.reversed else ''}>"
+
+    def clear_caches(self) -> None:
+        """Drop the per-face data built on first use (trim classifier, SurfaceData and trim
+        grid, point projectors): the next path pays them again, as a first call does."""
+        self._classifier = None
+        self._kernel: tuple | None = None
+        self._projectors: dict = {}
 
     # -- parameters -------------------------------------------------------------------
     @property
@@ -156,7 +163,8 @@ class FaceSurface:
     def project(self, point, within_face_box: bool = True) -> tuple[float, float, float]:
         """(u, w, distance mm) of the nearest point of the surface to ``point``.
 
-        OCCT's exact projection (GeomAPI_ProjectPointOnSurf), restricted to the face's
+        OCCT's exact projection (GeomAPI_ProjectPointOnSurf, initialised once per face and
+        kept: its sample grid of the surface is per face), restricted to the face's
         parameter box when ``within_face_box``. Where that finds no interior extremum (a
         point beyond the face's edges), falls back to the nearest point of the trimmed
         face (BRepExtrema_DistShapeShape). Raises GeometryError when both find none.
@@ -165,11 +173,16 @@ class FaceSurface:
         if not all(math.isfinite(c) for c in xyz):
             raise InputError(f"{self!r}: cannot project the non-finite point {xyz}")
         pnt = gp_Pnt(*xyz)
-        if within_face_box:
-            proj = GeomAPI_ProjectPointOnSurf(pnt, self.geom_surface, *self.u_range,
-                                              *self.w_range)
-        else:
-            proj = GeomAPI_ProjectPointOnSurf(pnt, self.geom_surface)
+        proj = self._projectors.get(within_face_box)
+        if proj is None:  # its sample grid of the surface is built once per face
+            proj = self._projectors[within_face_box] = GeomAPI_ProjectPointOnSurf()
+            if within_face_box:
+                proj.Init(self.geom_surface, *self.u_range, *self.w_range)
+            else:
+                # as GeomAPI_ProjectPointOnSurf(point, surface) does: Precision::Confusion
+                proj.Init(self.geom_surface, *self.geom_surface.Bounds(),
+                          Precision.Confusion_s())
+        proj.Perform(pnt)
         if proj.IsDone() and proj.NbPoints() > 0:
             u, w = proj.LowerDistanceParameters()
             return u, w, proj.LowerDistance()

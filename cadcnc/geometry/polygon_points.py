@@ -22,6 +22,8 @@ from OCP.GeomAbs import (GeomAbs_BSplineCurve, GeomAbs_BSplineSurface, GeomAbs_C
                          GeomAbs_Torus)
 from OCP.gp import gp_Trsf
 
+from . import bspline_blob
+
 _jit = numba.njit(cache=True, nogil=True)
 
 
@@ -125,11 +127,16 @@ def pcurve_points(c2, t: np.ndarray) -> np.ndarray | None:
     if periodic:  # the same curve with flat, clamped knots (OCCT inserts them exactly)
         bs = bs.Copy()
         bs.SetNotPeriodic()
-    poles = np.array([bs.Pole(i).Coord() for i in range(1, bs.NbPoles() + 1)])
-    weights = (np.array([bs.Weight(i) for i in range(1, bs.NbPoles() + 1)])
-               if bs.IsRational() else np.zeros(0))
-    return _curve_points(_flat(bs.KnotSequence()), bs.Degree(), poles, weights,
-                         _wrap(t, first, last, periodic))
+    read = bspline_blob.curve2d(bs)  # all numbers in one OCCT call; None: pole by pole
+    if read is not None:
+        poles, weights, knots, mults = read
+        flat = np.repeat(knots, mults)  # bs is not periodic here: its KnotSequence
+    else:
+        poles = np.array([bs.Pole(i).Coord() for i in range(1, bs.NbPoles() + 1)])
+        weights = (np.array([bs.Weight(i) for i in range(1, bs.NbPoles() + 1)])
+                   if bs.IsRational() else np.zeros(0))
+        flat = _flat(bs.KnotSequence())
+    return _curve_points(flat, bs.Degree(), poles, weights, _wrap(t, first, last, periodic))
 
 
 def _frame(ax3) -> tuple[np.ndarray, ...]:

@@ -61,6 +61,7 @@ from OCP.GeomAbs import (
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Face
 
+from . import bspline_blob
 from ..errors import InputError
 
 SURFACE_KINDS = {
@@ -236,16 +237,26 @@ def _poles_surface(kind: int, surf):
     if max(p, q) > MAX_DEGREE:
         return None
     nu, nv = surf.NbUPoles(), surf.NbVPoles()
-    poles = np.array([[surf.Pole(i, j).Coord() for j in range(1, nv + 1)]
-                      for i in range(1, nu + 1)], dtype=np.float64).reshape(nu, nv, 3)
     rational = surf.IsURational() or surf.IsVRational()
-    weights = np.ones((nu, nv))
-    if rational:
-        weights = np.array([[surf.Weight(i, j) for j in range(1, nv + 1)]
-                            for i in range(1, nu + 1)], dtype=np.float64)
+    # a B-spline's numbers in one OCCT call (geometry/bspline_blob.py); else pole by pole
+    read = bspline_blob.surface(surf) if isinstance(surf, Geom_BSplineSurface) else None
+    if read is not None:
+        poles, blob_weights, (uk, um), (vk, vm) = read
+        weights = blob_weights if rational else np.ones((nu, nv))
+    else:
+        poles = np.array([[surf.Pole(i, j).Coord() for j in range(1, nv + 1)]
+                          for i in range(1, nu + 1)], dtype=np.float64).reshape(nu, nv, 3)
+        weights = np.ones((nu, nv))
+        if rational:
+            weights = np.array([[surf.Weight(i, j) for j in range(1, nv + 1)]
+                                for i in range(1, nu + 1)], dtype=np.float64)
     if isinstance(surf, Geom_BSplineSurface):
-        knots_u, knots_v = _flat(surf.UKnotSequence()), _flat(surf.VKnotSequence())
         periodic = [int(surf.IsUPeriodic()), int(surf.IsVPeriodic())]
+        # a periodic direction's flat knots extend the knots periodically: OCCT's own
+        knots_u = (_flat(surf.UKnotSequence()) if read is None or periodic[0]
+                   else np.repeat(uk, um))
+        knots_v = (_flat(surf.VKnotSequence()) if read is None or periodic[1]
+                   else np.repeat(vk, vm))
     else:
         knots_u, knots_v = _bezier_knots(p), _bezier_knots(q)
         periodic = [0, 0]

@@ -7,9 +7,11 @@ surface): the paper derives them for finishing (C = 0), where the two agree.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
+
+from .cycle import PAPER_INVERSE_LIMIT
 
 
 @dataclass
@@ -35,16 +37,19 @@ class SurfaceBounds:
 
 
 def _rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.einsum("ij,ij->i", a, b)
+    """Row-wise dot products over the last axis (broadcast): (..., 3) x (..., 3) -> (...)."""
+    return np.einsum("...j,...j->...", a, b)
 
 
 def surface_curvatures(ru, rw, n, ff, t):
     """k along t, principal k_max/k_min and geodesic torsion tau along t, per row.
 
-    ``ff`` is (N, 6): E, F, G, L, M, N. Vectorised forms of cadcnc.geometry.differential (tests/test_curvature_copies.py
-    ties them together).
+    ``ru``, ``rw``, ``n``, ``t`` (..., 3) and ``ff`` (..., 6): E, F, G, L, M, N (leading
+    axes broadcast: (N, 3) for one surface, (2, N, 3) for both with t (N, 3)). Vectorised
+    forms of cadcnc.geometry.differential (tests/test_curvature_copies.py ties them
+    together).
     """
-    E, F, G, L, M, N = ff.T
+    E, F, G, L, M, N = np.moveaxis(ff, -1, 0)
     det = E * G - F * F
     tu, tw = _rows(ru, t), _rows(rw, t)
     a = (G * tu - F * tw) / det
@@ -78,8 +83,11 @@ def bounds_for_surface(R: float, f: np.ndarray, eps: np.ndarray, k, k_max, k_min
     return SurfaceBounds(eps, k, k_max, k_min, tau, eq11, eq12, eq15, eps_ss, eq16)
 
 
-def mp_length(R: float, k1, k2, q1, q2, n1, n2) -> np.ndarray:
-    """|mp| = (rho1 + R)(rho2 + R) sqrt(1 - (n1.n2)^2) / |o1 o2| (inf where a k ~ 0)."""
+def mp_length(R, k1, k2, q1, q2, n1, n2) -> np.ndarray:
+    """|mp| = (rho1 + R)(rho2 + R) sqrt(1 - (n1.n2)^2) / |o1 o2| (inf where a k ~ 0).
+
+    k1, k2 (N,); q1, q2, n1, n2 (N, 3); R a float, or (m, 1) for m offsets at once
+    (then (m, N))."""
     with np.errstate(divide="ignore", invalid="ignore"):
         o1 = q1 + n1 / k1[:, None]
         o2 = q2 + n2 / k2[:, None]
@@ -87,3 +95,30 @@ def mp_length(R: float, k1, k2, q1, q2, n1, n2) -> np.ndarray:
         s = np.sqrt(np.maximum(1 - _rows(n1, n2) ** 2, 0.0))
         mp = (rho1 + R) * (rho2 + R) * s / np.linalg.norm(o1 - o2, axis=1)
     return np.where(np.isfinite(mp), mp, np.inf)
+
+
+def pair_bounds(R, points, contacts, normals, ru, rw, forms, t, f
+                ) -> tuple[SurfaceBounds, SurfaceBounds]:
+    """Both surfaces' bounds at once (one numpy pass for the pair, not one per surface).
+
+    ``R`` (2,) offsets (mm); ``points`` (N, 3); ``contacts``, ``normals``, ``ru``, ``rw``
+    (N, 2, 3); ``forms`` (N, 2, 6); ``t`` (N, 3) unit tangents; ``f`` (N,) steps (mm).
+    Where the exact inverse moved a contact (eq. 5 would amplify its error), the paper's
+    steady state of eq. 5 does not apply: eps_ss is the measured carried error and eq16
+    eq. 12 from it (the step's own bound, whatever the inverse).
+    """
+    R = np.asarray(R, dtype=float)[:, None]                      # (2, 1)
+    pair = [np.swapaxes(a, 0, 1) for a in (contacts, normals, ru, rw, forms)]
+    q, n = pair[0], pair[1]                                      # (2, N, 3)
+    k, kmax, kmin, tau = surface_curvatures(pair[2], pair[3], n, pair[4], t)
+    eps = np.linalg.norm(points - (q + R[:, :, None] * n), axis=2)
+    mp = mp_length(R, k[0], k[1], q[0], q[1], n[0], n[1])
+    b = bounds_for_surface(R, f, eps, k, kmax, kmin, tau, mp)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rho = R * np.maximum(np.abs(kmax - k), np.abs(kmin - k)) / np.abs(1.0 - R * k)
+    exact = rho > PAPER_INVERSE_LIMIT
+    if exact.any():
+        b.eps_ss = np.where(exact, eps, b.eps_ss)
+        b.eq16 = np.where(exact, b.eq12, b.eq16)
+    names = [f.name for f in fields(SurfaceBounds)]
+    return tuple(SurfaceBounds(**{m: getattr(b, m)[i] for m in names}) for i in (0, 1))

@@ -15,9 +15,8 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from ..interp.cycle import CLOSED, END, PAPER_INVERSE_LIMIT
-from ..interp.error_bounds import (
-    SurfaceBounds, bounds_for_surface, mp_length, surface_curvatures,
-)
+from ..interp.bounds_compiled import pair_bounds
+from ..interp.error_bounds import SurfaceBounds
 from ..interp.record import PathRecord
 from ..job import Job
 
@@ -139,31 +138,14 @@ def compute_bounds(path: Toolpath, ru: np.ndarray, rw: np.ndarray,
                    forms: np.ndarray) -> tuple[SurfaceBounds, SurfaceBounds]:
     """Per point, the bounds for the step leaving it (f = the next cycle's commanded step).
 
-    ``ru``, ``rw`` (N, 2, 3) and ``forms`` (N, 2, 6: E, F, G, L, M, N) per surface.
+    ``ru``, ``rw`` (N, 2, 3) and ``forms`` (N, 2, 6: E, F, G, L, M, N) per surface; both
+    surfaces in one compiled pass (``interp.bounds_compiled``, the same numbers as the
+    numpy reference ``error_bounds.pair_bounds``).
     """
-    t = path.tangents
     f = np.append(path.commanded[1:], path.commanded[-1] if len(path) > 1 else 0.0)
-    curv = [surface_curvatures(ru[:, i], rw[:, i], path.normals[:, i], forms[:, i], t)
-            for i in (0, 1)]
-    out = []
-    for i in (0, 1):
-        R = path.offsets[i]
-        eps = np.linalg.norm(path.points - (path.contacts[:, i] + R * path.normals[:, i]), axis=1)
-        k, kmax, kmin, tau = curv[i]
-        mp = mp_length(R, curv[0][0], curv[1][0], path.contacts[:, 0], path.contacts[:, 1],
-                       path.normals[:, 0], path.normals[:, 1])
-        b = bounds_for_surface(R, f, eps, k, kmax, kmin, tau, mp)
-        # where the exact inverse moved this contact (eq. 5 would amplify its error), the
-        # paper's steady state of eq. 5 does not apply: report eq. 12 from the measured
-        # carried error instead (the step's own bound, whatever the inverse)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            rho = R * np.maximum(np.abs(kmax - k), np.abs(kmin - k)) / np.abs(1.0 - R * k)
-        exact = rho > PAPER_INVERSE_LIMIT
-        if exact.any():
-            b.eps_ss = np.where(exact, eps, b.eps_ss)
-            b.eq16 = np.where(exact, b.eq12, b.eq16)
-        out.append(b)
-    return out[0], out[1]
+    out = pair_bounds(np.asarray(path.offsets, dtype=float), path.points, path.contacts,
+                      path.normals, ru, rw, forms, path.tangents, f, PAPER_INVERSE_LIMIT)
+    return SurfaceBounds(*out[0]), SurfaceBounds(*out[1])
 
 
 def toolpath_head(path: Toolpath, n: int, stop_reason: str, stop_detail: str) -> Toolpath:

@@ -22,7 +22,7 @@ import math
 import numba
 import numpy as np
 
-_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 _EPS = 2.220446049250313e-16  # RealEpsilon()
 PLANE, CYLINDER, CONE, SPHERE, TORUS = 0, 1, 2, 3, 4
 """OCCT's GeomAbs_SurfaceType values of the elementary kinds."""

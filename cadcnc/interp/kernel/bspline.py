@@ -28,7 +28,7 @@ POS_TOL = 0.5e-9
 BASIS_SCRATCH = (MAX_DEGREE + 1) * (MAX_DEGREE + 6)
 """Floats of work one call of ``basis_derivatives`` needs for its tables."""
 
-_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 
 
 @_jit

@@ -14,7 +14,7 @@ import math
 import numba
 import numpy as np
 
-_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 
 # a contact row
 C_U, C_W, C_R, C_RU, C_RW, C_NRM = 0, 1, 2, 5, 8, 11

@@ -15,7 +15,7 @@ from .step import (
     state_margin, step, trial, write_row,
 )
 
-_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 
 
 @_jit

@@ -53,8 +53,8 @@ from .bspline import (BASIS_SCRATCH, MAX_DEGREE, near_knot, normalize_periodic,
                       surface_derivatives)
 from .swept import UNSUPPORTED, extrusion, revolution
 
-_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
-_inline = numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+_inline = numba.njit(cache=True, nogil=True, error_model="numpy", inline="always", _nrt=False)
 
 PLANE, CYLINDER, CONE, SPHERE, TORUS = 0, 1, 2, 3, 4
 BEZIER, BSPLINE, REVOLUTION, EXTRUSION, OFFSET = 5, 6, 7, 8, 9

@@ -32,7 +32,7 @@ from .evaluators import d2
 from . import trim_lookup
 from .trim_lookup import CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE
 
-_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 lookup = trim_lookup.lookup   # numba-compiled already (cadcnc.trim)
 wrap = trim_lookup.wrap
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from .bspline import curve_derivatives, normalize_periodic
 
-_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 
 LINE, CIRCLE, ELLIPSE, BEZIER_CURVE, BSPLINE_CURVE = 0, 1, 2, 5, 6
 """Curve kinds: OCCT's GeomAbs_CurveType values."""
