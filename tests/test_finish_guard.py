@@ -226,3 +226,30 @@ def test_planar_wall_proof_never_clears_a_hit(stepped):
         hits += m_exact < 0.0
     assert hits > 5
     assert sum(w.cells.searches for w in fast._walls.values() if w is not None) > 20
+
+
+def test_a_stay_down_witness_is_a_real_refutation(slab):
+    """Where finish_links finds a face point nearer than R' - tol to a move, OCCT's swept
+    distance of that move is below R' - tol too (moves between centres on the top's
+    offset, 1-3 mm apart, across the convex and concave parts)."""
+    from cadcnc.geometry.move_clearance import MoveClearance
+    from cadcnc.ops.finish_links import StayDown
+    top = slab.face(5)
+    stay = StayDown(slab, {5: (top, HeightCells(top))}, 3.0, 40.0, 1e-6)
+    moves = MoveClearance(slab, 3.0, 40.0)
+    rng = np.random.default_rng(8)
+    refuted = 0
+    for _ in range(14):
+        u, w = rng.uniform(*top.u_range), rng.uniform(*top.w_range)
+        a = top.point(u, w) + 3.0 * top.normal(u, w)
+        u2 = np.clip(u + rng.uniform(-3, 3), *top.u_range)
+        w2 = np.clip(w + rng.uniform(-3, 3), *top.w_range)
+        b = top.point(u2, w2) + 3.0 * top.normal(u2, w2)
+        before = stay.refuted
+        allowed = stay(a, b)
+        if stay.refuted > before:
+            refuted += 1
+            assert not allowed and moves.distance(a, b) < 3.0 - 1e-6, (a, b)
+        else:
+            assert allowed == moves.clear(a, b, 1e-6)
+    assert refuted >= 3

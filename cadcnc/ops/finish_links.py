@@ -59,7 +59,8 @@ def witness(face, cells, m: np.ndarray, limit: float) -> bool:
         r, ru, rw, ruu, ruw, rww = (np.array(v) for v in face.derivative_tuples(u, w))
         e = r - m
         g = np.array([e @ ru, e @ rw])
-        h = np.array([[ru @ ru + e @ ruu, ru @ rw + e @ ruw], [ru @ rw + e @ ruw, rw @ rw + e @ rww]])
+        off = ru @ rw + e @ ruw
+        h = np.array([[ru @ ru + e @ ruu, off], [off, rw @ rw + e @ rww]])
         try:
             du, dw = np.linalg.solve(h, -g)
         except np.linalg.LinAlgError:
