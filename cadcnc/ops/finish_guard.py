@@ -2,7 +2,7 @@
 
 A finishing pass follows one face F with the ball; :class:`~cadcnc.geometry.clearance.
 ClearanceGuard` checks at every ball centre p the third faces (every face but F) and the
-shank against F itself. Two cheap, sound proofs stand in for OCCT's distances:
+shank against F itself. Cheap, sound proofs stand in for OCCT's distances:
 
 - **The shank against F**: :class:`~cadcnc.ops.finish_cells.HeightCells` (the cell boxes
   of F above the centre are horizontally further from it than F is; see that module).
@@ -13,16 +13,19 @@ shank against F itself. Two cheap, sound proofs stand in for OCCT's distances:
   box at least R' - tol from the segment (an exact segment-to-box distance) and descends
   into the others; when every branch is pruned, the least pruned distance is a lower
   bound of the face's distance, and the clearance it gives is >= 0 without an OCCT
-  distance. A box still too near at the finest level (the tool really near the face, e.g.
-  on the edge it shares with the followed face), or more than ``VISITS`` boxes looked at,
-  falls back to the exact distance.
+  distance (after ``VISITS`` boxes, the boxes left count as they are). A box still too
+  near at the finest level (the tool really near the face) falls back to the exact
+  distance. A face with closed forms (plane, cylinder, sphere) uses them first.
+- **Walls hanging from F's edge** (:mod:`.finish_walls`): cleared in closed form where
+  the tool rides along the edge they share with F, where boxes cannot clear them.
 
 **The budget.** After a clear margin at p, :meth:`FinishGuard.budget` returns a radius
 within which every centre is known clear (docs/interpolator.md): the least of the broad
-phase's reach left, every near third face's cached margin (1-Lipschitz), the own face's
-proofs (the face wholly below the centre; the height cells' cached proof; its cached
-margin, 2-Lipschitz) and the ball's distance to the own face's edges (1-Lipschitz). The
-compiled stepper then commits the steps inside it without asking. Lengths mm.
+phase's reach left, every near third face's cached margin (1-Lipschitz) or wall proof,
+the own face's proofs (the face wholly below the centre; the height cells' cached proof;
+its cached margin, 2-Lipschitz) and the ball's distance to the own face's edges
+(1-Lipschitz). The compiled stepper then commits the steps inside it without asking.
+Lengths mm.
 """
 
 from __future__ import annotations
@@ -107,8 +110,10 @@ class BoxTree:
 
 
 class FinishGuard(ClearanceGuard):
-    """The third-face guard of a pass following one face (``pair`` = (face,)), whose own
-    face rule is proven by :class:`HeightCells` where it can (module doc)."""
+    """The guard of a pass following one face (``pair`` = (face,)), or of a pair's path:
+    the own-face rule proven by :class:`HeightCells`, third faces by closed forms,
+    :class:`BoxTree` and :class:`~cadcnc.ops.finish_walls.WallProof` where they can, and
+    a :meth:`budget` (module doc)."""
 
     def __init__(self, part, pair, offset: float, shank: float, tol: float = 1e-6,
                  reach: float | None = None, own_tol: float = 1e-3):
