@@ -1,4 +1,4 @@
-"""Guide-surface finishing against OpenCAMLib's drop-cutter (issue 13, docs/finishing_vs_ocl.md).
+"""Guide-surface finishing against OpenCAMLib's drop-cutter (issue 13, docs/finishing.md).
 
 The same faces, the same pass lines (cadcnc's planes: angle 0, stepover 1 mm), the same
 point spacing (cadcnc's step f = F Ts = 0.1 mm; OCL's points 0.1 mm apart along each
@@ -81,6 +81,8 @@ class Stopwatch:
                ("cadcnc.ops.finish_uncut", "_reasons",
                 "of which reasons (guard on samples)"),
                ("cadcnc.ops.finish", "linked", "linking (zigzag links verified)"),
+               ("cadcnc.ops.finish_links", "witness",
+                "of which stay-down witnesses (refutations)"),
                ("cadcnc.geometry.move_clearance", "MoveClearance.distance",
                 "of which stay-down checks (OCCT)"),
                ("cadcnc.ops.finish", "pass_cuts", "passes (stepping, guard, exact step)"),
@@ -88,7 +90,11 @@ class Stopwatch:
                ("cadcnc.geometry.clearance", "ClearanceGuard.margin",
                 "clearance guard (every face, ball and shank)"),
                ("cadcnc.geometry.clearance", "ClearanceGuard._exact",
-                "of which exact OCCT distances")]
+                "of which per-face checks (proofs, else OCCT)"),
+               ("cadcnc.geometry.clearance", "ClearanceGuard._segment_distance",
+                "of which exact segment distances (closed form, else OCCT)"),
+               ("cadcnc.ops.finish_guard", "FinishGuard.budget",
+                "guard budgets (steps then left to the kernel)")]
 
     def __init__(self):
         self.seconds: dict[str, float] = {}

@@ -185,13 +185,8 @@ class ClearanceGuard:
         for a third face whose distance to its whole surface already clears R' - tol, that
         distance (a lower bound: the margin stays >= 0); else OCCT's."""
         length = self.shank if length is None else length
-        a = self._analytic[k - 1]
-        d = a.segment_distance(p, length)
-        if d is None and k not in self.pair:
-            d = a.segment_distance(p, length, trimmed=False)
-            d = d if d is not None and d >= self.threshold else None
+        d = self._closed_segment_distance(k, p, length)
         if d is not None:
-            self.closed_calls += 1
             return d, False
         self.exact_calls += 1
         face = self._faces[k - 1].topods
@@ -212,6 +207,19 @@ class ClearanceGuard:
                   and self._own_shapes.Contains(ext.SupportOnShape2(n))
                   for n in range(1, ext.NbSolution() + 1))
         return ext.Value(), own
+
+    def _closed_segment_distance(self, k: int, p, length: float) -> float | None:
+        """The closed forms of :meth:`_segment_distance` (mm), or None when none applies."""
+        a = self._analytic[k - 1]
+        if a.kind is None:
+            return None
+        d = a.segment_distance(p, length)
+        if d is None and k not in self.pair:
+            d = a.segment_distance(p, length, trimmed=False)
+            d = d if d is not None and d >= self.threshold else None
+        if d is not None:
+            self.closed_calls += 1
+        return d
 
     def _own_edge_margin(self, k: int, p) -> float:
         """The ball's margin (mm, against R' - own_tol) from the edges of own face k: the

@@ -6,8 +6,9 @@ height), runs one pass per plane (:func:`~cadcnc.ops.finish_pass.pass_cuts`: the
 guide-surface interpolation, the ball touching the faces, its centre on the plane), every
 other pass reversed for a zigzag, and links the cuts (:func:`~cadcnc.program.linking.linked`):
 a zigzag stays down between two cuts only where that straight move of the ball and shank is
-verified clear of the part (:class:`~cadcnc.geometry.move_clearance.MoveClearance`: at
-least R' - 1 µm from every face), otherwise, and always for one-way, it retracts to the
+verified clear of the part (:class:`~cadcnc.ops.finish_links.StayDown`: a cheap witness
+refutes it, else :class:`~cadcnc.geometry.move_clearance.MoveClearance` proves it at least
+R' - 1 µm from every face), otherwise, and always for one-way, it retracts to the
 clearance height. What the passes left uncut (largest scallop, area not machined and
 why) is reported in the program's notes and skipped list (:mod:`.finish_uncut`). Lengths
 mm, feed mm/min, period s, angles degrees.
@@ -20,13 +21,14 @@ import numbers
 import numpy as np
 
 from ..errors import InputError
-from ..geometry.move_clearance import MoveClearance
 from ..geometry.part import Part
 from ..job import Finish, Job, Tool
 from ..program.linking import linked
 from ..program.program import CutSegment, Program, Skipped
 from ..tolerances import DEFAULT, Tolerances
+from .finish_links import StayDown
 from .finish_pass import GuidePlane, pass_cuts
+from .finish_setup import pass_setup
 from .finish_plan import centre_chord, plan_planes, sample_faces
 from .finish_uncut import uncut_report
 from .pair_program import safe_height
@@ -72,8 +74,10 @@ def finish(part, faces, *, radius: float, allowance: float = 0.0,
             progress(k + 1, len(plan.offsets), f"plane {k + 1} at {offset:.3f} mm")
     stay_down = None
     if pattern == "zigzag":
-        moves = MoveClearance(part, job.tool.offset, job.tool.shank)
-        stay_down = lambda a, b: moves.clear(a, b, tol.hit)  # noqa: E731
+        setup = pass_setup(part, op.faces, job)
+        stay_down = StayDown(part, {f: (part.face(f), setup.guard(f).height_cells(f))
+                                    for f in op.faces}, job.tool.offset, job.tool.shank,
+                             tol.hit)
     program = Program(job, linked(cuts, safe_height(part, job), join=JOIN,
                                   stay_down=stay_down), skipped)
     report = uncut_report(program, part, samples, plan)

@@ -41,6 +41,7 @@ UNMACHINED = 4.0
 STEEP_DEG = 10.0
 """deg: a face this near vertical, not parallel to the planes, is too steep to climb."""
 NEIGHBOURS = 64  # cut points looked at around each sample's ideal centre
+CHUNK = 2048     # samples measured at a time
 GUARD_SAMPLES = 200  # per face and reason: samples whose tool is checked against the part
 WHY = {
     "unreachable": "normals pointing down: the ball cannot reach it from +Z",
@@ -114,14 +115,17 @@ def uncut_report(program, part, samples, plan) -> UncutReport:
     scallop = np.full(len(samples), np.nan)
     if cuts:
         pts = np.vstack(cuts)
-        dist, idx = cKDTree(pts).query(q, k=min(NEIGHBOURS, len(pts)),
-                                       distance_upper_bound=r1)
-        dist, idx = dist.reshape(len(q), -1), idx.reshape(len(q), -1)
-        found = np.isfinite(dist)
-        c = pts[np.where(found, idx, 0)]                                   # (N, K, 3)
-        leftover = _leftover(c, found, samples.points + allowance * nrm, nrm, radius)
+        tree, kk = cKDTree(pts), min(NEIGHBOURS, len(pts))
         k, _ = across(samples, n)
-        scallop = _cusps(c, found, dist, q, nrm, n, k, radius, allowance)
+        base = samples.points + allowance * nrm
+        for a in range(0, len(q), CHUNK):   # rows are independent; a chunk stays in cache
+            b = slice(a, a + CHUNK)
+            dist, idx = tree.query(q[b], k=kk, distance_upper_bound=r1)
+            dist, idx = dist.reshape(len(q[b]), -1), idx.reshape(len(q[b]), -1)
+            found = np.isfinite(dist)
+            c = pts[np.where(found, idx, 0)]                               # (n, K, 3)
+            leftover[b] = _leftover(c, found, base[b], nrm[b], radius)
+            scallop[b] = _cusps(c, found, dist, q[b], nrm[b], n, k[b], radius, allowance)
     reason = np.array(plan.reason, dtype=object)
     machined = (leftover <= threshold) & (reason == "")
     area = samples.areas
