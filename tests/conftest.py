@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
+import io
 import json
+import os
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -58,3 +62,52 @@ def fixture_path(name: str, i: int, j: int, *, radius: float = 3.0, feed: float 
         _paths[key] = cadcnc.intersection_path(part.face(i), part.face(j), radius=radius,
                                                feed=feed, period=period, **kwargs)
     return _paths[key]
+
+
+@dataclass
+class Run:
+    """What one in-process ``cadcnc`` run left: its exit code, stdout and stderr."""
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+@contextlib.contextmanager
+def _cwd(path):
+    old = os.getcwd()
+    os.chdir(path or old)
+    try:
+        yield
+    finally:
+        os.chdir(old)
+
+
+def cadcnc_cli(*args, cwd=None, check=None) -> Run:
+    """Run ``cadcnc ARGS`` in this process (``cadcnc.cli.app.main``); returns its exit code,
+    stdout and stderr. ``check``: the exit code it must give."""
+    from cadcnc.cli.app import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with _cwd(cwd), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main([str(a) for a in args])
+        except SystemExit as e:  # argparse: --help, usage errors
+            code = e.code
+    run = Run(code, out.getvalue(), err.getvalue())
+    if check is not None:
+        assert run.returncode == check, (run.returncode, run.stdout, run.stderr)
+    return run
+
+
+BOSS_JOB = ["--faces", "4", "5", "--radius", "3", "--feed", "1500", "--period", "4ms"]
+
+
+@pytest.fixture(scope="session")
+def boss_cli_outputs(tmp_path_factory):
+    """(folder, run): ``cadcnc path bspline_boss.step BOSS_JOB -o p.json -o p.csv -o p.ngc``
+    run once per test session (in-process), shared by the modules that read its program or
+    its summary (do not modify the files)."""
+    d = tmp_path_factory.mktemp("boss_path")
+    run = cadcnc_cli("path", FIXTURES / "bspline_boss.step", *BOSS_JOB, "-o", d / "p.json",
+                     "-o", d / "p.csv", "-o", d / "p.ngc", check=0)
+    return d, run

@@ -22,8 +22,7 @@ from cadcnc.io.toolpath_csv import CSV_COLUMNS
 from cadcnc.io.program_outputs import PROGRAM_CSV_COLUMNS
 from cadcnc.job import Job, PairPath, Tool
 from cadcnc.ops import pair_program
-from conftest import FIXTURES
-from test_cli import cadcnc_cli
+from conftest import FIXTURES, cadcnc_cli
 
 FACTS = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
 SHELF = FIXTURES / FACTS["shelf"]["file"]

@@ -7,9 +7,7 @@ them, with no cadcnc code.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import io
 import json
 import math
 
@@ -25,7 +23,6 @@ from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Compound
 
 import cadcnc
-from cadcnc.cli.app import main
 from cadcnc.geometry.material_side import CLOSED_SHELL, FLIPPED, OPEN_LEVEL, OPEN_SHELL, VOID
 from cadcnc.geometry.report import faces_report
 from cadcnc.geometry.sewing import file_faces, inconsistent_edges, sew
@@ -33,7 +30,7 @@ from cadcnc.geometry.step_file import read_step
 from cadcnc.tolerances import DEFAULT
 from cadcnc.verification import gouge_gate
 from cadcnc.verification.material import IN, OUT, Material, PartFaces
-from conftest import FIXTURES
+from conftest import FIXTURES, cadcnc_cli
 
 SIDE = json.loads((FIXTURES / "surface_models.json").read_text())
 BOSS = ["surf_boss_solid", "surf_boss_shell", "surf_boss_faces"]
@@ -203,10 +200,9 @@ def test_a_gap_within_the_sewing_tolerance_is_closed_and_reported():
 
 
 def cli(*args) -> tuple[int, str, str]:
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        code = main([str(a) for a in args])
-    return code, out.getvalue(), err.getvalue()
+    """(exit code, stdout, stderr) of ``cadcnc ARGS`` run in this process."""
+    run = cadcnc_cli(*args)
+    return run.returncode, run.stdout, run.stderr
 
 
 def test_cli_faces_says_which_rule_applied():

@@ -16,8 +16,7 @@ import pytest
 import cadcnc
 from cadcnc.job import Job, PairPath, Tool
 
-from conftest import FIXTURES, load_fixture
-from test_cli import cadcnc_cli
+from conftest import FIXTURES, cadcnc_cli, load_fixture
 
 BOSS = FIXTURES / "bspline_boss.step"
 JOB = ["--radius", "3", "--feed", "1500", "--period", "4ms"]

@@ -23,11 +23,13 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from OCP.BRep import BRep_Builder
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
 from OCP.BRepClass3d import BRepClass3d_SolidClassifier
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.gp import gp_Pnt
 from OCP.TopAbs import TopAbs_IN
+from OCP.TopoDS import TopoDS_Compound
 
 import cadcnc
 from cadcnc.errors import CadcncError
@@ -58,18 +60,22 @@ def part_of(name: str):
 
 
 def boundary_distances(part, points: np.ndarray) -> np.ndarray:
-    """(N,) distance (mm) from each point to the part's boundary: the least OCCT
-    vertex-to-face distance over its faces."""
-    out = np.full(len(points), np.inf)
-    dss = BRepExtrema_DistShapeShape()
-    vertices = [BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex() for p in points]
+    """(N,) distance (mm) from each point to the part's boundary: OCCT's vertex-to-shape
+    distance to the compound of all its faces, i.e. the least vertex-to-face distance over
+    its faces (one call per point: OCCT skips the faces whose boxes are farther)."""
+    faces = TopoDS_Compound()
+    builder = BRep_Builder()
+    builder.MakeCompound(faces)
     for n in range(1, len(part) + 1):
-        dss.LoadS2(part.face(n).topods)
-        for k, v in enumerate(vertices):
-            dss.LoadS1(v)
-            dss.Perform()
-            assert dss.IsDone()
-            out[k] = min(out[k], dss.Value())
+        builder.Add(faces, part.face(n).topods)
+    dss = BRepExtrema_DistShapeShape()
+    dss.LoadS2(faces)
+    out = np.empty(len(points))
+    for k, p in enumerate(points):
+        dss.LoadS1(BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex())
+        dss.Perform()
+        assert dss.IsDone()
+        out[k] = dss.Value()
     return out
 
 

@@ -34,7 +34,7 @@ from cadcnc.verification.bounds import point_box_distance, segment_lower_bound
 from cadcnc.verification.material import IN, OUT, Material, PartFaces
 from cadcnc.verification.probe import FaceProbe
 
-from conftest import FIXTURES, fixture_path, load_fixture
+from conftest import BOSS_JOB, FIXTURES, cadcnc_cli, fixture_path, load_fixture
 
 SIDE = json.loads((FIXTURES / "reliability_fixtures.json").read_text())
 CASES = [(name, case) for name, rec in SIDE.items() for case in rec["cases"]]
@@ -302,8 +302,6 @@ def test_the_cli_gates_the_program_it_writes(tmp_path):
     """Was exit 0: points dropped at 0.002 mm left chords 2.05 um deep into the sphere
     (the fuzz's draw, confirmed by OCCT distances at the written moves' midpoints), while
     the CLI gated only the computed points. The JSON keeps every computed point: it passes."""
-    from test_cli import cadcnc_cli
-
     args = ["path", FIXTURES / "sphere_cylinder.step", "--faces", "1", "2", "--radius",
             "6.6", "--feed", "21000", "--period", "4ms", "--tolerance", "0.002"]
     ngc = tmp_path / "s.ngc"
@@ -320,17 +318,13 @@ def test_the_cli_gates_the_program_it_writes(tmp_path):
     assert cadcnc_cli(*args[:-2], "-o", ngc).returncode == 0   # every point kept: passes
 
 
-def test_the_blending_tolerance_is_written_and_counted(tmp_path):
+def test_the_blending_tolerance_is_written_and_counted(tmp_path, boss_cli_outputs):
     """G64 P is a tenth of the gouge limit, written in the program and counted by the CLI's
-    gate: a move must keep the ball within the limit less P."""
-    from conftest import FIXTURES
-    from test_cli import cadcnc_cli
-
-    boss = FIXTURES / "bspline_boss.step"
-    job = ("--faces", "4", "5", "--radius", "3", "--feed", "1500", "--period", "4ms")
-    ok = cadcnc_cli("path", boss, *job, "-o", tmp_path / "a.ngc", "--quiet")
-    assert ok.returncode == 0 and "G64 P0.0001\n" in (tmp_path / "a.ngc").read_text()
-    tight = cadcnc_cli("path", boss, *job, "--gouge-tolerance", "1e-6", "-o",
-                       tmp_path / "b.ngc", "--quiet", check=5)
+    gate: a move must keep the ball within the limit less P. (The default run's G-code is
+    the session's, conftest.boss_cli_outputs.)"""
+    d, ok = boss_cli_outputs
+    assert ok.returncode == 0 and "G64 P0.0001\n" in (d / "p.ngc").read_text()
+    tight = cadcnc_cli("path", FIXTURES / "bspline_boss.step", *BOSS_JOB, "--gouge-tolerance",
+                       "1e-6", "-o", tmp_path / "b.ngc", "--quiet", check=5)
     assert tight.returncode == 5 and "less the blending tolerance 1e-07 mm" in tight.stderr
     assert not (tmp_path / "b.ngc").exists()

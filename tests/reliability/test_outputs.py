@@ -15,10 +15,10 @@ import time
 
 import pytest
 
-from conftest import FIXTURES
-from test_cli import cadcnc_cli
+from conftest import FIXTURES, cadcnc_cli
 
 BOSS = FIXTURES / "bspline_boss.step"
+POCKET = FIXTURES / "pocket.step"  # faces 10 17: a straight edge, a program in ~0.2 s
 SLOT = FIXTURES / "narrow_slot.step"
 JOB = ["--radius", "3", "--feed", "1500", "--period", "4ms"]
 
@@ -55,34 +55,38 @@ def test_demo_with_a_folder_in_the_way_replaces_nothing(tmp_path):
 
 
 def test_an_output_never_overwrites_the_input(tmp_path):
+    """A program written beside its input leaves the input alone; an output that is (a link
+    to) the input is refused. The pocket's straight edge: any part shows this."""
     step = tmp_path / "part.step"
-    step.write_bytes(BOSS.read_bytes())
+    step.write_bytes(POCKET.read_bytes())
     link = tmp_path / "link.json"
     link.symlink_to(step)
     for out in (step, link):
         before = step.read_bytes()
-        run = cadcnc_cli("path", step, "--faces", "4", "5", *JOB, "-o", out.with_suffix(
+        run = cadcnc_cli("path", step, "--faces", "10", "17", *JOB, "-o", out.with_suffix(
             ".json") if out == step else out)
         if out == step:
-            continue
-        one_line(run, 4, "input of this run")
+            assert run.returncode == 0, run.stderr
+        else:
+            one_line(run, 4, "input of this run")
         assert step.read_bytes() == before
 
 
-def test_output_equal_to_input_json_is_refused(tmp_path):
+def test_output_equal_to_input_json_is_refused(tmp_path, boss_program):
     saved = tmp_path / "p.json"
-    cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", saved, "--quiet", check=0)
+    saved.write_text(boss_program)
     before = saved.read_bytes()
     one_line(cadcnc_cli("plot", saved, "-o", saved), 4)
     assert saved.read_bytes() == before
 
 
 def test_symlinked_output_is_followed_not_replaced(tmp_path):
+    """The pocket's straight edge: any program shows how its output is written."""
     target = tmp_path / "real.json"
     target.write_text("old")
     link = tmp_path / "link.json"
     link.symlink_to(target)
-    cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", link, "--quiet", check=0)
+    cadcnc_cli("path", POCKET, "--faces", "10", "17", *JOB, "-o", link, "--quiet", check=0)
     assert link.is_symlink() and json.loads(target.read_text())["format"] == "cadcnc-program"
 
 
@@ -93,12 +97,10 @@ def test_a_very_long_output_name_is_a_clear_error(tmp_path):
 
 
 @pytest.fixture(scope="module")
-def boss_program(tmp_path_factory) -> str:
-    """The program JSON text ``cadcnc path`` writes for the boss's faces 4 5 (computed once:
-    the malformed-file tests each edit a copy)."""
-    saved = tmp_path_factory.mktemp("boss") / "p.json"
-    cadcnc_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", saved, "--quiet", check=0)
-    return saved.read_text()
+def boss_program(boss_cli_outputs) -> str:
+    """The program JSON text ``cadcnc path`` writes for the boss's faces 4 5 (computed once
+    per session, conftest: the malformed-file tests each edit a copy)."""
+    return (boss_cli_outputs[0] / "p.json").read_text()
 
 
 def _cut(d: dict) -> dict:
@@ -190,9 +192,10 @@ def test_ctrl_c_at_any_moment_keeps_a_whole_set(tmp_path, delay):
 def test_ctrl_c_after_the_files_are_written_keeps_the_exit_code(tmp_path):
     """Was exit -2 (killed by the signal) with the files complete: after ``main`` returned,
     Python's teardown reset SIGINT to the system default and spent ~0.7 s freeing OCCT and
-    numba objects. The program now ends at once after flushing its output."""
+    numba objects. The program now ends at once after flushing its output. The pocket's
+    straight edge: the moment after writing is the same for any program."""
     out = tmp_path / "b.json"
-    proc = subprocess.Popen(_cli("path", BOSS, "--faces", "4", "5", *JOB, "-o", out),
+    proc = subprocess.Popen(_cli("path", POCKET, "--faces", "10", "17", *JOB, "-o", out),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env={**os.environ, "PYTHONUNBUFFERED": "1"})
     for line in proc.stdout:   # the summary's last line: the files are in place
@@ -201,4 +204,4 @@ def test_ctrl_c_after_the_files_are_written_keeps_the_exit_code(tmp_path):
             break
     proc.communicate(timeout=60)
     assert proc.returncode in (0, 130), proc.returncode
-    assert _cut(json.loads(out.read_text()))["faces"] == [4, 5]
+    assert _cut(json.loads(out.read_text()))["faces"] == [10, 17]
