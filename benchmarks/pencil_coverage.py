@@ -33,7 +33,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from coverage import judge_path, oracle_for, pairs_of, spread  # noqa: E402
+from pair_coverage import judge_path, oracle_for, pairs_of, spread  # noqa: E402
 from coverage_judge import covered, judge_pair_cached, missed_runs  # noqa: E402
 from coverage_paths import cadcnc_command, classify, distance_to_polylines  # noqa: E402
 

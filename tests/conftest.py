@@ -21,8 +21,8 @@ _parts: dict = {}
 
 
 def load_benchmark(name: str):
-    """A benchmarks/ module by file path: benchmarks/ is not put on sys.path, where its
-    coverage.py would shadow the ``coverage`` package that numba looks for."""
+    """A benchmarks/ module by file path, registered under its name, without putting
+    benchmarks/ on sys.path (tests import no benchmark by plain ``import``)."""
     spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module

@@ -8,7 +8,7 @@ polyline of its pair. Written paths are judged too: a point whose distance to ei
 its two faces differs from R' by more than 1 um, or that is nearer than R' - 1 um to any
 face, makes the path silent-bad.
 
-    python benchmarks/coverage.py [--fixtures] [--parts DIR] --radius 2 [--radius 3]
+    python benchmarks/pair_coverage.py [--fixtures] [--parts DIR] --radius 2 [--radius 3]
         [--feed 1500] [--period 4ms] [--json OUT] [--workers 2] [--timeout 120]
         [--max-samples 60] [--max-pairs N]
 
