@@ -143,6 +143,7 @@ class Oracle:
                       for n in range(1, fmap.Extent() + 1)}
         self.boxes = np.array([self._box(f.face) for f in self.faces.values()]).reshape(-1, 6)
         self.edges = self._shared_edges()
+        self.corrections: list[dict] = []  # face_distance's (see there)
 
     @staticmethod
     def _face(n: int, face) -> Face:
@@ -334,11 +335,35 @@ class Oracle:
                 return {**out, "verdict": "unreachable", "face": n}
         return {**out, "verdict": "feasible"}
 
+    # -- judging written points (silent-bad) -------------------------------------------------
     def clearance(self, p: np.ndarray, reach: float) -> tuple[float, int]:
-        """Distance from p to the nearest face within ``reach`` (for judging paths)."""
-        return self.ball_clearance(p, reach)
+        """(distance, face) from p to the nearest face within ``reach`` (inf, 0 if none),
+        each distance by :meth:`face_distance` (for judging paths)."""
+        best = (math.inf, 0)
+        for n in self.near_faces(p, p, reach):
+            d = self.face_distance(p, int(n))
+            if d < best[0]:
+                best = (d, int(n))
+        return best
 
     def face_distance(self, p: np.ndarray, number: int) -> float:
+        """Distance from p to the trimmed face, mm: BRepExtrema_DistShapeShape, or the
+        distance to the foot of p on the surface when that is shorter and the foot lies
+        on the face by ``on_face`` (BRepTopAdaptor_FClass2d, as the verdicts use).
+
+        BRepExtrema classifies its projected foot with BRepClass_FaceClassifier, which can
+        call an inside point OUT at a degenerate ray and then answer the distance to the
+        face's boundary (bug27453 piattello face 118: 3.795 mm for 3.000). A foot on the
+        face bounds the distance from above like BRepExtrema's own answer, so the smaller
+        of the two is never below the true distance; corrections are counted."""
         vertex = BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex()
         dss = BRepExtrema_DistShapeShape(vertex, self.faces[number].face)
-        return dss.Value() if dss.IsDone() else math.inf
+        dist = dss.Value() if dss.IsDone() else math.inf
+        f = self.faces[number]
+        u, v = f.project(p, None)
+        foot = float(np.linalg.norm(np.asarray(p, float) - f.point(u, v)))
+        if foot < dist - 1e-9 and f.on_face(u, v):
+            self.corrections.append({"face": number, "p": [float(x) for x in p],
+                                     "brepextrema": dist, "foot": foot})
+            return foot
+        return dist

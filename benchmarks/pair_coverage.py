@@ -63,9 +63,12 @@ def judge_path(o: Oracle, faces, polylines, offset: float, cap: int) -> dict:
 
     ``shank_mm``: how far the shank (p to p + 10 R' z) comes nearer than R' to the part
     at the worst checked point, with its face; reported beside silent-bad (the shank
-    rule is the spec's, the gouge gate does not check it)."""
+    rule is the spec's, the gouge gate does not check it). ``corrected``: distances where
+    BRepExtrema's answer was replaced by a shorter one to a foot on the face
+    (``Oracle.face_distance``)."""
     worst_face, worst_gouge, checked = 0.0, 0.0, 0
     worst_shank, shank_face = 0.0, 0
+    corrections = len(o.corrections)
     for line in polylines:
         idx = np.unique(np.linspace(0, len(line) - 1, min(cap, len(line))).round().astype(int))
         for p in line[idx]:
@@ -80,6 +83,7 @@ def judge_path(o: Oracle, faces, polylines, offset: float, cap: int) -> dict:
                 worst_shank, shank_face = offset - dist, face
     return {"checked": checked, "off_face_mm": worst_face, "gouge_mm": worst_gouge,
             "shank_mm": worst_shank, "shank_face": shank_face,
+            "corrected": o.corrections[corrections:],
             "bad": worst_face > TOL or worst_gouge > TOL}
 
 
@@ -218,6 +222,11 @@ def table(records: list[dict], notes: list[dict]) -> str:
                     + ", ".join(f"{k} {v}" for k, v in counts.most_common()))
     for radius in sorted({r["radius"] for r in records}):
         rows.extend(program_notes([r for r in records if r["radius"] == radius], radius))
+    for r in records:
+        for c in r.get("path_check", {}).get("corrected", []):
+            rows.append(f"{r['part']} faces {r['faces']} R {r['radius']}: face {c['face']} at "
+                        f"{[round(x, 4) for x in c['p']]}: BRepExtrema {c['brepextrema']:.4f}"
+                        f" mm, foot on the face (FClass2d) {c['foot']:.4f} mm: the foot counts")
     for n in notes:
         if n["problem"] or not n["pairs"]:
             rows.append(f"{n['part']}: no pair judged ({n['problem'] or 'no concave edge'}); "

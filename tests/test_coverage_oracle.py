@@ -119,3 +119,36 @@ def test_api_mode_runs_the_pair_runner_with_the_period_in_seconds():
     msg = "cadcnc: path: faces 3 and 4: no feasible ball position along their shared " \
           "concave edge(s): edge 1: the ball touches face 4 outside the face"
     assert classify(2, msg) == "no feasible position (stretch finder)"
+
+
+def test_face_distance_closed_form_and_the_classifier_correction(pocket, monkeypatch):
+    """Pocket floor (z = 15, the pocket spans x -30..30): 3 mm above its middle the
+    distance is 3; above (-40, 0), outside the pocket, the foot is off the face and the
+    distance is to the floor's edge x = -30, sqrt(10^2 + 3^2). When BRepExtrema overstates
+    a distance (its classifier calling an inside foot OUT), the foot on the face replaces
+    it and is counted; a foot off the face never does."""
+    floor, *_ = _plane("pocket", "pocket floor z=15")
+    inside, outside = np.array([0.0, 0.0, 18.0]), np.array([-40.0, 0.0, 18.0])
+    pocket.corrections.clear()
+    assert pocket.face_distance(inside, floor) == pytest.approx(3.0, abs=1e-9)
+    assert pocket.face_distance(outside, floor) == pytest.approx(np.sqrt(109.0), abs=1e-9)
+    assert pocket.corrections == []
+
+    real = _oracle.BRepExtrema_DistShapeShape
+
+    class Overstated:  # BRepExtrema answering 1 mm too far, as at a degenerate ray
+        def __init__(self, a, b):
+            self.d = real(a, b)
+
+        def IsDone(self):
+            return self.d.IsDone()
+
+        def Value(self):
+            return self.d.Value() + 1.0
+
+    monkeypatch.setattr(_oracle, "BRepExtrema_DistShapeShape", Overstated)
+    assert pocket.face_distance(inside, floor) == pytest.approx(3.0, abs=1e-9)
+    assert pocket.face_distance(outside, floor) == pytest.approx(np.sqrt(109.0) + 1.0)
+    assert [c["face"] for c in pocket.corrections] == [floor]
+    assert pocket.clearance(inside, 3.5)[0] <= 3.0 + 1e-9
+    pocket.corrections.clear()
