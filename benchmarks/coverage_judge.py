@@ -13,7 +13,6 @@ Lengths mm.
 from __future__ import annotations
 
 import collections
-import functools
 import hashlib
 import json
 import os
@@ -33,7 +32,6 @@ VERSION = 2  # of the judge's verdicts (2: `unreachable`)
 _HERE = Path(__file__).resolve().parent
 
 
-@functools.lru_cache(maxsize=1)
 def judge_digest() -> str:
     """sha1 (12 hex digits) of the judge's source: coverage_oracle.py and this file."""
     h = hashlib.sha1()
@@ -42,13 +40,16 @@ def judge_digest() -> str:
     return h.hexdigest()[:12]
 
 
+DIGEST = judge_digest()  # at import: the source this process runs
+
+
 def _cache_file(step: str, faces, radius: float, cap) -> Path | None:
     folder = os.environ.get(CACHE_ENV)
     if not folder:
         return None
     st = os.stat(step)
     name = (f"{Path(step).name}-{st.st_size}-{int(st.st_mtime)}-R{radius:g}-{faces[0]}-"
-            f"{faces[1]}-cap{cap}-v{VERSION}-{judge_digest()}.json")
+            f"{faces[1]}-cap{cap}-v{VERSION}-{DIGEST}.json")
     return Path(folder) / name
 
 
