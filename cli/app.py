@@ -17,6 +17,8 @@ from importlib.metadata import version
 from cadcnc.errors import CadcncError  # light: the package loads OCCT lazily
 from cadcnc.interrupts import sigint_deferred
 
+from .pencil import DEFAULT_FEED, DEFAULT_PERIOD
+
 UNITS = "Units: lengths mm, feed mm/min, period with a unit (4ms, 0.004s, 250us)."
 
 
@@ -37,9 +39,13 @@ def _job_options(p, required: bool) -> None:
     p.add_argument("--radius", required=required, metavar="R", help="ball radius, mm")
     p.add_argument("--allowance", default="0", metavar="C",
                    help="stock allowance left on both faces, mm (default 0)")
-    p.add_argument("--feed", required=required, metavar="F", help="feed, mm/min")
-    p.add_argument("--period", required=required, metavar="T",
-                   help="interpolation period with its unit: 4ms, 0.004s or 250us")
+    # `path` defaults as `pencil` does (1500 mm/min, 4 ms); `verify` keeps None (the JSON's)
+    feed, period = (DEFAULT_FEED, DEFAULT_PERIOD) if required else (None, None)
+    p.add_argument("--feed", default=feed, metavar="F",
+                   help="feed, mm/min" + (f" (default {feed})" if feed else ""))
+    p.add_argument("--period", default=period, metavar="T",
+                   help="interpolation period with its unit: 4ms, 0.004s or 250us"
+                        + (f" (default {period}: the paper's 0.1 mm step)" if period else ""))
     p.add_argument("--start", metavar="X,Y,Z",
                    help="start point near the intersection, mm (default: the shared "
                         "concave edge's start)")
