@@ -152,3 +152,28 @@ def test_face_distance_closed_form_and_the_classifier_correction(pocket, monkeyp
     assert [c["face"] for c in pocket.corrections] == [floor]
     assert pocket.clearance(inside, 3.5)[0] <= 3.0 + 1e-9
     pocket.corrections.clear()
+
+
+def test_surface_models_are_sewn_with_the_files_face_numbers():
+    """The same part as a solid, a closed shell and loose faces (two of them reversed in
+    the file): the judge sews the loose faces, keeps the file's numbers, and finds the same
+    concave edge with the same verdicts and centres. The open sheet's floor points down in
+    the file: its material side is chosen so that most of the area faces +Z, which makes
+    the floor-wall corner concave (270 deg)."""
+    judged = {}
+    for name in ("surf_boss_solid", "surf_boss_shell", "surf_boss_faces"):
+        o = Oracle(read_shape(str(ROOT / "fixtures" / f"{name}.step")))
+        (edge,) = o.concave_edges()
+        judged[name] = (o.rules, edge.faces, [o.judge(edge, t, 2.0, 20.0)
+                                              for t in o.samples(edge, cap=9)])
+    assert [judged[n][0] for n in judged] == [["solid"], ["closed shell"], ["closed shell"]]
+    solid = judged["surf_boss_solid"]
+    for name in ("surf_boss_shell", "surf_boss_faces"):
+        assert judged[name][1] == solid[1] == (4, 5)
+        assert [v["verdict"] for v in judged[name][2]] == [v["verdict"] for v in solid[2]]
+        assert np.abs(np.array([v["p"] for v in judged[name][2]])
+                      - [v["p"] for v in solid[2]]).max() < 1e-9
+    sheet = Oracle(read_shape(str(ROOT / "fixtures" / "surf_sheet.step")))
+    (edge,) = sheet.concave_edges()
+    assert sheet.rules == ["open shell, flipped"] and edge.faces == (1, 2)
+    assert abs(edge.angles - 270.0).max() < 1.0
