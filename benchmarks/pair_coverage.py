@@ -212,7 +212,7 @@ def table(records: list[dict], notes: list[dict]) -> str:
         written = sum(run["outcome"] == "written" for run in runs)
         bad = sum(bool(r.get("path_check", {}).get("bad")) for r in rs)
         crashes = sum(run["outcome"] in ("crash", "timeout") for run in runs)
-        pct = lambda a, b: f"{100.0 * a / b:.0f}" if b else "-"  # noqa: E731
+        pct = lambda a, b: f"{100.0 * a / b:.1f}" if b else "-"  # noqa: E731
         cu, u = (sum(r.get(k, 0) for r in rs) for k in ("covered_unreachable", "unreachable"))
         missed = sum(len(r.get("missed", [])) for r in rs)
         rows.append(f"| {part} | {radius} | {len(rs)} | {c} / {f} | {pct(c, f)} | {missed} "
