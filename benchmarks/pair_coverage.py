@@ -39,7 +39,7 @@ from coverage_paths import classify, run_faces, run_path  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 
 _ORACLES: dict[str, Oracle] = {}
-SHOWN_CORRECTION = 1e-6  # mm: face_distance corrections below this are round-off, not listed
+SHOWN_CORRECTION = 1e-4  # mm: face_distance corrections listed (smaller: far below 1 um)
 
 
 def oracle_for(step: str) -> Oracle:
@@ -66,7 +66,7 @@ def judge_path(o: Oracle, faces, polylines, offset: float, cap: int) -> dict:
     at the worst checked point, with its face; reported beside silent-bad (the shank
     rule is the spec's, the gouge gate does not check it). ``corrected``: distances where
     BRepExtrema's answer was replaced by one shorter by more than SHOWN_CORRECTION to a
-    foot on the face (``Oracle.face_distance``)."""
+    foot on the face (``Oracle.face_distance``), each (face, point) once."""
     worst_face, worst_gouge, checked = 0.0, 0.0, 0
     worst_shank, shank_face = 0.0, 0
     corrections = len(o.corrections)
@@ -84,9 +84,19 @@ def judge_path(o: Oracle, faces, polylines, offset: float, cap: int) -> dict:
                 worst_shank, shank_face = offset - dist, face
     return {"checked": checked, "off_face_mm": worst_face, "gouge_mm": worst_gouge,
             "shank_mm": worst_shank, "shank_face": shank_face,
-            "corrected": [c for c in o.corrections[corrections:]
-                          if c["brepextrema"] - c["foot"] > SHOWN_CORRECTION],
+            "corrected": unique_corrections(o.corrections[corrections:]),
             "bad": worst_face > TOL or worst_gouge > TOL}
+
+
+def unique_corrections(found: list[dict]) -> list[dict]:
+    """The corrections above SHOWN_CORRECTION, each (face, point) once."""
+    seen, out = set(), []
+    for c in found:
+        key = (c["face"], tuple(c["p"]))
+        if c["brepextrema"] - c["foot"] > SHOWN_CORRECTION and key not in seen:
+            seen.add(key)
+            out.append(c)
+    return out
 
 
 def run_pair(task: dict) -> dict:
@@ -225,9 +235,7 @@ def table(records: list[dict], notes: list[dict]) -> str:
     for radius in sorted({r["radius"] for r in records}):
         rows.extend(program_notes([r for r in records if r["radius"] == radius], radius))
     for r in records:
-        for c in r.get("path_check", {}).get("corrected", []):
-            if c["brepextrema"] - c["foot"] <= SHOWN_CORRECTION:
-                continue
+        for c in unique_corrections(r.get("path_check", {}).get("corrected", [])):
             rows.append(f"{r['part']} faces {r['faces']} R {r['radius']}: face {c['face']} at "
                         f"{[round(x, 4) for x in c['p']]}: BRepExtrema {c['brepextrema']:.4f}"
                         f" mm, foot on the face (FClass2d) {c['foot']:.4f} mm: the foot counts")

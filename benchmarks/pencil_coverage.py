@@ -34,7 +34,7 @@ from pathlib import Path
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pair_coverage import (  # noqa: E402
-    SHOWN_CORRECTION, judge_path, oracle_for, pairs_of, spread)
+    judge_path, oracle_for, pairs_of, spread, unique_corrections)
 from coverage_judge import covered, judge_pair_cached, missed_runs  # noqa: E402
 from coverage_paths import cadcnc_command, classify, distance_to_polylines  # noqa: E402
 
@@ -207,9 +207,7 @@ def table(records: list[dict]) -> str:
             rows.append(f"- {r['part']} R {r['radius']}: silent-bad cut faces {b['faces']}: "
                         f"off its faces by {b['off_face_mm']:.2e} mm, gouge "
                         f"{b['gouge_mm']:.2e} mm")
-        for c in check.get("corrected", []):
-            if c["brepextrema"] - c["foot"] <= SHOWN_CORRECTION:
-                continue
+        for c in unique_corrections(check.get("corrected", [])):
             rows.append(f"- {r['part']} R {r['radius']}: face {c['face']} at "
                         f"{[round(x, 4) for x in c['p']]}: BRepExtrema {c['brepextrema']:.4f}"
                         f" mm, foot on the face (FClass2d) {c['foot']:.4f} mm: the foot counts")
