@@ -38,6 +38,14 @@ from .stretches import Feasibility, edge_stretches, pair_stretches
 
 CHAIN_GAP = 1e-3
 """mm: a cut starting this near another's end continues it (no lift)."""
+OWN_SHARE = 0.7
+"""Share of the gouge limit by which the ball may come nearer than R' to its own faces'
+edges (the guard's own-face rule), so that a stretch ending there passes the gate of the
+program as written: of the limit, the G64 P blending takes 0.1 (io.gcode.BLEND_SHARE),
+the rounding of the written coordinates up to 0.1 (tolerance / 10) and the chords
+between points the rest. With the whole limit (guard_for) a cut ending on a B-spline
+face's edge (edge tolerance 8.7 um in bug32596_abc_0_13.step) reached 0.9998-1.005 um
+and the gate refused the whole program (exit 5)."""
 DEFAULT_FEED = 1500.0     # mm/min: with DEFAULT_PERIOD, the paper's 0.1 mm step
 DEFAULT_PERIOD = 0.004    # s
 
@@ -83,7 +91,7 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
             s1, s2 = part.face(i), part.face(j)
             with clock("guards"):   # one per pair (its cache serves all its corners)
                 guard = guards.get((i, j)) or guards.setdefault(
-                    (i, j), guard_for(part, (i, j), cjob))
+                    (i, j), pencil_guard(part, (i, j), cjob))
             if corner.kind == EDGE:
                 with clock("stretches"):
                     if (i, j) not in stretches:
@@ -123,6 +131,14 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
         ordered, unreachable = reachable_order(part, job, cuts, z_safe)
         segments = linked(ordered, z_safe, join=CHAIN_GAP)
     return Program(job, segments, skipped + unreachable)
+
+
+def pencil_guard(part: Part, pair: tuple[int, int], job: Job) -> ClearanceGuard:
+    """The stepper's and stretch search's guard of a pencil corner: ``guard_for``'s, with
+    the own-face rule at OWN_SHARE of the gouge limit (mm)."""
+    tol = job.tolerances
+    return guard_for(part, pair, replace(job, tolerances=replace(tol, gouge=OWN_SHARE
+                                                                 * tol.gouge)))
 
 
 class _Clock:
