@@ -24,29 +24,20 @@ from __future__ import annotations
 
 import argparse
 import gc
-import sys
 import time
 import tracemalloc
 from pathlib import Path
 
-# numba probes for the `coverage` package at import: this folder's coverage.py must not
-# answer (it would break numba's import), so import numba with the folder off the path
-_HERE = Path(__file__).resolve().parent
-_PATH = list(sys.path)
-sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != _HERE]
-import numba  # noqa: E402,F401
-sys.path[:] = _PATH
+import numpy as np
+from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.Geom import Geom_OffsetSurface
+from OCP.GeomAPI import GeomAPI_IntSS
+from OCP.gp import gp_Pnt, gp_Vec
 
-import numpy as np  # noqa: E402
-from OCP.BRepAdaptor import BRepAdaptor_Surface  # noqa: E402
-from OCP.Geom import Geom_OffsetSurface  # noqa: E402
-from OCP.GeomAPI import GeomAPI_IntSS  # noqa: E402
-from OCP.gp import gp_Pnt, gp_Vec  # noqa: E402
-
-import cadcnc  # noqa: E402
-from cadcnc.interp.stepper import Stepper  # noqa: E402
-from cadcnc.ops.pair_path import pair_job, plan_path  # noqa: E402
-from latency import latency, percentiles  # noqa: E402
+import cadcnc
+from cadcnc.interp.stepper import Stepper
+from cadcnc.ops.pair_path import pair_job, plan_path
+from latency import latency, percentiles
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = [("bspline_boss", 4, 5), ("crossing_cylinders", 1, 2), ("sphere_cylinder", 1, 2),

@@ -1,5 +1,5 @@
 """The judge's verdicts on one pair's concave edges, and coverage of them by cut polylines
-(shared by ``coverage.py``, one ``cadcnc path`` run per pair, and ``pencil_coverage.py``,
+(shared by ``pair_coverage.py``, one ``cadcnc path`` run per pair, and ``pencil_coverage.py``,
 one ``cadcnc pencil`` run per part).
 
 Positions are those of ``coverage_oracle.py``: every 0.2 mm of each concave edge, at least
@@ -13,6 +13,7 @@ Lengths mm.
 from __future__ import annotations
 
 import collections
+import hashlib
 import json
 import os
 from pathlib import Path
@@ -24,9 +25,23 @@ from coverage_paths import distance_to_polylines
 COVERED = 5e-3  # mm: a feasible position within this of a cut polyline is covered
 CACHE_ENV = "COVERAGE_JUDGE_CACHE"
 """A folder named by this environment variable keeps each pair's verdicts (one JSON file
-per part, radius, pair and cap), so that coverage.py and pencil_coverage.py judge a part
-once. The key holds the file's size and mtime and VERSION."""
+per part, radius, pair and cap), so that pair_coverage.py and pencil_coverage.py judge a
+part once. The key holds the file's size and mtime, VERSION and a digest of the judge's
+source (this file, coverage_oracle.py and coverage_sewing.py): any change to the judge makes a new key."""
 VERSION = 2  # of the judge's verdicts (2: `unreachable`)
+_HERE = Path(__file__).resolve().parent
+
+
+def judge_digest() -> str:
+    """sha1 (12 hex digits) of the judge's source: coverage_oracle.py, coverage_sewing.py
+    and this file."""
+    h = hashlib.sha1()
+    for name in ("coverage_oracle.py", "coverage_judge.py", "coverage_sewing.py"):
+        h.update((_HERE / name).read_bytes())
+    return h.hexdigest()[:12]
+
+
+DIGEST = judge_digest()  # at import: the source this process runs
 
 
 def _cache_file(step: str, faces, radius: float, cap) -> Path | None:
@@ -35,7 +50,7 @@ def _cache_file(step: str, faces, radius: float, cap) -> Path | None:
         return None
     st = os.stat(step)
     name = (f"{Path(step).name}-{st.st_size}-{int(st.st_mtime)}-R{radius:g}-{faces[0]}-"
-            f"{faces[1]}-cap{cap}-v{VERSION}.json")
+            f"{faces[1]}-cap{cap}-v{VERSION}-{DIGEST}.json")
     return Path(folder) / name
 
 

@@ -14,6 +14,9 @@ to both offset surfaces in the plane through the sample normal to the edge, and 
 - the shank, the segment p .. p + L z (L = 10 R by default), at least R' - 1 um from
   every face (the same broad phase and exact distances, from the segment as an edge).
 
+A surface model (no solid) is sewn first, its faces keeping the file's numbers, and
+given a material side (``coverage_sewing.py``).
+
 Lengths in mm. Verdicts: ``feasible`` (all four rules), ``ball`` (the ball fits, the
 shank hits ``face``), or a reason: ``no_tangency``, ``off_face`` (face), ``nearer``
 (face), ``inside`` (the ball on the material side).
@@ -49,6 +52,8 @@ from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_IN, TopAbs_ON, TopAbs_RE
 from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
+
+from coverage_sewing import sew_model
 
 SPACING = 0.2        # mm between edge samples (the spec)
 MIN_SAMPLES = 9      # per edge (the spec)
@@ -135,22 +140,32 @@ class Oracle:
     """The part as the judge sees it: faces, boxes and shared edges, then verdicts."""
 
     def __init__(self, shape):
-        self.shape = shape
+        sewn = sew_model(shape)  # a surface model: sewn, file numbers kept
+        self.shape = shape if sewn is None else sewn.shape
+        self.rules = ["solid"] if sewn is None else sewn.rules
         fmap = TopTools_IndexedMapOfShape()
-        TopExp.MapShapes_s(shape, TopAbs_FACE, fmap)
+        TopExp.MapShapes_s(self.shape, TopAbs_FACE, fmap)
         self.fmap = fmap
-        self.faces = {n: self._face(n, TopoDS.Face_s(fmap.FindKey(n)))
-                      for n in range(1, fmap.Extent() + 1)}
+        if sewn is None:
+            self.number = list(range(fmap.Extent() + 1))   # index in fmap -> face number
+            self.faces = {n: self._face(n, TopoDS.Face_s(fmap.FindKey(n)))
+                          for n in range(1, fmap.Extent() + 1)}
+        else:
+            self.number = [0] * (fmap.Extent() + 1)
+            for n, f in sewn.faces.items():
+                self.number[fmap.FindIndex(f)] = n
+            self.faces = {n: self._face(n, f, sewn.flip[n]) for n, f in sewn.faces.items()}
         self.boxes = np.array([self._box(f.face) for f in self.faces.values()]).reshape(-1, 6)
         self.edges = self._shared_edges()
+        self.corrections: list[dict] = []  # face_distance's (see there)
 
     @staticmethod
-    def _face(n: int, face) -> Face:
+    def _face(n: int, face, flip: bool = False) -> Face:
         surface = BRep_Tool.Surface_s(face)
         umin, umax, vmin, vmax = BRepTools.UVBounds_s(face)
         periods = (surface.UPeriod() if surface.IsUPeriodic() else 0.0,
                    surface.VPeriod() if surface.IsVPeriodic() else 0.0)
-        return Face(n, face, surface, face.Orientation() == TopAbs_REVERSED,
+        return Face(n, face, surface, (face.Orientation() == TopAbs_REVERSED) != flip,
                     ShapeAnalysis_Surface(surface), BRepTopAdaptor_FClass2d(face, CLASSIFY_TOL),
                     (umin, umax, vmin, vmax), periods)
 
@@ -168,7 +183,8 @@ class Oracle:
             edge = TopoDS.Edge_s(emap.FindKey(k))
             if BRep_Tool.Degenerated_s(edge):
                 continue
-            numbers = sorted({self.fmap.FindIndex(f) for f in emap.FindFromIndex(k)})
+            numbers = sorted({self.number[self.fmap.FindIndex(f)]
+                              for f in emap.FindFromIndex(k)})
             if len(numbers) != 2:
                 continue  # a seam or a free or non-manifold edge
             curve = BRepAdaptor_Curve(edge)
@@ -334,11 +350,35 @@ class Oracle:
                 return {**out, "verdict": "unreachable", "face": n}
         return {**out, "verdict": "feasible"}
 
+    # -- judging written points (silent-bad) -------------------------------------------------
     def clearance(self, p: np.ndarray, reach: float) -> tuple[float, int]:
-        """Distance from p to the nearest face within ``reach`` (for judging paths)."""
-        return self.ball_clearance(p, reach)
+        """(distance, face) from p to the nearest face within ``reach`` (inf, 0 if none),
+        each distance by :meth:`face_distance` (for judging paths)."""
+        best = (math.inf, 0)
+        for n in self.near_faces(p, p, reach):
+            d = self.face_distance(p, int(n))
+            if d < best[0]:
+                best = (d, int(n))
+        return best
 
     def face_distance(self, p: np.ndarray, number: int) -> float:
+        """Distance from p to the trimmed face, mm: BRepExtrema_DistShapeShape, or the
+        distance to the foot of p on the surface when that is shorter and the foot lies
+        on the face by ``on_face`` (BRepTopAdaptor_FClass2d, as the verdicts use).
+
+        BRepExtrema classifies its projected foot with BRepClass_FaceClassifier, which can
+        call an inside point OUT at a degenerate ray and then answer the distance to the
+        face's boundary (bug27453 piattello face 118: 3.795 mm for 3.000). A foot on the
+        face bounds the distance from above like BRepExtrema's own answer, so the smaller
+        of the two is never below the true distance; corrections are counted."""
         vertex = BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex()
         dss = BRepExtrema_DistShapeShape(vertex, self.faces[number].face)
-        return dss.Value() if dss.IsDone() else math.inf
+        dist = dss.Value() if dss.IsDone() else math.inf
+        f = self.faces[number]
+        u, v = f.project(p, None)
+        foot = float(np.linalg.norm(np.asarray(p, float) - f.point(u, v)))
+        if foot < dist - 1e-9 and f.on_face(u, v):
+            self.corrections.append({"face": number, "p": [float(x) for x in p],
+                                     "brepextrema": dist, "foot": foot})
+            return foot
+        return dist

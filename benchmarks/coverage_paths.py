@@ -22,6 +22,7 @@ EXPECTED_CODES = {0, 2, 3, 4, 5, 6}  # anything else (or a traceback) is a crash
 
 REASONS = [  # (reason, pattern in cadcnc's message), first match wins
     ("no feasible position (stretch finder)", re.compile(r"no feasible ball position")),
+    ("no corner to cut (pencil)", re.compile(r"no corner to cut")),
     ("start off a face", re.compile(r"touches face \d+ outside the face|outside the face")),
     ("ball cuts the part (gouge gate)", re.compile(r"cuts into the part")),
     ("faces tangent at the start", re.compile(r"stopped at the start point \(tangent\)")),

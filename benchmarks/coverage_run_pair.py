@@ -15,12 +15,7 @@ coverage it would have given can be counted). Exit codes follow the CLI: 0 writt
 from __future__ import annotations
 
 import json
-import os
 import sys
-
-# this folder holds coverage.py, which would shadow the `coverage` package numba imports
-sys.path[:] = [p for p in sys.path if os.path.abspath(p or ".") != os.path.dirname(
-    os.path.abspath(__file__))]
 
 
 def main(argv: list[str]) -> int:

@@ -32,21 +32,15 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
+import cadcnc
+from cadcnc.geometry.part import optimal_box
+from cadcnc.verification import gate_program
+from finish_bench_tools import FaceDistances, run_ocl, tessellate
+import freeform_slab
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-# benchmarks/coverage.py would shadow the `coverage` package numba probes when imported:
-# import numba with this folder off sys.path, then put it back for the sibling modules
-sys.path[:] = [p for p in sys.path if os.path.abspath(p or ".") != HERE]
-import numba  # noqa: E402,F401
-sys.path.insert(0, HERE)
-
-import numpy as np  # noqa: E402
-
-import cadcnc  # noqa: E402
-from cadcnc.geometry.part import optimal_box  # noqa: E402
-from cadcnc.verification import gate_program  # noqa: E402
-from finish_bench_tools import FaceDistances, run_ocl, tessellate  # noqa: E402
-import freeform_slab  # noqa: E402
-
 ROOT = Path(HERE).parent
 R, FEED, PERIOD = 3.0, 1500.0, 0.004
 SPACING = FEED * PERIOD / 60.0    # 0.1 mm: cadcnc's step, OCL's point spacing

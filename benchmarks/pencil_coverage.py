@@ -33,7 +33,8 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from coverage import judge_path, oracle_for, pairs_of, spread  # noqa: E402
+from pair_coverage import (  # noqa: E402
+    judge_path, oracle_for, pairs_of, spread, unique_corrections)
 from coverage_judge import covered, judge_pair_cached, missed_runs  # noqa: E402
 from coverage_paths import cadcnc_command, classify, distance_to_polylines  # noqa: E402
 
@@ -144,7 +145,10 @@ def measure(step: Path, radius: float, args) -> dict:
         rec["check"] = {"cuts": len(bad), "bad": sum(b["bad"] for b in bad),
                         "points": sum(b["checked"] for b in bad),
                         "off_face_mm": max((b["off_face_mm"] for b in bad), default=0.0),
-                        "gouge_mm": max((b["gouge_mm"] for b in bad), default=0.0)}
+                        "gouge_mm": max((b["gouge_mm"] for b in bad), default=0.0),
+                        "bad_cuts": [{"faces": s["faces"], **{k: b[k] for k in (
+                            "off_face_mm", "gouge_mm")}} for s, b in zip(cuts, bad) if b["bad"]],
+                        "corrected": [c for b in bad for c in b["corrected"]]}
     rec["seconds"] = round(time.perf_counter() - t0, 1)
     return rec
 
@@ -198,6 +202,15 @@ def table(records: list[dict]) -> str:
         for m in r["missed"][:5]:
             rows.append(f"- {r['part']} R {r['radius']}: missed faces {m['faces']} edge "
                         f"{m['edge']}: {m['n']} positions {m['from']} .. {m['to']}")
+        check = r.get("check", {})
+        for b in check.get("bad_cuts", []):
+            rows.append(f"- {r['part']} R {r['radius']}: silent-bad cut faces {b['faces']}: "
+                        f"off its faces by {b['off_face_mm']:.2e} mm, gouge "
+                        f"{b['gouge_mm']:.2e} mm")
+        for c in unique_corrections(check.get("corrected", [])):
+            rows.append(f"- {r['part']} R {r['radius']}: face {c['face']} at "
+                        f"{[round(x, 4) for x in c['p']]}: BRepExtrema {c['brepextrema']:.4f}"
+                        f" mm, foot on the face (FClass2d) {c['foot']:.4f} mm: the foot counts")
         if times(r["run"].get("summary", "")) != "-":
             rows.append(f"- {r['part']} R {r['radius']}: {times(r['run']['summary'])}")
     return "\n".join(rows)

@@ -25,8 +25,10 @@ _parts: dict = {}
 
 
 def load_benchmark(name: str):
-    """A benchmarks/ module by file path: benchmarks/ is not put on sys.path, where its
-    coverage.py would shadow the ``coverage`` package that numba looks for."""
+    """A benchmarks/ module by file path, registered under its name; benchmarks/ goes at
+    the end of sys.path so that its sibling imports resolve (installed packages first)."""
+    if str(ROOT / "benchmarks") not in sys.path:
+        sys.path.append(str(ROOT / "benchmarks"))
     spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module

@@ -157,8 +157,8 @@ def test_a_program_stopped_short_exits_6(tmp_path, monkeypatch):
     the rest of its stretch listed as stopped short: exit 6, nothing written unless
     --allow-partial (still 6); the summary says partial and why."""
     real = pair_program.stepper_for
-    monkeypatch.setattr(pair_program, "stepper_for", lambda plan, max_cycles, record: real(
-        plan, 40, record, check_cycles=False))  # a deliberately short run, as documented
+    monkeypatch.setattr(pair_program, "stepper_for", lambda plan, max_cycles, record, **kw: real(
+        plan, 40, record, check_cycles=False, **kw))  # a deliberately short run, as documented
     out = tmp_path / "p.json"
     args = ["path", SHELF, *SHELF_JOB, "--stretch", "1", "-o", out]
     run = cadcnc_cli(*args)

@@ -119,3 +119,61 @@ def test_api_mode_runs_the_pair_runner_with_the_period_in_seconds():
     msg = "cadcnc: path: faces 3 and 4: no feasible ball position along their shared " \
           "concave edge(s): edge 1: the ball touches face 4 outside the face"
     assert classify(2, msg) == "no feasible position (stretch finder)"
+
+
+def test_face_distance_closed_form_and_the_classifier_correction(pocket, monkeypatch):
+    """Pocket floor (z = 15, the pocket spans x -30..30): 3 mm above its middle the
+    distance is 3; above (-40, 0), outside the pocket, the foot is off the face and the
+    distance is to the floor's edge x = -30, sqrt(10^2 + 3^2). When BRepExtrema overstates
+    a distance (its classifier calling an inside foot OUT), the foot on the face replaces
+    it and is counted; a foot off the face never does."""
+    floor, *_ = _plane("pocket", "pocket floor z=15")
+    inside, outside = np.array([0.0, 0.0, 18.0]), np.array([-40.0, 0.0, 18.0])
+    pocket.corrections.clear()
+    assert pocket.face_distance(inside, floor) == pytest.approx(3.0, abs=1e-9)
+    assert pocket.face_distance(outside, floor) == pytest.approx(np.sqrt(109.0), abs=1e-9)
+    assert pocket.corrections == []
+
+    real = _oracle.BRepExtrema_DistShapeShape
+
+    class Overstated:  # BRepExtrema answering 1 mm too far, as at a degenerate ray
+        def __init__(self, a, b):
+            self.d = real(a, b)
+
+        def IsDone(self):
+            return self.d.IsDone()
+
+        def Value(self):
+            return self.d.Value() + 1.0
+
+    monkeypatch.setattr(_oracle, "BRepExtrema_DistShapeShape", Overstated)
+    assert pocket.face_distance(inside, floor) == pytest.approx(3.0, abs=1e-9)
+    assert pocket.face_distance(outside, floor) == pytest.approx(np.sqrt(109.0) + 1.0)
+    assert [c["face"] for c in pocket.corrections] == [floor]
+    assert pocket.clearance(inside, 3.5)[0] <= 3.0 + 1e-9
+    pocket.corrections.clear()
+
+
+def test_surface_models_are_sewn_with_the_files_face_numbers():
+    """The same part as a solid, a closed shell and loose faces (two of them reversed in
+    the file): the judge sews the loose faces, keeps the file's numbers, and finds the same
+    concave edge with the same verdicts and centres. The open sheet's floor points down in
+    the file: its material side is chosen so that most of the area faces +Z, which makes
+    the floor-wall corner concave (270 deg)."""
+    judged = {}
+    for name in ("surf_boss_solid", "surf_boss_shell", "surf_boss_faces"):
+        o = Oracle(read_shape(str(ROOT / "fixtures" / f"{name}.step")))
+        (edge,) = o.concave_edges()
+        judged[name] = (o.rules, edge.faces, [o.judge(edge, t, 2.0, 20.0)
+                                              for t in o.samples(edge, cap=9)])
+    assert [judged[n][0] for n in judged] == [["solid"], ["closed shell"], ["closed shell"]]
+    solid = judged["surf_boss_solid"]
+    for name in ("surf_boss_shell", "surf_boss_faces"):
+        assert judged[name][1] == solid[1] == (4, 5)
+        assert [v["verdict"] for v in judged[name][2]] == [v["verdict"] for v in solid[2]]
+        assert np.abs(np.array([v["p"] for v in judged[name][2]])
+                      - [v["p"] for v in solid[2]]).max() < 1e-9
+    sheet = Oracle(read_shape(str(ROOT / "fixtures" / "surf_sheet.step")))
+    (edge,) = sheet.concave_edges()
+    assert sheet.rules == ["open shell, flipped"] and edge.faces == (1, 2)
+    assert abs(edge.angles - 270.0).max() < 1.0

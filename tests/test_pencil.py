@@ -144,3 +144,25 @@ def test_a_hole_of_the_balls_radius_is_cut_by_a_plunge():
     assert point.path.faces == (11, 12) and prog.complete and not prog.skipped
     gate = gouge_gate(point.path, part, moves=prog.all_moves())
     assert gate.ok, gate.message
+
+
+def test_the_guard_keeps_own_face_edges_within_the_written_programs_allowance():
+    """A cut may end where the ball reaches its own face's edge (a B-spline face whose edge
+    lies off its surface by the file's tolerance). The gate of the written program allows
+    the gouge limit less G64 P (blend_for) and the G-code's rounding (tolerance / 10, the
+    rule of digits_for): every operation's guard (pencil's, path's) must stop the ball inside that, with room for the
+    chords between points; third faces keep the 1 nm rule."""
+    from cadcnc.io.gcode import DEFAULT_TOLERANCE, blend_for, digits_for
+    from cadcnc.job import Job, PairPath, Tool
+    from cadcnc.ops.guard import operation_guard
+
+    part = load_fixture("pocket")
+    job = Job(Tool(3.0, 0.0), 1500.0, 0.004, PairPath(faces=(9, 12), edge=0))
+    tol = job.tolerances
+    guard = operation_guard(part, (9, 12), job)
+    gouge = tol.gouge
+    rounding = np.sqrt(3) / 2 * 10.0 ** -digits_for(DEFAULT_TOLERANCE)
+    room = gouge - blend_for(gouge) - rounding            # what the written moves may use
+    intrusion = guard.offset - guard.own_threshold        # what the guard lets the ball do
+    assert 0.0 < intrusion <= room - 0.05 * gouge, (intrusion, room)
+    assert guard.threshold == pytest.approx(guard.offset - tol.hit, abs=1e-15)

@@ -3,9 +3,6 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-
 import cadquery as cq
 import numpy as np
 import pytest
@@ -14,7 +11,7 @@ import cadcnc
 from cadcnc.geometry.part import Part
 from cadcnc.ops.pencil import NOT_REACHABLE
 from cadcnc.verification import gouge_gate
-from conftest import ROOT
+from conftest import load_benchmark
 
 RADIUS = 1.0   # shank 10 mm, shorter than the 30 mm void
 
@@ -30,12 +27,7 @@ def shape():
 
 
 def _oracle():
-    path = ROOT / "benchmarks" / "coverage_oracle.py"
-    spec = importlib.util.spec_from_file_location("coverage_oracle", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["coverage_oracle"] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_benchmark("coverage_oracle")
 
 
 def test_judge_calls_the_void_floor_unreachable(shape):

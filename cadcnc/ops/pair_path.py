@@ -186,16 +186,17 @@ def check_cycle_count(plan: PathPlan, max_cycles: int) -> None:
 
 
 def stepper_for(plan: PathPlan, max_cycles: int = 1_000_000, record: bool = True, *,
-                check_cycles: bool = True) -> Stepper:
+                check_cycles: bool = True, guard=None) -> Stepper:
     """The stepper of a solved plan; InputError when its cycle estimate exceeds the limit
-    (``check_cycles=False`` for a deliberately short run of a longer path)."""
+    (``check_cycles=False`` for a deliberately short run of a longer path). ``guard``: the
+    collision stop's guard, given here (the compiled stepper reads it when built)."""
     if check_cycles:
         check_cycle_count(plan, max_cycles)
     job = plan.job
     return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
                    period=job.period, direction=plan.direction, end=plan.end,
                    closed=plan.closed, tol=job.tolerances, max_cycles=max_cycles,
-                   record=record, check_boundary=plan.check_boundary)
+                   record=record, check_boundary=plan.check_boundary, guard=guard)
 
 
 def run_plan(plan: PathPlan, max_cycles: int = 1_000_000, progress=None) -> Toolpath:

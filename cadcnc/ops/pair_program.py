@@ -47,8 +47,9 @@ def _run(plan: PathPlan, guard, max_cycles: int, progress, allow_empty: bool = F
          ) -> Toolpath:
     """Run the plan's stepper with ``guard``; a path of its start alone is an error unless
     ``allow_empty`` (the caller then skips it with the stop's reason)."""
-    stepper = stepper_for(plan, max_cycles, True)
-    stepper.guard = guard
+    # the guard goes to the constructor: set afterwards, the compiled stepper (built
+    # without one) committed every trial without asking it (no collision stop at all)
+    stepper = stepper_for(plan, max_cycles, True, guard=guard)
     stepper.run(progress)
     if stepper.cycles == 0 and not allow_empty:
         raise GeometryError(f"no path: the interpolator stopped at the start point "

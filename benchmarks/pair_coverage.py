@@ -8,7 +8,7 @@ polyline of its pair. Written paths are judged too: a point whose distance to ei
 its two faces differs from R' by more than 1 um, or that is nearer than R' - 1 um to any
 face, makes the path silent-bad.
 
-    python benchmarks/coverage.py [--fixtures] [--parts DIR] --radius 2 [--radius 3]
+    python benchmarks/pair_coverage.py [--fixtures] [--parts DIR] --radius 2 [--radius 3]
         [--feed 1500] [--period 4ms] [--json OUT] [--workers 2] [--timeout 120]
         [--max-samples 60] [--max-pairs N]
 
@@ -39,6 +39,7 @@ from coverage_paths import classify, run_faces, run_path  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 
 _ORACLES: dict[str, Oracle] = {}
+SHOWN_CORRECTION = 1e-4  # mm: face_distance corrections listed (smaller: far below 1 um)
 
 
 def oracle_for(step: str) -> Oracle:
@@ -63,9 +64,12 @@ def judge_path(o: Oracle, faces, polylines, offset: float, cap: int) -> dict:
 
     ``shank_mm``: how far the shank (p to p + 10 R' z) comes nearer than R' to the part
     at the worst checked point, with its face; reported beside silent-bad (the shank
-    rule is the spec's, the gouge gate does not check it)."""
+    rule is the spec's, the gouge gate does not check it). ``corrected``: distances where
+    BRepExtrema's answer was replaced by one shorter by more than SHOWN_CORRECTION to a
+    foot on the face (``Oracle.face_distance``), each (face, point) once."""
     worst_face, worst_gouge, checked = 0.0, 0.0, 0
     worst_shank, shank_face = 0.0, 0
+    corrections = len(o.corrections)
     for line in polylines:
         idx = np.unique(np.linspace(0, len(line) - 1, min(cap, len(line))).round().astype(int))
         for p in line[idx]:
@@ -80,7 +84,19 @@ def judge_path(o: Oracle, faces, polylines, offset: float, cap: int) -> dict:
                 worst_shank, shank_face = offset - dist, face
     return {"checked": checked, "off_face_mm": worst_face, "gouge_mm": worst_gouge,
             "shank_mm": worst_shank, "shank_face": shank_face,
+            "corrected": unique_corrections(o.corrections[corrections:]),
             "bad": worst_face > TOL or worst_gouge > TOL}
+
+
+def unique_corrections(found: list[dict]) -> list[dict]:
+    """The corrections above SHOWN_CORRECTION, each (face, point) once."""
+    seen, out = set(), []
+    for c in found:
+        key = (c["face"], tuple(c["p"]))
+        if c["brepextrema"] - c["foot"] > SHOWN_CORRECTION and key not in seen:
+            seen.add(key)
+            out.append(c)
+    return out
 
 
 def run_pair(task: dict) -> dict:
@@ -206,7 +222,7 @@ def table(records: list[dict], notes: list[dict]) -> str:
         written = sum(run["outcome"] == "written" for run in runs)
         bad = sum(bool(r.get("path_check", {}).get("bad")) for r in rs)
         crashes = sum(run["outcome"] in ("crash", "timeout") for run in runs)
-        pct = lambda a, b: f"{100.0 * a / b:.0f}" if b else "-"  # noqa: E731
+        pct = lambda a, b: f"{100.0 * a / b:.1f}" if b else "-"  # noqa: E731
         cu, u = (sum(r.get(k, 0) for r in rs) for k in ("covered_unreachable", "unreachable"))
         missed = sum(len(r.get("missed", [])) for r in rs)
         rows.append(f"| {part} | {radius} | {len(rs)} | {c} / {f} | {pct(c, f)} | {missed} "
@@ -218,6 +234,11 @@ def table(records: list[dict], notes: list[dict]) -> str:
                     + ", ".join(f"{k} {v}" for k, v in counts.most_common()))
     for radius in sorted({r["radius"] for r in records}):
         rows.extend(program_notes([r for r in records if r["radius"] == radius], radius))
+    for r in records:
+        for c in unique_corrections(r.get("path_check", {}).get("corrected", [])):
+            rows.append(f"{r['part']} faces {r['faces']} R {r['radius']}: face {c['face']} at "
+                        f"{[round(x, 4) for x in c['p']]}: BRepExtrema {c['brepextrema']:.4f}"
+                        f" mm, foot on the face (FClass2d) {c['foot']:.4f} mm: the foot counts")
     for n in notes:
         if n["problem"] or not n["pairs"]:
             rows.append(f"{n['part']}: no pair judged ({n['problem'] or 'no concave edge'}); "
