@@ -38,7 +38,8 @@ from .stretches import Feasibility, edge_stretches, pair_stretches
 
 CHAIN_GAP = 1e-3
 """mm: a cut starting this near another's end continues it (no lift)."""
-
+DEFAULT_FEED = 1500.0     # mm/min: with DEFAULT_PERIOD, the paper's 0.1 mm step
+DEFAULT_PERIOD = 0.004    # s
 
 
 def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT_FEED,
