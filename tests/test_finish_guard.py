@@ -92,6 +92,25 @@ def test_grid_boxes_are_the_cells_own_boxes(slab):
                                rtol=0, atol=1e-12)
 
 
+def test_grid_boxes_of_a_range_past_the_knots_by_round_off(slab):
+    """A face's range may pass its surface's last knot by round-off (bug32596_abc_0_13
+    face 54: w up to 1 + 2e-16 on knots 0..1, where OCCT's InsertVKnots refused the knot
+    and pencil crashed): the refinement clips the grid lines to the knots and gives the
+    boxes of the range inside them, which still contain the surface."""
+    from cadcnc.ops.finish_cells import _cells
+    f = slab.face(5)
+    boxes = _Boxes(f)
+    us, ws = _cells(f, 2.0)
+    u_lo, u_hi, w_lo, w_hi = boxes.surface.Bounds()
+    assert (us[0], us[-1], ws[0], ws[-1]) == pytest.approx((u_lo, u_hi, w_lo, w_hi), abs=1e-9)
+    past_u = us.copy()
+    past_w = ws.copy()
+    past_u[0], past_u[-1] = u_lo - 4 * np.spacing(abs(u_lo) + 1), u_hi + 4 * np.spacing(u_hi + 1)
+    past_w[-1] = w_hi + 4 * np.spacing(w_hi + 1)
+    exact = boxes.grid(np.clip(us, u_lo, u_hi), np.clip(ws, w_lo, w_hi))
+    assert np.array_equal(boxes.grid(past_u, past_w), exact)
+
+
 def test_the_walls_hang_from_the_top_and_the_top_does_not(slab):
     from cadcnc.ops.finish_walls import hangs_from
     guard = FinishGuard(slab, (5,), 3.0, 40.0, 1e-6)

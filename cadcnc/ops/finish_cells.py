@@ -131,6 +131,22 @@ class _Boxes:
 
     def box(self, u0: float, u1: float, w0: float, w1: float) -> tuple:
         """(xmin, ymin, zmin, xmax, ymax, zmax) containing the surface over the range."""
+        try:
+            return self._box(u0, u1, w0, w1)
+        except Exception:   # noqa: BLE001 - OCCT refused the cut (a range past the knots)
+            return self._generic_box(u0, u1, w0, w1)
+
+    def _generic_box(self, u0: float, u1: float, w0: float, w1: float) -> tuple:
+        """OCCT's box of the face's surface over the range (any kind), widened by SLACK."""
+        b = Bnd_Box()
+        BndLib_AddSurface.Add_s(self.face._adaptor, u0, u1, w0, w1, 0.0, b)
+        pts = np.array(b.Get()).reshape(2, 3)
+        lo, hi = pts.min(axis=0) - SLACK, pts.max(axis=0) + SLACK
+        return (*lo.tolist(), *hi.tolist())
+
+    def _box(self, u0: float, u1: float, w0: float, w1: float) -> tuple:
+        if self.surface is None and self.curve is None:
+            return self._generic_box(u0, u1, w0, w1)
         if self.surface is not None:
             piece = self.surface.Copy()
             piece.Segment(u0, u1, w0, w1)
@@ -142,10 +158,6 @@ class _Boxes:
             base = np.array([poles.Value(i).Coord()
                              for i in range(poles.Lower(), poles.Upper() + 1)])
             pts = np.vstack([base + w0 * self.axis, base + w1 * self.axis])
-        else:
-            b = Bnd_Box()
-            BndLib_AddSurface.Add_s(self.face._adaptor, u0, u1, w0, w1, 0.0, b)
-            pts = np.array(b.Get()).reshape(2, 3)
         lo, hi = pts.min(axis=0) - SLACK, pts.max(axis=0) + SLACK
         return (*lo.tolist(), *hi.tolist())
 
@@ -155,10 +167,23 @@ class _Boxes:
         control points that live on each cell: the same as ``box`` cell by cell); else
         ``box`` per cell."""
         if self.surface is None or self.surface.IsUPeriodic() or self.surface.IsVPeriodic():
-            return np.array([[self.box(us[i], us[i + 1], ws[j], ws[j + 1])
-                              for j in range(len(ws) - 1)] for i in range(len(us) - 1)])
+            return self._cell_by_cell(us, ws)
+        try:
+            return self._refined(us, ws)
+        except Exception:   # noqa: BLE001 - OCCT refused a knot (bug32596_abc_0_13 face 3)
+            return self._cell_by_cell(us, ws)
+
+    def _cell_by_cell(self, us: np.ndarray, ws: np.ndarray) -> np.ndarray:
+        return np.array([[self.box(us[i], us[i + 1], ws[j], ws[j + 1])
+                          for j in range(len(ws) - 1)] for i in range(len(us) - 1)])
+
+    def _refined(self, us: np.ndarray, ws: np.ndarray) -> np.ndarray:
         from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
         piece = self.surface.Copy()
+        # a face's range can pass its surface's knots by round-off (1 + 2e-16 on
+        # bug32596_abc_0_13 face 54): OCCT refuses a knot outside them
+        u_lo, u_hi, w_lo, w_hi = piece.Bounds()
+        us, ws = np.clip(us, u_lo, u_hi), np.clip(ws, w_lo, w_hi)
         for cuts, insert, degree in ((us, piece.InsertUKnots, piece.UDegree()),
                                      (ws, piece.InsertVKnots, piece.VDegree())):
             knots, mults = TColStd_Array1OfReal(1, len(cuts)), TColStd_Array1OfInteger(
