@@ -39,3 +39,21 @@ def test_finish_example_runs_as_script_and_under_cq_editor(capsys):
     assert prog.job.operation.faces and len(prog.job.operation.faces) == 3  # top, 2 rounds
     runpy.run_path(example, run_name="__main__")
     assert "finish R 2:" in capsys.readouterr().out
+
+
+def test_show_program_shows_a_part_as_a_cadquery_shape():
+    """cadcnc.show_program given a cadcnc Part hands show_object a CadQuery Shape (what
+    CQ-editor can draw), then the cuts and the links as compounds."""
+    import cadquery as cq
+
+    import cadcnc
+    from conftest import load_fixture
+
+    part = load_fixture("bspline_boss")
+    program = cadcnc.pencil(part, radius=3.0)
+    shown = {}
+    cadcnc.show_program(lambda obj, name="", options=None: shown.__setitem__(name, obj),
+                        program, part)
+    assert set(shown) == {"part", "cuts", "links"}
+    assert isinstance(shown["part"], cq.Shape) and shown["part"].isValid()
+    assert all(isinstance(shown[k], cq.Compound) for k in ("cuts", "links"))

@@ -52,10 +52,11 @@ def show_program(show, program: Program, part=None) -> None:
     """Show a program in CQ-editor: ``show`` is its ``show_object``; the part (a Workplane,
     Shape or Part, optional) translucent, the cuts in red, the links in blue."""
     if part is not None:
-        shape = getattr(part, "tol", None) and part.shape   # a cadcnc Part: its OCCT shape
-        if shape is not None:
+        from ..geometry.part import Part
+
+        if isinstance(part, Part):   # CQ-editor shows CadQuery objects: its OCCT shape
             import cadquery as cq
-            part = cq.Shape.cast(shape)
+            part = cq.Shape.cast(part.shape)
         show(part, name="part", options={"alpha": 0.6})
     show(to_cq_compound(program, links=False), name="cuts", options={"color": "red"})
     if program.links:
