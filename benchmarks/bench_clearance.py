@@ -19,10 +19,10 @@ import time
 import numpy as np
 
 import cadcnc
-from cadcnc.geometry.clearance import guard_for
-from cadcnc.ops.pair_path import pair_job, stepper_for
-from cadcnc.ops.stretch_paths import plan_for_stretch
-from cadcnc.ops.stretches import pair_stretches
+from cadcnc.guard import guard_for
+from cadcnc.ops.path.pair_path import pair_job, stepper_for
+from cadcnc.ops.path.stretch_paths import plan_for_stretch
+from cadcnc.ops.path.stretches import pair_stretches
 
 R, FEED, PERIOD = 3.0, 1500.0, 0.004
 

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 import cadcnc
-from cadcnc.ops.pair_path import pair_job, plan_path
+from cadcnc.ops.path.pair_path import pair_job, plan_path
 from cadcnc.interp.stepper import Stepper
 from cadcnc.interp.tangency import solve_tangency
 from cadcnc.tolerances import DEFAULT

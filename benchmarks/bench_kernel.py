@@ -36,7 +36,7 @@ from OCP.gp import gp_Pnt, gp_Vec
 
 import cadcnc
 from cadcnc.interp.stepper import Stepper
-from cadcnc.ops.pair_path import pair_job, plan_path
+from cadcnc.ops.path.pair_path import pair_job, plan_path
 from latency import latency, percentiles
 
 ROOT = Path(__file__).resolve().parents[1]

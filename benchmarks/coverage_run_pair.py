@@ -24,7 +24,7 @@ def main(argv: list[str]) -> int:
     from cadcnc.errors import CadcncError
     from cadcnc.io.program_json import program_to_dict
     from cadcnc.job import Job, PairPath, Tool
-    from cadcnc.ops.pair_program import program_for_job, safe_height
+    from cadcnc.ops.path.pair_program import program_for_job, safe_height
     from cadcnc.program.linking import linked
     from cadcnc.program.program import Program
     from cadcnc.verification import gouge_gate

@@ -1,4 +1,4 @@
-"""Guide-surface finishing against OpenCAMLib's drop-cutter (issue 13, docs/finishing.md).
+"""Guide-surface finishing against OpenCAMLib's drop-cutter (issue 13, docs/finish.md).
 
 The same faces, the same pass lines (cadcnc's planes: angle 0, stepover 1 mm), the same
 point spacing (cadcnc's step f = F Ts = 0.1 mm; OCL's points 0.1 mm apart along each
@@ -70,24 +70,24 @@ class Stopwatch:
     """Seconds spent in named functions of cadcnc's finishing (wrapped in place while a
     run is timed; a wrapper costs about 0.3 µs a call): where cadcnc's time goes."""
 
-    WATCHED = [("cadcnc.ops.finish", "plan_for_job", "planning (planes, face sampling)"),
-               ("cadcnc.ops.finish", "uncut_report", "uncut report"),
-               ("cadcnc.ops.finish_uncut", "_reasons",
+    WATCHED = [("cadcnc.ops.finish.finish", "plan_for_job", "planning (planes, face sampling)"),
+               ("cadcnc.ops.finish.finish", "uncut_report", "uncut report"),
+               ("cadcnc.ops.finish.uncut", "_reasons",
                 "of which reasons (guard on samples)"),
-               ("cadcnc.ops.finish", "linked", "linking (zigzag links verified)"),
-               ("cadcnc.ops.finish_links", "witness",
+               ("cadcnc.ops.finish.finish", "linked", "linking (zigzag links verified)"),
+               ("cadcnc.guard.stay_down", "witness",
                 "of which stay-down witnesses (refutations)"),
-               ("cadcnc.geometry.move_clearance", "MoveClearance.distance",
+               ("cadcnc.guard.moves", "MoveClearance.distance",
                 "of which stay-down checks (OCCT)"),
-               ("cadcnc.ops.finish", "pass_cuts", "passes (stepping, guard, exact step)"),
-               ("cadcnc.ops.finish_pass", "_Pass.exact", "points onto the exact offset"),
-               ("cadcnc.geometry.clearance", "ClearanceGuard.margin",
+               ("cadcnc.ops.finish.finish", "pass_cuts", "passes (stepping, guard, exact step)"),
+               ("cadcnc.ops.finish.passes", "_Pass.exact", "points onto the exact offset"),
+               ("cadcnc.guard.clearance", "ClearanceGuard.margin",
                 "clearance guard (every face, ball and shank)"),
-               ("cadcnc.geometry.clearance", "ClearanceGuard._exact",
+               ("cadcnc.guard.clearance", "ClearanceGuard._exact",
                 "of which per-face checks (proofs, else OCCT)"),
-               ("cadcnc.geometry.clearance", "ClearanceGuard._segment_distance",
+               ("cadcnc.guard.clearance", "ClearanceGuard._segment_distance",
                 "of which exact segment distances (closed form, else OCCT)"),
-               ("cadcnc.ops.finish_guard", "FinishGuard.budget",
+               ("cadcnc.guard.guard", "OperationGuard.budget",
                 "guard budgets (steps then left to the kernel)")]
 
     def __init__(self):

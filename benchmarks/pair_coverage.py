@@ -1,6 +1,6 @@
 """Coverage of cadcnc's paths over every concave pair of the fixtures and of real parts.
 
-Issue 10's measurement (docs/coverage.md): the independent judge in
+Issue 10's measurement (docs/notes/coverage.md): the independent judge in
 ``coverage_oracle.py`` samples every concave shared edge every 0.2 mm and decides which
 ball positions are feasible; ``cadcnc path`` (the command line, one subprocess per run)
 writes paths; a feasible position is covered when it lies within 5 um of a written cut

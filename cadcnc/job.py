@@ -18,6 +18,9 @@ from .errors import InputError
 from .tolerances import DEFAULT, Tolerances
 
 SHANK_LENGTH_RADII = 10.0  # default shank length, in ball radii
+DEFAULT_FEED = 1500.0  # mm/min: with DEFAULT_PERIOD, the paper's 0.1 mm step
+DEFAULT_PERIOD = 0.004  # s: the interpolation period
+SAFE_MARGIN = 10.0  # mm above the part's top where links travel when no clearance is given
 MIN_STEP = 1e-6  # mm: the shortest commanded step f = F Ts per period a job may ask for
 Point = tuple[float, float, float]
 
@@ -112,7 +115,7 @@ class PairPath:
     ``offsets``: each surface's offset, None meaning R'; 0 makes that surface a guide
     surface carrying the ball centre. ``start``/``end``: points (mm) near the intersection;
     by default the ends of the faces' shared concave edge number ``edge`` (0-based).
-    A program of the pair (:func:`cadcnc.ops.pair_program.program_for_job`) follows every
+    A program of the pair (:func:`cadcnc.ops.path.pair_program.program_for_job`) follows every
     feasible stretch of every shared concave edge, or of edge ``edge`` alone when it is
     given (None: every edge), and of those only stretch number ``stretch`` (1-based along
     the edge) when given.
@@ -228,7 +231,7 @@ class Job:
     ``source``: the part's STEP file (None for a CadQuery object). ``clearance``: the Z
     height (mm) of rapid moves, None for the part's top plus a margin. ``flip_material``:
     the part is read with its material side inverted (``--flip-material``,
-    docs/surface_models.md), so that a saved path is verified on the same side.
+    docs/notes/surface_models.md), so that a saved path is verified on the same side.
     """
 
     tool: Tool

@@ -42,7 +42,7 @@ class Tolerances:
     - ``closed`` (mm): a curve (edge, intersection branch, polyline) whose ends are closer
       than this is a loop.
     - ``sewing`` (mm): the faces of a surface model (no solid) are sewn at this tolerance:
-      edges closer than it are merged (docs/surface_models.md); the largest edge tolerance
+      edges closer than it are merged (docs/notes/surface_models.md); the largest edge tolerance
       after sewing is reported.
 
     Verification and gates:

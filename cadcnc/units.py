@@ -1,6 +1,6 @@
 """Parse the quantities users type: durations with a unit, lengths, feeds and points.
 
-Internally cadcnc works in mm, mm/min and s (docs/conventions.md). A period must carry its
+Internally cadcnc works in mm, mm/min and s (docs/method.md). A period must carry its
 unit (``4ms``, ``0.004s``, ``250us``) because a bare ``4`` is ambiguous; lengths may carry
 ``mm`` and feeds ``mm/min``, nothing else. Every failure is an :class:`InputError` naming
 the parameter and the unit it expects.

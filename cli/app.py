@@ -59,7 +59,7 @@ def _job_options(p, required: bool) -> None:
 def _flip_option(p) -> None:
     p.add_argument("--flip-material", action="store_true",
                    help="the material is on the other side of every face (a surface "
-                        "model's side, or a solid's outside: docs/surface_models.md)")
+                        "model's side, or a solid's outside: docs/notes/surface_models.md)")
 
 
 def _gouge_options(p, gate: bool = True) -> None:

@@ -11,10 +11,9 @@ from cadcnc.errors import OutputError, StepFileError
 from cadcnc.io.output_set import OutputSet
 from cadcnc.io.outputs import SUFFIXES, render
 from cadcnc.io.plot import PICTURE_SUFFIXES, picture_bytes
-from cadcnc.io.gcode import SAFE_MARGIN
 from cadcnc.io.summary import summary
-from cadcnc.job import Job, PairPath, Tool
-from cadcnc.ops.pair_path import path_for_job
+from cadcnc.job import SAFE_MARGIN, Job, PairPath, Tool
+from cadcnc.ops.path.pair_path import path_for_job
 from cadcnc.verification import verify
 
 from .feedback import progress
@@ -77,7 +76,7 @@ def demo(args) -> int:
                                                title=f"demo: faces {i} and {j} of {step.name}")
     from cadcnc.io.program_json import program_json
     from cadcnc.io.program_plot import program_picture_bytes
-    from cadcnc.ops.pencil import pencil
+    from cadcnc.ops.pencil.pencil import pencil
 
     pen = pencil(part, radius=job.tool.radius)  # every corner of the part, linked
     say(f"pencil R {job.tool.radius:g}: {len(pen.cuts)} cuts, {pen.cut_length:.1f} mm cut, "

@@ -62,7 +62,7 @@ def _angle(text: str) -> float:
 def finish_command(args) -> int:
     import cadcnc
     from cadcnc.io.output_set import OutputSet
-    from cadcnc.ops.finish import JOIN, finish
+    from cadcnc.ops.finish.finish import JOIN, finish
 
     from .options import clearance, tolerances
 

@@ -8,10 +8,11 @@ import io
 from pathlib import Path
 
 from cadcnc.errors import InputError  # light: OCCT is imported inside the functions
+from cadcnc.job import DEFAULT_FEED as FEED, DEFAULT_PERIOD as PERIOD
 
 SUFFIXES = (".json", ".ngc", ".csv", ".png", ".glb")
-DEFAULT_FEED = "1500"  # mm/min; equal to cadcnc.ops.pencil.DEFAULT_FEED (a test checks)
-DEFAULT_PERIOD = "4ms"  # equal to cadcnc.ops.pencil.DEFAULT_PERIOD (a test checks)
+DEFAULT_FEED = f"{FEED:g}"  # the job's defaults as the options' text
+DEFAULT_PERIOD = f"{PERIOD * 1000:g}ms"
 
 
 def add_operation_options(p, allowance_help: str) -> None:
@@ -23,7 +24,7 @@ def add_operation_options(p, allowance_help: str) -> None:
                    help=f"feed, mm/min (default {DEFAULT_FEED})")
     p.add_argument("--period", default=DEFAULT_PERIOD, metavar="T",
                    help=f"interpolation period with its unit (default {DEFAULT_PERIOD}: "
-                        "a 0.1 mm step at 1500 mm/min)")
+                        f"a {FEED * PERIOD / 60:g} mm step at {DEFAULT_FEED} mm/min)")
     p.add_argument("--plunge-feed", metavar="F",
                    help="feed of the plunges in the links, mm/min (default: --feed)")
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
@@ -52,7 +53,7 @@ def gate_and_write(args, program, part, outputs, what: str, title: str, join: fl
     from cadcnc.io.program_gcode import program_ngc
     from cadcnc.io.program_json import program_json
     from cadcnc.io.program_plot import program_picture_bytes
-    from cadcnc.ops.pair_program import safe_height
+    from cadcnc.ops.path.pair_program import safe_height
     from cadcnc.verification.cut_back import cut_back
 
     from .options import program_gcode_options

@@ -7,8 +7,8 @@ import math
 from pathlib import Path
 
 from cadcnc.errors import InputError
-from cadcnc.io.gcode import SAFE_MARGIN, blend_for
-from cadcnc.job import Job, PairPath, Tool, check_number
+from cadcnc.io.gcode import blend_for
+from cadcnc.job import SAFE_MARGIN, Job, PairPath, Tool, check_number
 from cadcnc.tolerances import DEFAULT, Tolerances
 from cadcnc.units import parse_duration, parse_feed, parse_length, parse_point
 

@@ -42,7 +42,7 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
 def pencil_command(args) -> int:
     import cadcnc
     from cadcnc.io.output_set import OutputSet
-    from cadcnc.ops.pencil import CHAIN_GAP, pencil
+    from cadcnc.ops.pencil.pencil import CHAIN_GAP, pencil
 
     from .options import clearance, tolerances
 

@@ -1,6 +1,6 @@
 """``path``, ``verify`` and ``plot``: programs (every stretch of a corner, cut and linked).
 
-``path`` runs :func:`cadcnc.ops.pair_program.program_for_job`, gates the whole program
+``path`` runs :func:`cadcnc.ops.path.pair_program.program_for_job`, gates the whole program
 (every cut, every move written, links included) and writes it by suffix; ``verify`` and
 ``plot`` read a program JSON (version 2) or a toolpath JSON (version 1).
 """
@@ -20,7 +20,7 @@ from cadcnc.io.program_json import read_program
 from cadcnc.io.program_outputs import PROGRAM_SUFFIXES, render_program
 from cadcnc.io.program_plot import program_picture_bytes
 from cadcnc.io.program_summary import program_summary
-from cadcnc.ops.pair_program import program_for_job
+from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.verification import gate_program, verify as run_verify
 from cadcnc.verification.program_gate import cut_label
 

@@ -4,6 +4,10 @@
   top-level modules, the standard library, numpy and numba.
 - No import cycles between cadcnc modules, function-local imports included.
 - No module over 400 lines; no flat ``verification_*`` modules.
+- OCCT (OCP, cadquery) only in the geometry, guard and verification stages (and the
+  writers' pictures and CadQuery wires): never in ``ops/``, ``program/`` or ``controller/``.
+- No private name (``_x``) imported from another module.
+- Stages import only from stages before them (the order of docs/architecture.md).
 """
 
 from __future__ import annotations
@@ -118,3 +122,46 @@ def test_modules_are_small():
 def test_no_flat_verification_modules():
     assert not list(PKG.glob("verification_*.py"))
     assert (PKG / "verification" / "__init__.py").is_file()
+
+
+NO_OCCT_STAGES = ("cadcnc.ops", "cadcnc.program", "cadcnc.controller")
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES if n.startswith(NO_OCCT_STAGES)))
+def test_operations_program_and_controller_import_no_occt(name):
+    for mod in imports(name):
+        assert mod.split(".")[0] not in ("OCP", "cadquery"), (name, mod)
+
+
+def test_no_private_name_imported_across_modules():
+    found = []
+    for name, path in MODULES.items():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom):
+                found += [f"{name}: {a.name}" for a in node.names
+                          if a.name.startswith("_") and not a.name.startswith("__")]
+    assert found == []
+
+
+STAGES = ["geometry", "interp", "guard", "program", "ops", "controller", "io",
+          "verification", "apt", "cli"]
+"""The data flow, in order; a stage imports only from itself and the stages before it
+(io and verification read programs; verification may use io's written-move readers)."""
+
+
+def stage(name: str) -> int | None:
+    parts = name.split(".")
+    return STAGES.index(parts[1]) if len(parts) > 1 and parts[1] in STAGES else None
+
+
+def test_nothing_imports_upward():
+    upward = []
+    for name in MODULES:
+        mine = stage(name)
+        if mine is None:
+            continue
+        for dep in internal(name):
+            theirs = stage(dep)
+            if theirs is not None and theirs > mine:
+                upward.append(f"{name} -> {dep}")
+    assert upward == []

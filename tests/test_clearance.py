@@ -15,7 +15,7 @@ import math
 import pytest
 
 import cadcnc
-from cadcnc.geometry.clearance import ClearanceGuard
+from cadcnc.guard.clearance import ClearanceGuard
 
 from conftest import FIXTURES
 

@@ -21,7 +21,8 @@ from cadcnc.io.program_json import read_program
 from cadcnc.io.toolpath_csv import CSV_COLUMNS
 from cadcnc.io.program_outputs import PROGRAM_CSV_COLUMNS
 from cadcnc.job import Job, PairPath, Tool
-from cadcnc.ops import pair_program
+from cadcnc.ops import common
+from cadcnc.ops.path import pair_program
 from conftest import FIXTURES, cadcnc_cli
 
 FACTS = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
@@ -156,8 +157,8 @@ def test_a_program_stopped_short_exits_6(tmp_path, monkeypatch):
     """A cut stopped by the cycle limit (a real stop of the stepper, forced low here) leaves
     the rest of its stretch listed as stopped short: exit 6, nothing written unless
     --allow-partial (still 6); the summary says partial and why."""
-    real = pair_program.stepper_for
-    monkeypatch.setattr(pair_program, "stepper_for", lambda plan, max_cycles, record, **kw: real(
+    real = common.stepper_for
+    monkeypatch.setattr(common, "stepper_for", lambda plan, max_cycles, record, **kw: real(
         plan, 40, record, check_cycles=False, **kw))  # a deliberately short run, as documented
     out = tmp_path / "p.json"
     args = ["path", SHELF, *SHELF_JOB, "--stretch", "1", "-o", out]

@@ -12,7 +12,7 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
 
 import cadcnc
 from cadcnc.errors import FaceNumberError
-from cadcnc.ops.corners import BLEND, EDGE, NOT_SELECTED, TANGENT_FACES, find_corners
+from cadcnc.ops.pencil.corners import BLEND, EDGE, NOT_SELECTED, TANGENT_FACES, find_corners
 
 FIX = Path(__file__).resolve().parent.parent / "fixtures"
 SIDECAR = json.loads((FIX / "pencil_fixtures.json").read_text())
@@ -130,7 +130,7 @@ def test_edge_corners_are_the_concave_edges_of_the_base_fixtures(name):
     want = {}
     for p in BASE[name]["pairs"]:
         inside = p.get("interior_class") if p.get("end_class") == "tangent" else None
-        # concave inside and tangent only at its ends counts as concave (conventions.md)
+        # concave inside and tangent only at its ends counts as concave (docs/method.md)
         n = sum(e["class"] == "concave" or (e["class"] == "mixed" and inside == "concave")
                 for e in p["edges"])
         if n:

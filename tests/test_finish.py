@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.geometry.move_clearance import MoveClearance
-from cadcnc.ops.finish import finish, plan_for_job
-from cadcnc.ops.finish_plan import centre_chord, plan_planes, sample_faces
-from cadcnc.ops.finish_uncut import uncut_report
+from cadcnc.guard.moves import MoveClearance
+from cadcnc.ops.finish.finish import finish, plan_for_job
+from cadcnc.ops.finish.plan import centre_chord, plan_planes, sample_faces
+from cadcnc.ops.finish.uncut import uncut_report
 from cadcnc.verification import gate_program
 from cadcnc.verification.probe import shape_distances
 from conftest import FIXTURES

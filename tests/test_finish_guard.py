@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.geometry.clearance import ClearanceGuard
-from cadcnc.ops.finish_guard import BoxTree, FinishGuard, HeightCells, _Boxes
+from cadcnc.guard.clearance import ClearanceGuard
+from cadcnc.guard.box_tree import BoxTree
+from cadcnc.guard.cells import FaceBoxes, HeightCells
+from cadcnc.guard.guard import OperationGuard
 
 from conftest import FIXTURES
 
@@ -22,7 +24,7 @@ def slab():
 @pytest.mark.parametrize("face", [5, 1, 2])   # the B-spline top, two extruded sides
 def test_every_cell_box_contains_its_surface(slab, face):
     f = slab.face(face)
-    boxes = _Boxes(f)
+    boxes = FaceBoxes(f)
     assert boxes.surface is not None or boxes.curve is not None   # the tight path
     (u0, u1), (w0, w1) = f.u_range, f.w_range
     rng = np.random.default_rng(1)
@@ -43,7 +45,7 @@ def test_the_finishing_guard_never_clears_a_hit(slab):
     exactly where the exact guard's is, and its bounds were used."""
     top = slab.face(5)
     exact = ClearanceGuard(slab, (5,), 3.0, 40.0, 1e-6)
-    fast = FinishGuard(slab, (5,), 3.0, 40.0, 1e-6)
+    fast = OperationGuard(slab, (5,), 3.0, 40.0, 1e-6)
     rng = np.random.default_rng(2)
     disagree = 0
     for _ in range(150):
@@ -81,10 +83,10 @@ def test_box_tree_bounds_the_distance_from_below(slab):
 
 def test_grid_boxes_are_the_cells_own_boxes(slab):
     """One knot refinement gives each cell the box of its own Segment's control points."""
-    from cadcnc.ops.finish_cells import _cells
+    from cadcnc.guard.cells import face_cells
     f = slab.face(5)
-    boxes = _Boxes(f)
-    us, ws = _cells(f, 2.0)
+    boxes = FaceBoxes(f)
+    us, ws = face_cells(f, 2.0)
     grid = boxes.grid(us, ws)
     for i in range(0, len(us) - 1, 3):
         for j in range(0, len(ws) - 1, 3):
@@ -97,10 +99,10 @@ def test_grid_boxes_of_a_range_past_the_knots_by_round_off(slab):
     face 54: w up to 1 + 2e-16 on knots 0..1, where OCCT's InsertVKnots refused the knot
     and pencil crashed): the refinement clips the grid lines to the knots and gives the
     boxes of the range inside them, which still contain the surface."""
-    from cadcnc.ops.finish_cells import _cells
+    from cadcnc.guard.cells import face_cells
     f = slab.face(5)
-    boxes = _Boxes(f)
-    us, ws = _cells(f, 2.0)
+    boxes = FaceBoxes(f)
+    us, ws = face_cells(f, 2.0)
     u_lo, u_hi, w_lo, w_hi = boxes.surface.Bounds()
     assert (us[0], us[-1], ws[0], ws[-1]) == pytest.approx((u_lo, u_hi, w_lo, w_hi), abs=1e-9)
     past_u = us.copy()
@@ -112,11 +114,11 @@ def test_grid_boxes_of_a_range_past_the_knots_by_round_off(slab):
 
 
 def test_the_walls_hang_from_the_top_and_the_top_does_not(slab):
-    from cadcnc.ops.finish_walls import hangs_from
-    guard = FinishGuard(slab, (5,), 3.0, 40.0, 1e-6)
+    from cadcnc.guard.walls import hangs_from
+    guard = OperationGuard(slab, (5,), 3.0, 40.0, 1e-6)
     assert all(hangs_from(slab.face(k), guard._own_shapes) for k in (1, 2, 3, 4))
     assert not hangs_from(slab.face(6), guard._own_shapes)    # the bottom: a B-spline
-    other = FinishGuard(slab, (6,), 3.0, 40.0, 1e-6)           # walls do not hang from it
+    other = OperationGuard(slab, (6,), 3.0, 40.0, 1e-6)           # walls do not hang from it
     assert not any(hangs_from(slab.face(k), other._own_shapes) for k in (1, 2, 3, 4))
 
 
@@ -140,7 +142,7 @@ def test_the_wall_proof_never_clears_a_hit(slab):
     """Centres near the rim, where the walls are within R': the finishing guard (walls
     proven in closed form) agrees in sign with the exact guard (OCCT distances)."""
     exact = ClearanceGuard(slab, (5,), 3.0, 40.0, 1e-6)
-    fast = FinishGuard(slab, (5,), 3.0, 40.0, 1e-6)
+    fast = OperationGuard(slab, (5,), 3.0, 40.0, 1e-6)
     rng = np.random.default_rng(4)
     hits = 0
     for p in _near_the_rim(slab.face(5), rng, 120):
@@ -155,7 +157,7 @@ def test_every_centre_within_the_budget_is_clear(slab):
     """After a clear margin, every centre within the budget is clear for the exact guard
     (random points on spheres of the budget's radius and inside)."""
     exact = ClearanceGuard(slab, (5,), 3.0, 40.0, 1e-6)
-    fast = FinishGuard(slab, (5,), 3.0, 40.0, 1e-6)
+    fast = OperationGuard(slab, (5,), 3.0, 40.0, 1e-6)
     top = slab.face(5)
     rng = np.random.default_rng(5)
     budgets = []
@@ -214,9 +216,9 @@ def stepped():
 
 
 def test_planar_walls_hang_from_the_top_and_rising_ones_do_not(stepped):
-    from cadcnc.ops.finish_walls import hangs_from
+    from cadcnc.guard.walls import hangs_from
     part, top = stepped
-    guard = FinishGuard(part, (top,), 3.0, 40.0, 1e-6)
+    guard = OperationGuard(part, (top,), 3.0, 40.0, 1e-6)
     answers = {}
     for k in range(1, len(part) + 1):
         f = part.face(k)
@@ -234,7 +236,7 @@ def test_planar_walls_hang_from_the_top_and_rising_ones_do_not(stepped):
 def test_planar_wall_proof_never_clears_a_hit(stepped):
     part, top = stepped
     exact = ClearanceGuard(part, (top,), 3.0, 40.0, 1e-6)
-    fast = FinishGuard(part, (top,), 3.0, 40.0, 1e-6)
+    fast = OperationGuard(part, (top,), 3.0, 40.0, 1e-6)
     rng = np.random.default_rng(7)
     hits = 0
     for _ in range(150):
@@ -251,8 +253,8 @@ def test_a_stay_down_witness_is_a_real_refutation(slab):
     """Where finish_links finds a face point nearer than R' - tol to a move, OCCT's swept
     distance of that move is below R' - tol too (moves between centres on the top's
     offset, 1-3 mm apart, across the convex and concave parts)."""
-    from cadcnc.geometry.move_clearance import MoveClearance
-    from cadcnc.ops.finish_links import StayDown
+    from cadcnc.guard.moves import MoveClearance
+    from cadcnc.guard.stay_down import StayDown
     top = slab.face(5)
     stay = StayDown(slab, {5: (top, HeightCells(top))}, 3.0, 40.0, 1e-6)
     moves = MoveClearance(slab, 3.0, 40.0)

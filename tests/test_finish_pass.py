@@ -1,4 +1,4 @@
-"""One guide plane's finishing pass (cadcnc.ops.finish_pass) on the finishing fixtures.
+"""One guide plane's finishing pass (cadcnc.ops.finish.passes) on the finishing fixtures.
 
 Every fact is measured by OCCT or taken from the fixtures' closed forms
 (fixtures/finish_fixtures.json, fixtures/build_finish_fixtures.py), never from the pass.
@@ -22,7 +22,7 @@ from OCP.gp import gp_Pnt
 import cadcnc
 from cadcnc.interp.cycle import COLLISION
 from cadcnc.job import Job, PairPath, Tool
-from cadcnc.ops.finish_pass import GuidePlane, pass_cuts
+from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
 from cadcnc.verification.probe import FaceProbe
 from cadcnc.verification.surface_checks import check_surface
 from cadcnc.verification.whole_part import check_whole_part

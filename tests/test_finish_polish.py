@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 import cadcnc
-from cadcnc.ops.finish_polish import face_derivatives
+from cadcnc.ops.finish.polish import face_derivatives
 
 from conftest import FIXTURES
 

@@ -14,13 +14,13 @@ import numpy as np
 import pytest
 
 import cadcnc
-import cadcnc.ops.finish_crossings as crossings_module
-import cadcnc.ops.finish_pass as pass_module
+import cadcnc.ops.finish.crossings as crossings_module
+import cadcnc.ops.finish.passes as pass_module
 from cadcnc.job import Finish, Job, PairPath, Tool
-from cadcnc.ops.finish import finish, plan_for_job
-from cadcnc.ops.finish_check import pass_problems
-from cadcnc.ops.finish_pass import GuidePlane, pass_cuts
-from cadcnc.ops.finish_setup import pass_setup
+from cadcnc.ops.finish.finish import finish, plan_for_job
+from cadcnc.ops.finish.check import pass_problems
+from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
+from cadcnc.ops.finish.setup import pass_setup
 from cadcnc.program.program import FAILED, CutSegment
 
 from conftest import FIXTURES

@@ -14,7 +14,7 @@ from OCP.gp import gp_Pnt
 
 import cadcnc
 from cadcnc.interp.cycle import CLOSED, END
-from cadcnc.ops.pair_path import pair_job, plan_path, stepper_for
+from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for
 from cadcnc.interp.stepper import Stepper, Tangency
 from cadcnc.tolerances import DEFAULT
 
@@ -96,7 +96,7 @@ def test_every_pair_within_1um_of_both_offset_surfaces(name, i, j):
             # umbilic to rounding: sqrt(H^2 - K) turns 1e-16 noise into ~1e-9 1/mm
             umbilic = (np.abs(b.k_max - b.k_min) < 1e-6 * np.abs(b.k))[:-1]
             # where the surface is umbilic (sphere) the bound's leading term vanishes and what
-            # remains is the O(f^4) linearisation of eq. 4 (docs/interpolator.md)
+            # remains is the O(f^4) linearisation of eq. 4 (docs/method.md)
             assert not np.any(over & ~umbilic), (n, np.nonzero(over & ~umbilic)[0][:5])
             assert np.all(dev[1:][umbilic] <= 10 * f ** 4 * np.abs(b.k[:-1][umbilic]) ** 3
                           + 1e-12)
@@ -145,7 +145,7 @@ def test_radius_zero_traces_the_shared_edge(name, i, j):
         curve = BRep_Tool.Curve_s(edge.edge, 0.0, 0.0)
         dist = [GeomAPI_ProjectPointOnCurve(gp_Pnt(*p), curve).LowerDistance()
                 for p in tp.points]
-        assert max(dist) < 1e-4, max(dist)       # measured: docs/interpolator.md
+        assert max(dist) < 1e-4, max(dist)       # measured: docs/method.md
         assert tp.length == pytest.approx(edge.length, rel=2e-3)
 
 

@@ -18,7 +18,7 @@ import pytest
 from conftest import load_fixture
 
 from cadcnc.interp.error_bounds import pair_bounds
-from cadcnc.ops.pair_path import pair_job, plan_path, stepper_for
+from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for
 from cadcnc.program.toolpath import toolpath_from_record
 
 CASES = [("bspline_boss", 4, 5), ("torus_cone", 1, 2), ("crossing_cylinders", 1, 2)]

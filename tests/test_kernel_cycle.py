@@ -13,7 +13,7 @@ from conftest import load_fixture
 
 from cadcnc.interp.compiled import CompiledStepper
 from cadcnc.interp.stepper import Stepper
-from cadcnc.ops.pair_path import pair_job, plan_path
+from cadcnc.ops.path.pair_path import pair_job, plan_path
 from test_pinned_paths import CASES
 from build_pinned_paths import radius_for  # noqa: E402 (fixtures/ on sys.path)
 

@@ -11,7 +11,7 @@ from conftest import load_fixture
 from cadcnc.interp.cycle import BOUNDARY, COLLISION, STOP_REASONS
 from cadcnc.interp.landing import LANDING_TOL, MAX_TRIALS, land
 from cadcnc.interp.stepper import Stepper
-from cadcnc.ops.pair_path import pair_job, plan_path
+from cadcnc.ops.path.pair_path import pair_job, plan_path
 from test_pinned_paths import CASES
 from build_pinned_paths import radius_for  # noqa: E402 (fixtures/ on sys.path)
 

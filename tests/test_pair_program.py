@@ -10,7 +10,7 @@ import pytest
 import cadcnc
 from cadcnc.errors import FacePairError, InputError
 from cadcnc.job import Job, PairPath, Tool
-from cadcnc.ops.pair_program import LIMIT_SLACK, program_for_job, safe_height
+from cadcnc.ops.path.pair_program import LIMIT_SLACK, program_for_job, safe_height
 from conftest import FIXTURES
 
 FACTS = json.loads((FIXTURES / "stretch_fixtures.json").read_text())

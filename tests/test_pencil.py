@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.ops.pair_program import CLIMB, climb_measure
-from cadcnc.ops.pencil import pencil
+from cadcnc.ops.path.pair_program import CLIMB, climb_measure
+from cadcnc.ops.pencil.pencil import pencil
 from cadcnc.verification import gouge_gate
 from conftest import FIXTURES, load_fixture
 
@@ -154,12 +154,12 @@ def test_the_guard_keeps_own_face_edges_within_the_written_programs_allowance():
     chords between points; third faces keep the 1 nm rule."""
     from cadcnc.io.gcode import DEFAULT_TOLERANCE, blend_for, digits_for
     from cadcnc.job import Job, PairPath, Tool
-    from cadcnc.ops.guard import operation_guard
+    from cadcnc.guard import guard_for
 
     part = load_fixture("pocket")
     job = Job(Tool(3.0, 0.0), 1500.0, 0.004, PairPath(faces=(9, 12), edge=0))
     tol = job.tolerances
-    guard = operation_guard(part, (9, 12), job)
+    guard = guard_for(part, (9, 12), job)
     gouge = tol.gouge
     rounding = np.sqrt(3) / 2 * 10.0 ** -digits_for(DEFAULT_TOLERANCE)
     room = gouge - blend_for(gouge) - rounding            # what the written moves may use

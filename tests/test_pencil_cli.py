@@ -14,7 +14,7 @@ import pytest
 from cadcnc.cli import operation as operation_cli
 from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_json import read_program
-from cadcnc.ops import pencil as pencil_op
+from cadcnc import job as job_module
 from cadcnc.units import parse_duration, parse_feed
 from conftest import FIXTURES
 from test_cli import cadcnc_cli
@@ -38,8 +38,8 @@ def commanded(prog) -> np.ndarray:
 
 
 def test_defaults_are_the_operations():
-    assert parse_feed(operation_cli.DEFAULT_FEED) == pencil_op.DEFAULT_FEED
-    assert parse_duration(operation_cli.DEFAULT_PERIOD) == pencil_op.DEFAULT_PERIOD
+    assert parse_feed(operation_cli.DEFAULT_FEED) == job_module.DEFAULT_FEED
+    assert parse_duration(operation_cli.DEFAULT_PERIOD) == job_module.DEFAULT_PERIOD
 
 
 def test_outputs_agree(block_run):

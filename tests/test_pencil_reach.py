@@ -9,7 +9,7 @@ import pytest
 
 import cadcnc
 from cadcnc.geometry.part import Part
-from cadcnc.ops.pencil import NOT_REACHABLE
+from cadcnc.ops.pencil.pencil import NOT_REACHABLE
 from cadcnc.verification import gouge_gate
 from conftest import load_benchmark
 

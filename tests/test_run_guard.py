@@ -1,4 +1,4 @@
-"""The stepper of a cut asks its guard at every cycle (pair_program._run).
+"""The stepper of a cut asks its guard at every cycle (ops.common.run_stretch).
 
 The compiled stepper reads its guard when it is built; a guard assigned afterwards was
 never asked while trials passed, so no collision stop happened inside a cut (r0901_ec,
@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from cadcnc.interp.cycle import COLLISION
-from cadcnc.ops.pair_path import pair_job, plan_path
-from cadcnc.ops.pair_program import _run
+from cadcnc.ops.path.pair_path import pair_job, plan_path
+from cadcnc.ops.common import run_stretch
 from conftest import SIDECAR, load_fixture
 
 
@@ -46,7 +46,7 @@ def test_a_cut_stops_where_its_guard_says(compiled, monkeypatch):
                            period=0.004)
     plan = plan_path(s1, s2, job)
     guard = FiveMillimetres(plan.start.p)
-    tp = _run(plan, guard, 100_000, None)
+    tp = run_stretch(plan, guard, 100_000, None)
     travelled = np.linalg.norm(tp.points[-1] - np.asarray(plan.start.p))
     assert tp.stop_reason == COLLISION, tp.stop_detail
     assert travelled == pytest.approx(5.0, abs=1e-6)

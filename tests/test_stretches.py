@@ -18,11 +18,11 @@ import pytest
 
 import cadcnc
 from cadcnc.errors import FacePairError
-from cadcnc.geometry.clearance import guard_for
+from cadcnc.guard import guard_for
 from cadcnc.job import Tool
-from cadcnc.ops.pair_path import pair_job
-from cadcnc.ops.stretch_paths import nearest_start, stretch_paths
-from cadcnc.ops.stretches import COLLISION, REASONS, Feasibility, pair_stretches
+from cadcnc.ops.path.pair_path import pair_job
+from cadcnc.ops.path.stretch_paths import nearest_start, stretch_paths
+from cadcnc.ops.path.stretches import COLLISION, REASONS, Feasibility, pair_stretches
 
 from conftest import FIXTURES
 
@@ -162,7 +162,7 @@ class _Window:
 
     def sample(self, s, anchor, tangent, seed=None):
         from cadcnc.interp.stepper import Tangency
-        from cadcnc.ops.stretches import BOUNDARY, FEASIBLE, Sample
+        from cadcnc.ops.path.stretches import BOUNDARY, FEASIBLE, Sample
 
         u = s % 10.0
         ok = u >= 9.9 or u <= 2.5
@@ -172,7 +172,7 @@ class _Window:
 
 
 def test_a_stretch_across_the_seam_of_a_closed_edge_is_one_stretch():
-    from cadcnc.ops.stretches import _refine, _stretches, EdgeStretches
+    from cadcnc.ops.path.stretches import _refine, _stretches, EdgeStretches
 
     curve, feas = _Circle(), _Window()
     grid = np.arange(0.0, 10.0, 0.2)
@@ -193,7 +193,7 @@ def test_a_hole_of_the_balls_radius_is_one_position_cut_as_a_point():
     and floor is R' from the centre), so the whole bottom edge is one feasible position,
     the closed form (10, 10, 17), and its program is a single-point cut."""
     from cadcnc.job import Job, PairPath
-    from cadcnc.ops.pair_program import program_for_job
+    from cadcnc.ops.path.pair_program import program_for_job
 
     part = cadcnc.load_step(FIXTURES / "narrow_slot.step")
     job = Job(Tool(2.0), 1500.0, 0.004, PairPath(faces=(11, 12), edge=None))

@@ -2,7 +2,7 @@
 
 :func:`check` loads every part and checks every face number and every EDGE end (the two
 faces share that concave edge) before any path is computed; :func:`run_job` and
-:func:`stream_job` then compute one entry through :mod:`cadcnc.ops.pair_path`. A library
+:func:`stream_job` then compute one entry through :mod:`cadcnc.ops.path.pair_path`. A library
 error comes back as the same kind of error prefixed with the PATH statement's line.
 """
 
@@ -12,7 +12,7 @@ from dataclasses import replace
 
 from ..errors import CadcncError, InputError
 from ..geometry.part import load_step
-from ..ops.pair_path import path_for_job, plan_path, shared_edge_for, stepper_for
+from ..ops.path.pair_path import path_for_job, plan_path, shared_edge_for, stepper_for
 from .program import ProgramEntry
 
 

@@ -2,7 +2,7 @@
 
 A face is a *concave blend* of radius r when, at every sample of a grid over its
 parameter box, its largest principal curvature is concave, k_max ~ 1/r > 0 (curvature
-sign of docs/conventions.md: k > 0 bends towards the cutter), the spread of 1/k_max
+sign of docs/method.md: k > 0 bends towards the cutter), the spread of 1/k_max
 over the samples is within ``RADIUS_SPREAD`` of r, and its tangent *rails* reach two
 faces or more: edges running along the blend's spine (across the cross-section, whose
 direction is the k_max principal direction; a hole's wall in two halves is no blend). Tangent edges along the cross-section are its

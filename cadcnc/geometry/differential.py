@@ -2,7 +2,7 @@
 
 Kernel-free: takes the partial derivatives r_u, r_w, r_uu, r_uw, r_ww ((3,) float arrays, mm)
 and the unit normal n that points out of the material, and returns fundamental forms and
-curvatures. Curvature sign convention (docs/conventions.md): second fundamental form taken
+curvatures. Curvature sign convention (docs/method.md): second fundamental form taken
 against n, so k < 0 where the surface bends away from the cutter (convex seen from outside)
 and k > 0 where it bends towards it (concave). Curvatures are in 1/mm.
 """

@@ -155,6 +155,20 @@ class FaceSurface:
         self._adaptor.D2(u, w, p, v[0], v[1], v[2], v[3], v[4])
         return p.Coord(), v[0].Coord(), v[1].Coord(), v[2].Coord(), v[4].Coord(), v[3].Coord()
 
+    def parameter_lengths(self) -> tuple[float, float]:
+        """Approximate lengths (mm) of the face's u and w parameter ranges on the surface
+        (the largest |r_u| (u1 - u0) and |r_w| (w1 - w0) over a 5 x 5 grid; at least 1e-6),
+        used to size sampling grids and cells."""
+        (u0, u1), (w0, w1) = self.u_range, self.w_range
+        out = np.empty((6, 3))
+        lu = lw = 0.0
+        for u in np.linspace(u0, u1, 5):
+            for w in np.linspace(w0, w1, 5):
+                d = self.derivatives_array(u, w, out)
+                lu = max(lu, float(np.linalg.norm(d[1])) * (u1 - u0))
+                lw = max(lw, float(np.linalg.norm(d[2])) * (w1 - w0))
+        return max(lu, 1e-6), max(lw, 1e-6)
+
     @property
     def normal_sign(self) -> float:
         """+1, or -1 on a REVERSED face: multiplies r_u x r_w into the outward normal."""

@@ -235,7 +235,7 @@ class Part:
         angles, points = [], []
         for t in ts:
             p = np.array(curve.Value(t).Coord())
-            sides = [self._inward_and_normal(edge, self.face(n), t) for n in (i, j)]
+            sides = [self.inward_and_normal(edge, self.face(n), t) for n in (i, j)]
             (d1, n1), (d2, n2) = sides
             theta = math.degrees(math.atan2(np.linalg.norm(np.cross(d1, d2)), d1 @ d2))
             angles.append(360.0 - theta if d2 @ n1 > 0 else theta)
@@ -259,7 +259,7 @@ class Part:
                           start, end, t_start, t_end)
 
     @staticmethod
-    def _inward_and_normal(edge, face: FaceSurface, t: float):
+    def inward_and_normal(edge, face: FaceSurface, t: float):
         """(inward direction, outward normal) of ``face`` at edge parameter t.
 
         The face's wires leave the material on the left seen from the normal, so with T

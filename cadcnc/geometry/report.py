@@ -35,7 +35,7 @@ def faces_report(part: Part) -> dict:
 
 def material_report(part: Part) -> dict:
     """{"rule", "flipped", ["shells", "sewing"]}: which rule put the material where
-    (docs/surface_models.md); for a surface model each shell's faces and rule, and the
+    (docs/notes/surface_models.md); for a surface model each shell's faces and rule, and the
     sewing tolerance, largest edge tolerance after sewing (mm) and free edges."""
     out = {"rule": part.material_rule, "flipped": part.flip_material}
     model = part.surface_model

@@ -3,7 +3,7 @@
 Kernel-free: a surface is anything with ``derivative_tuples(u, w)`` (r and its first and
 second partials as float 3-tuples), ``normal_sign``, ``wrap(u, w)`` and ``classify(u, w)``
 (:class:`cadcnc.geometry.face_surface.FaceSurface` is one). See docs/method.md section 3
-(the equation numbers below) and docs/interpolator.md. Lengths mm, curvatures 1/mm, feed
+(the equation numbers below) and docs/method.md. Lengths mm, curvatures 1/mm, feed
 mm/min, period s.
 
 The cycle from state (p, contacts q1, q2) with step f (mm):
@@ -37,7 +37,7 @@ SINGULAR = "singular"        # a singular parameter point (pole, apex, collapsed
 DIVERGED = "diverged"        # the carried error exceeded its safety limit
 MAX_CYCLES = "max_cycles"    # the cycle limit was reached
 COLLISION = "collision"      # the ball or shank would come closer than allowed to a third
-                             # face (the stepper's guard, docs/interpolator.md)
+                             # face (the stepper's guard, docs/method.md)
 STOP_REASONS = (END, CLOSED, BOUNDARY, TANGENT, CURVATURE, SINGULAR, DIVERGED, MAX_CYCLES,
                 COLLISION)
 

@@ -36,7 +36,7 @@ class Tangency:
 
 
 class Guard(Protocol):
-    """Clearance from the faces other than the two followed (docs/interpolator.md).
+    """Clearance from the faces other than the two followed (docs/method.md).
 
     ``margin(p)``: the signed clearance (mm) of the cutter centre p (3-tuple) from those
     faces, >= 0 clear, < 0 when the ball or shank comes closer than allowed, and a detail

@@ -24,7 +24,7 @@ import re
 import numpy as np
 
 from ..errors import InputError
-from ..job import check_number
+from ..job import SAFE_MARGIN, check_number
 from ..tolerances import DEFAULT as _DEFAULT_TOLERANCES
 
 DEFAULT_GOUGE = _DEFAULT_TOLERANCES.gouge  # mm: the default gouge limit
@@ -46,9 +46,8 @@ def blend_word(blend: float) -> str:
     """``G64 P<blend>`` with enough decimals to print ``blend`` (mm) exactly to 1e-7."""
     if not (math.isfinite(blend) and blend > 0):
         raise InputError(f"G64 P blending tolerance must be > 0 mm, got {blend!r}")
-    return f"G64 P{_num(blend, 7)}"
+    return f"G64 P{num(blend, 7)}"
 CLEARANCE = 2.0  # mm above the first point where the rapid approach ends
-SAFE_MARGIN = 10.0  # mm above the highest point (part or path) for rapids
 
 
 def digits_for(tolerance: float) -> int:
@@ -96,13 +95,13 @@ def simplify(points: np.ndarray, tolerance: float) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
-def _comment(text: str) -> str:
+def comment(text: str) -> str:
     """An NGC comment: no parentheses inside, ASCII only."""
     text = re.sub(r"[()]", lambda m: "[" if m.group() == "(" else "]", str(text))
     return "(" + text.encode("ascii", "replace").decode() + ")"
 
 
-def _num(v: float, digits: int) -> str:
+def num(v: float, digits: int) -> str:
     s = f"{v:.{digits}f}"
     if "." in s:
         s = s.rstrip("0").rstrip(".")
@@ -139,7 +138,7 @@ def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
     for k, (path, pts) in enumerate(zip(paths, programmed), 1):
         if not np.all(np.isfinite(pts)):
             raise InputError(f"path {k} has a non-finite point: nothing written")
-        if float(_num(path.job.feed, 3)) <= 0:
+        if float(num(path.job.feed, 3)) <= 0:
             raise InputError(f"path {k}: feed {path.job.feed:g} mm/min prints as F0: too "
                              "slow for G-code")
     top = max(float(p[:, 2].max()) for p in programmed)
@@ -150,31 +149,31 @@ def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
     elif safe_z < top + clearance:
         raise InputError(f"safe Z {safe_z:g} mm is below the path's highest point "
                          f"{top:g} mm plus the clearance {clearance:g} mm")
-    n = lambda v: _num(v, digits)  # noqa: E731
+    n = lambda v: num(v, digits)  # noqa: E731
     point_name = "tool tip (ball centre Z - R)" if tool_tip else "ball centre"
     lines = [
         "%",
-        _comment(f"cadcnc {title}".strip()),
-        _comment(f"programmed point: {point_name}; units mm; +Z is the spindle axis"),
-        _comment(f"tolerance {tol:g} mm ({'points dropped' if tolerance else 'every point kept'}"
+        comment(f"cadcnc {title}".strip()),
+        comment(f"programmed point: {point_name}; units mm; +Z is the spindle axis"),
+        comment(f"tolerance {tol:g} mm ({'points dropped' if tolerance else 'every point kept'}"
                  f"); {digits} decimals"),
         "G17 G21 G40 G90 G94",
         blend_word(blend_for(DEFAULT_GOUGE) if blend is None else blend),
         f"G0 Z{n(safe_z)}",
     ]
     if spindle:
-        lines.append(f"S{_num(spindle, 0)} M3")
+        lines.append(f"S{num(spindle, 0)} M3")
     for k, (path, pts) in enumerate(zip(paths, programmed), 1):
         keep = simplify(pts, tolerance) if tolerance else np.arange(len(pts))
         r, c = path.job.tool.radius, path.job.tool.allowance
-        lines.append(_comment(
+        lines.append(comment(
             f"path {k}: faces {path.faces[0]} {path.faces[1]}, ball R {r:g} mm, allowance "
             f"{c:g} mm, {len(keep)} of {len(pts)} points, stop: {path.stop_reason}"))
         first = pts[0]
         lines += [
             f"G0 X{n(first[0])} Y{n(first[1])}",
             f"G0 Z{n(first[2] + clearance)}",
-            f"F{_num(path.job.feed, 3)}",
+            f"F{num(path.job.feed, 3)}",
             f"G1 Z{n(first[2])}",
         ]
         lines += [f"G1 X{n(x)} Y{n(y)} Z{n(z)}" for x, y, z in pts[keep[1:]]]
@@ -190,7 +189,7 @@ def write_ngc(paths, out, **options) -> None:
     write_text(out, to_ngc(paths, **options))
 
 
-_WORD = re.compile(r"([XYZ])(-?\d+(?:\.\d*)?)")
+WORD = re.compile(r"([XYZ])(-?\d+(?:\.\d*)?)")
 
 
 def programmed_moves(text: str, tool_tip_offset: float = 0.0) -> np.ndarray:
@@ -206,7 +205,7 @@ def programmed_moves(text: str, tool_tip_offset: float = 0.0) -> np.ndarray:
     for line in text.splitlines():
         if not line.startswith(("G0 ", "G1 ")):
             continue
-        for axis, value in _WORD.findall(line):
+        for axis, value in WORD.findall(line):
             pos["XYZ".index(axis)] = float(value)
         if not any(math.isnan(v) for v in pos):
             out.append((pos[0], pos[1], pos[2] + tool_tip_offset))

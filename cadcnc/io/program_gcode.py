@@ -21,7 +21,7 @@ from ..errors import InputError
 from ..job import check_number
 from ..program.program import Program
 from .gcode import (
-    _WORD, DEFAULT_GOUGE, DEFAULT_TOLERANCE, _comment, _num, blend_for, blend_word, digits_for,
+    WORD, DEFAULT_GOUGE, DEFAULT_TOLERANCE, comment, num, blend_for, blend_word, digits_for,
     simplify,
 )
 
@@ -41,10 +41,10 @@ def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: b
     if spindle is not None:
         check_number("spindle speed", spindle, "rpm")
     for name, f in (("feed", feed), ("plunge feed", plunge)):
-        if float(_num(f, 3)) <= 0:
+        if float(num(f, 3)) <= 0:
             raise InputError(f"{name} {f:g} mm/min prints as F0: too slow for G-code")
     dz = program.job.tool.radius if tool_tip else 0.0
-    n = lambda v: _num(v, digits)  # noqa: E731
+    n = lambda v: num(v, digits)  # noqa: E731
     xyz = lambda p: f"X{n(p[0])} Y{n(p[1])} Z{n(p[2] - dz)}"  # noqa: E731
     for k, seg in enumerate(program.segments, 1):
         if not np.all(np.isfinite(seg.points)):
@@ -54,38 +54,38 @@ def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: b
     first = program.segments[0].points[0]
     lines = [
         "%",
-        _comment(f"cadcnc {title}".strip()),
-        _comment(f"programmed point: {point_name}; units mm; +Z is the spindle axis"),
-        _comment(f"tolerance {tol:g} mm ({'points dropped' if tolerance else 'every point kept'}"
-                 f"); {digits} decimals; feed {_num(feed, 3)}, plunge {_num(plunge, 3)} "
+        comment(f"cadcnc {title}".strip()),
+        comment(f"programmed point: {point_name}; units mm; +Z is the spindle axis"),
+        comment(f"tolerance {tol:g} mm ({'points dropped' if tolerance else 'every point kept'}"
+                 f"); {digits} decimals; feed {num(feed, 3)}, plunge {num(plunge, 3)} "
                  "mm/min"),
         "G17 G21 G40 G90 G94",
         blend_word(blend_for(DEFAULT_GOUGE) if blend is None else blend),
         f"G0 Z{n(first[2] - dz)}",
     ]
     if spindle:
-        lines.append(f"S{_num(spindle, 0)} M3")
+        lines.append(f"S{num(spindle, 0)} M3")
     lines.append(f"G0 X{n(first[0])} Y{n(first[1])}")
     current = None  # the feed word in force
     for k, seg in enumerate(program.segments, 1):
         if seg.kind == "cut":
             path = seg.path
             keep = simplify(seg.points, tolerance) if tolerance else np.arange(len(seg.points))
-            lines.append(_comment(
+            lines.append(comment(
                 f"segment {k}: cut, faces {path.faces[0]} {path.faces[1]}, {len(keep)} of "
                 f"{len(seg.points)} points, stop: {path.stop_reason}"))
             if current != feed:
-                lines.append(f"F{_num(feed, 3)}")
+                lines.append(f"F{num(feed, 3)}")
                 current = feed
             lines += [f"G1 {xyz(p)}" for p in seg.points[keep[1:]]]
             continue
-        lines.append(_comment(f"segment {k}: link"))
+        lines.append(comment(f"segment {k}: link"))
         for p, rapid in zip(seg.points[1:], seg.rapid):
             if rapid:
                 lines.append(f"G0 {xyz(p)}")
                 continue
             if current != plunge:
-                lines.append(f"F{_num(plunge, 3)}")
+                lines.append(f"F{num(plunge, 3)}")
                 current = plunge
             lines.append(f"G1 {xyz(p)}")
     if spindle:
@@ -110,7 +110,7 @@ def segment_moves(text: str, tool_tip_offset: float = 0.0) -> list[np.ndarray]:
             continue
         if not line.startswith(("G0 ", "G1 ")):
             continue
-        for axis, value in _WORD.findall(line):
+        for axis, value in WORD.findall(line):
             pos["XYZ".index(axis)] = float(value)
         if out and not any(math.isnan(v) for v in pos):
             out[-1].append(tuple(pos))

@@ -18,7 +18,7 @@ d(x) = min_{q in K} |x - q|:
   bound of d(a) and d(b) may be used in place of the exact values (the bound increases
   with both).
 
-Lengths in mm; docs/gate.md states what the gate proves with these bounds.
+Lengths in mm; docs/notes/gate.md states what the gate proves with these bounds.
 """
 
 from __future__ import annotations

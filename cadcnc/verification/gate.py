@@ -8,7 +8,7 @@ material), and the ball swept along every straight move actually commanded, boun
 part of :func:`~cadcnc.verification.verify`, so that a CLI can call it before writing
 every path. The answer is ``ok`` only when the check completed and proved every depth
 within the limit: an exception inside the check, or a depth it could not measure,
-refuses the path. docs/gate.md states what is checked and the bound it uses.
+refuses the path. docs/notes/gate.md states what is checked and the bound it uses.
 """
 
 from __future__ import annotations

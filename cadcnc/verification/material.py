@@ -172,7 +172,7 @@ class Material:
         the same distance share q, and the sum of their normals at q decides (a
         pseudo-normal: exact for an edge between two faces, concave or convex; at a free
         edge of an open shell the one face's normal, as if the sheet went on; at a vertex
-        of three or more faces an unweighted sum, which can err: docs/surface_models.md).
+        of three or more faces an unweighted sum, which can err: docs/notes/surface_models.md).
         """
         face, signed, unsigned = self.faces.nearest(point)
         if not face or math.isnan(signed):

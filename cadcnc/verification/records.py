@@ -252,7 +252,7 @@ class SweepCheck:
     ``proven``: every move is proven to cut no deeper than ``allowance_mm`` (the gouge
     limit less ``blend_mm``), i.e. to stay at least ``clearance_mm`` = R' - allowance
     from the part, outside it. ``depth_bound_mm``: the proven upper bound of the depth
-    over all moves (docs/gate.md); ``depth_mm``: the deepest depth measured (a lower
+    over all moves (docs/notes/gate.md); ``depth_mm``: the deepest depth measured (a lower
     bound of the true deepest; exact on moves that needed the exact step).
     ``hits``: the faces cut beyond the allowance. ``distances_evaluated``: point-to-face
     distances; ``exact_moves``: segment-to-face distances (the exact step).

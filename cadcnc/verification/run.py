@@ -28,7 +28,7 @@ COVER_RADIUS_STEPS = 0.6  # a centre covers the reference within 0.6 f_max of it
 def verify(toolpath, part=None, *, tol: Tolerances | None = None,
            sample_unseeded: int = SAMPLE_UNSEEDED, reference_spacing_mm: float = 0.01,
            whole_part: bool = True, progress=None) -> VerificationReport:
-    """Check ``toolpath`` against OCCT; see the package docstring and docs/validation.md.
+    """Check ``toolpath`` against OCCT; see the package docstring and docs/notes/validation.md.
 
     ``part``: the :class:`~cadcnc.geometry.part.Part` the path was computed on (default:
     the STEP file named by ``toolpath.job.source``). ``tol``: the thresholds (default the

@@ -1,11 +1,11 @@
-"""Regenerate the results in docs/validation.md and docs/img/deviation_vs_step.png.
+"""Regenerate the results in docs/notes/validation.md and docs/img/deviation_vs_step.png.
 
     .venv/bin/python docs/scripts/validation_report.py
 
 Runs every concave pair of every fixture (fixtures/fixtures.json) at steps 0.1, 0.2, 0.5
 and 1 mm (period 4 ms, radius 3 mm, or 1.5 mm where the pair cannot take a 3 mm ball),
 verifies each path with :func:`cadcnc.verification.verify`, and rewrites the part of
-docs/validation.md between the ``results`` markers. Deterministic up to OCCT timings.
+docs/notes/validation.md between the ``results`` markers. Deterministic up to OCCT timings.
 """
 
 from __future__ import annotations
@@ -122,7 +122,7 @@ def plot(curves, path: Path):
 def main() -> int:
     rows, curves = run()
     plot(curves, ROOT / "docs" / "img" / "deviation_vs_step.png")
-    md = ROOT / "docs" / "validation.md"
+    md = ROOT / "docs" / "notes" / "validation.md"
     text = md.read_text()
     head, rest = text.split(START, 1)
     tail = rest.split(END, 1)[1]

@@ -291,7 +291,7 @@ def test_verdict_thresholds_are_checked():
 
 def test_a_ball_within_the_allowance_is_refused_with_the_reason():
     """R' <= the allowance: the ball runs on the faces and no distance bound can prove
-    its chords (docs/gate.md); the gate says so rather than pass them unproven."""
+    its chords (docs/notes/gate.md); the gate says so rather than pass them unproven."""
     part, tp = load_fixture("pocket"), fixture_path("pocket", 10, 17, radius=0.0)
     gate = gouge_gate(tp, part)
     assert not gate.ok and "runs on the faces" in gate.message

@@ -1,0 +1,87 @@
+"""Boxes of a face's surface over a grid of cells, halved lazily: a lower bound of the
+distance from the tool's axis segment to a face without OCCT.
+
+The distance from the tool's segment to a face is at least its distance to any box
+containing the face. :class:`BoxTree` keeps the boxes of the face's surface over a grid of
+cells (:class:`~cadcnc.guard.cells.FaceBoxes`) and, lazily, over their quarters, eighths ...
+down to ``DEPTH`` halvings: a query prunes every box at least R' - tol from the segment
+and descends into the others; when every branch is pruned, the least pruned distance is a
+lower bound of the face's distance (after ``VISITS`` boxes, the boxes left count as they
+are). A box still too near at the finest level returns None: the caller asks OCCT.
+Lengths mm.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .cells import CELL_MM, FaceBoxes, face_cells
+
+DEPTH = 5
+"""Halvings of a BoxTree cell at most (1 mm cells down to about 0.03 mm)."""
+VISITS = 400
+"""Boxes a BoxTree query halves, at most (then the boxes left count as they are)."""
+
+
+def segment_box_distance(p, length: float, b) -> float:
+    """Distance (mm) from the segment p .. p + length z to the box b (6,)."""
+    dx = max(b[0] - p[0], p[0] - b[3], 0.0)
+    dy = max(b[1] - p[1], p[1] - b[4], 0.0)
+    dz = max(b[2] - (p[2] + length), p[2] - b[5], 0.0)
+    return math.sqrt(dx * dx + dy * dy + dz * dz)
+
+
+class BoxTree:
+    """Boxes of a face's surface over a grid of cells, halved lazily (module doc)."""
+
+    def __init__(self, face, cell_mm: float = CELL_MM):
+        self.source = FaceBoxes(face)
+        self.us, self.ws = face_cells(face, cell_mm)
+        self.top = self.source.grid(self.us, self.ws).reshape(-1, 6)
+        self._sub: dict = {}
+
+    def _children(self, node):
+        """The four halves of a cell (u0, u1, w0, w1, level), with their boxes."""
+        if node not in self._sub:
+            u0, u1, w0, w1, level = node
+            um, wm = 0.5 * (u0 + u1), 0.5 * (w0 + w1)
+            kids = [(a, b, c, d, level + 1) for a, b in ((u0, um), (um, u1))
+                    for c, d in ((w0, wm), (wm, w1))]
+            self._sub[node] = [(k, self.source.box(*k[:4])) for k in kids]
+        return self._sub[node]
+
+    def lower_bound(self, p, length: float, need: float, want: float = 0.0) -> float | None:
+        """A lower bound >= ``need`` (mm) of the distance from the segment p .. p +
+        length z to the face, or None when the boxes cannot prove one. Boxes nearer than
+        ``want`` (>= need) are halved while they may be, so that the bound comes out near
+        ``want`` where it can (a larger budget); a box at the last level, or met after
+        ``VISITS`` boxes, counts with its own distance."""
+        want = max(want, need)
+        lo, hi = self.top[:, 0:3], self.top[:, 3:6]
+        q = np.asarray(p, float)
+        gap = np.maximum(np.maximum(lo - (q + (0.0, 0.0, length)), 0.0),
+                         np.maximum(q - hi, 0.0))
+        d = np.sqrt((gap * gap).sum(axis=1))
+        far = d >= want
+        best = float(d[far].min()) if far.any() else math.inf
+        nw = len(self.ws) - 1
+        stack = [((self.us[i // nw], self.us[i // nw + 1], self.ws[i % nw],
+                   self.ws[i % nw + 1], 0), float(d[i])) for i in np.nonzero(~far)[0].tolist()]
+        visits = 0
+        while stack:
+            node, dist = stack.pop()
+            if node[4] == DEPTH or visits > VISITS:
+                if dist < need:
+                    return None
+                best = min(best, dist)
+                continue
+            for kid, box in self._children(node):
+                visits += 1
+                dist = segment_box_distance(p, length, box)
+                if dist >= want:
+                    best = min(best, dist)
+                else:
+                    stack.append((kid, dist))
+        return best

@@ -1,0 +1,137 @@
+"""Guide-surface finishing: raster passes of the ball over selected faces, one program.
+
+:func:`finish` samples the selected faces, places vertical guide planes at the pass angle
+(:mod:`.finish_plan`: a fixed stepover, or the spacing that keeps the scallop within a
+height), runs one pass per plane (:func:`~cadcnc.ops.finish.passes.pass_cuts`: the paper's
+guide-surface interpolation, the ball touching the faces, its centre on the plane), every
+other pass reversed for a zigzag, and links the cuts (:func:`~cadcnc.program.linking.linked`):
+a zigzag stays down between two cuts only where that straight move of the ball and shank is
+verified clear of the part (:class:`~cadcnc.guard.stay_down.StayDown`: a cheap witness
+refutes it, else :class:`~cadcnc.guard.moves.MoveClearance` proves it at least
+R' - 1 µm from every face), otherwise, and always for one-way, it retracts to the
+clearance height. What the passes left uncut (largest scallop, area not machined and
+why) is reported in the program's notes and skipped list (:mod:`.finish_uncut`). Lengths
+mm, feed mm/min, period s, angles degrees.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+from ...errors import InputError
+from ...geometry.part import Part
+from ...job import Finish, Job, Tool
+from ...program.linking import linked
+from ...program.program import CutSegment, Program, Skipped
+from ...tolerances import DEFAULT, Tolerances
+from ...guard.stay_down import StayDown
+from .passes import GuidePlane, pass_cuts
+from .setup import pass_setup
+from .plan import centre_chord, plan_planes, sample_faces
+from .uncut import uncut_report
+from ..common import safe_height
+from ...job import DEFAULT_FEED, DEFAULT_PERIOD
+
+JOIN = 1e-6
+"""mm: a cut starting this near the last one's end continues it (one pass, chained)."""
+SAMPLES_PER_SPACING = 4
+"""The faces are sampled this many times per plane spacing (stepover, or the flat
+spacing of the scallop height)."""
+
+
+def finish(part, faces, *, radius: float, allowance: float = 0.0,
+           stepover: float | None = None, scallop: float | None = None,
+           angle: float = 0.0, pattern: str = "zigzag", feed: float = DEFAULT_FEED,
+           period: float = DEFAULT_PERIOD, clearance: float | None = None,
+           shank_length: float | None = None, tol: Tolerances = DEFAULT,
+           progress=None) -> Program:
+    """The finishing program of ``faces`` of ``part`` (see the module doc).
+
+    ``part``: a :class:`~cadcnc.geometry.part.Part`, or a CadQuery Workplane or Shape;
+    ``faces``: face numbers (1-based), CadQuery/OCCT faces of the part, or a Workplane
+    selection such as ``wp.faces(">Z")``. ``radius`` R and ``allowance`` C (mm): the ball
+    runs R' = R + C from the faces. Exactly one of ``stepover`` (plane spacing, mm) and
+    ``scallop`` (largest scallop height, mm). ``angle``: the passes' direction to +X (deg);
+    ``pattern``: "zigzag" or "oneway". ``clearance``: ball-centre Z of the retracts
+    (default the part's top + 10 mm). ``progress(done, total, what)`` after each plane.
+    """
+    if not isinstance(part, Part):
+        part = Part.from_cadquery(part, tol)
+    op = Finish(face_numbers(part, faces), stepover, scallop, angle, pattern)
+    job = Job(Tool(radius, allowance, shank_length), feed, period, op, source=part.source,
+              clearance=clearance, tolerances=tol)
+    plan, samples = plan_for_job(part, job)
+    cuts: list[CutSegment] = []
+    skipped: list[Skipped] = []
+    for k, offset in enumerate(plan.offsets):
+        res = pass_cuts(part, op.faces, GuidePlane(op.angle, float(offset)), job,
+                        reverse=pattern == "zigzag" and k % 2 == 1)
+        cuts += res.cuts
+        skipped += res.skipped
+        if progress is not None:
+            progress(k + 1, len(plan.offsets), f"plane {k + 1} at {offset:.3f} mm")
+    stay_down = None
+    if pattern == "zigzag":
+        setup = pass_setup(part, op.faces, job)
+        stay_down = StayDown(part, {f: (part.face(f), setup.guard(f).height_cells(f))
+                                    for f in op.faces}, job.tool.offset, job.tool.shank,
+                             tol.hit)
+    program = Program(job, linked(cuts, safe_height(part, job), join=JOIN,
+                                  stay_down=stay_down), skipped)
+    report = uncut_report(program, part, samples, plan)
+    program.skipped += report.skipped()
+    program.notes += report.notes()
+    return program
+
+
+def plan_for_job(part: Part, job: Job):
+    """(plan, samples): the guide planes of a finishing ``job`` and the samples of its
+    faces they were placed from; InputError for a face the ball cannot reach at all."""
+    op, tool = job.operation, job.tool
+    spacing = op.stepover if op.stepover is not None else float(
+        centre_chord(op.scallop, 0.0, tool.radius, tool.allowance))
+    samples = sample_faces(part, op.faces, spacing / SAMPLES_PER_SPACING)
+    for n in op.faces:
+        mine = samples.faces == n
+        if mine.any() and (samples.normals[mine, 2] < 0).all():
+            raise InputError(f"face {n} points down (its normals have -Z components "
+                             "everywhere): a ball cannot reach it from +Z")
+    plan = plan_planes(samples, tool.radius, tool.allowance, op.angle,
+                       stepover=op.stepover, scallop=op.scallop)
+    return plan, samples
+
+
+def face_numbers(part: Part, faces) -> tuple[int, ...]:
+    """The 1-based numbers of ``faces`` in ``part``: numbers, faces of the part (CadQuery
+    or OCCT), or a CadQuery Workplane selection; InputError for anything else."""
+    if hasattr(faces, "vals") and callable(faces.vals):  # a Workplane selection
+        faces = faces.vals()
+    elif isinstance(faces, (numbers.Integral, np.integer)) or hasattr(faces, "wrapped"):
+        faces = [faces]
+    try:
+        items = list(faces)
+    except TypeError:
+        raise InputError(f"faces must be face numbers, CadQuery faces or a Workplane "
+                         f"selection, got {type(faces).__name__}") from None
+    if not items:
+        raise InputError("no face selected: give at least one face")
+    out = []
+    for f in items:
+        if isinstance(f, bool):
+            raise InputError(f"face numbers are integers from 1, got {f!r}")
+        if isinstance(f, (numbers.Integral, np.integer)):
+            part.face(int(f))  # FaceNumberError names the range
+            out.append(int(f))
+            continue
+        kind = getattr(getattr(f, "wrapped", f), "ShapeType", None)
+        if kind is None or type(f).__name__ not in ("Face", "TopoDS_Face"):
+            raise InputError(f"faces must be face numbers or faces, got a "
+                             f"{type(f).__name__}")
+        n = part.face_number(f)
+        if n == 0:
+            raise InputError(f"a face given is not a face of the part {part.source} (a "
+                             "selection from another shape, or a copy of it?)")
+        out.append(n)
+    return tuple(out)

@@ -1,0 +1,238 @@
+"""Where a finishing operation's guide planes go: fixed or scallop-driven spacing.
+
+The ball centre runs on vertical planes ``dot(p, n) = d`` with n = (-sin A, cos A, 0)
+(A the pass angle). The planes cover the ball centres that touch the selected faces:
+from the smallest to the largest ``n . (p + R' N)`` over samples p of the faces (N the
+outward normal). With a stepover S they are S apart, centred on that range (at most S/2
+from either end). With a scallop height H they are placed one after another, each as far
+from the last as every sample between them allows (docs/finish.md, "Spacing"):
+
+    c = 2 sqrt(2 R H - H^2) sqrt(B / A) sqrt(1 - s^2),   s^2 = (2 R H - H^2) k^2 / (4 A B)
+    A = |1 - (C + H) k|,  B = |1 - R' k|,  Delta = c sqrt(1 - (n . N)^2)
+
+c is the distance between neighbouring ball centres across the passes that leaves a cusp
+H high on the surface offset by the allowance C (ball R, R' = R + C; k the surface's normal
+curvature across the passes, the sign of docs/method.md: < 0 convex), exact for a
+circular cross-section; sqrt(1 - (n . N)^2) turns that distance on the offset surface into
+the distance between the planes (a slope across the passes brings them closer). Samples
+the ball cannot serve are set apart with their reason: normals pointing down
+(``unreachable``), concave tighter than the ball (``too tight``), within
+``PARALLEL_DEG`` of parallel to the planes (``parallel wall``). Lengths mm.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import InputError
+from ...trim import OUTSIDE
+from .polish import face_derivatives
+
+PARALLEL_DEG = 5.0
+"""deg: a face whose normal is this near the planes' normal is a wall parallel to them."""
+DOWN_NZ = -1e-9
+"""A sample whose normal's Z is below this points down: the ball cannot reach it from +Z."""
+MAX_SAMPLES = 60_000
+"""Samples over all the selected faces at most (the grid is made coarser above)."""
+MIN_PER_SIDE = 4
+
+
+@dataclass
+class FaceSamples:
+    """Samples of the selected faces on a grid of nodes over each face's (u, w) box (its
+    edges included), nodes outside the trims dropped: (N, 3) points, normals (outward), r_u, r_w, r_uu, r_uw, r_ww;
+    (N,) face numbers and areas (mm^2, the node's trapezoid share of the face); ``spacing`` mm."""
+
+    points: np.ndarray
+    normals: np.ndarray
+    ru: np.ndarray
+    rw: np.ndarray
+    ruu: np.ndarray
+    ruw: np.ndarray
+    rww: np.ndarray
+    faces: np.ndarray
+    areas: np.ndarray
+    spacing: float
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+
+def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) -> FaceSamples:
+    """Samples of ``faces`` (numbers of ``part``) about ``spacing`` mm apart on the surface,
+    coarser when that would give more than ``max_samples`` in all."""
+    surfs = [part.face(n) for n in faces]
+    extents = [s.parameter_lengths() for s in surfs]
+    total = sum(lu * lw for lu, lw in extents) / spacing ** 2
+    if total > max_samples:
+        spacing *= math.sqrt(total / max_samples)
+    numbers, weights, derivs = [], [], []
+    for s, (lu, lw) in zip(surfs, extents):
+        nu = max(MIN_PER_SIDE, math.ceil(lu / spacing))
+        nw = max(MIN_PER_SIDE, math.ceil(lw / spacing))
+        (u0, u1), (w0, w1) = s.u_range, s.w_range
+        us, wu = _nodes(u0, u1, nu)
+        ws, ww = _nodes(w0, w1, nw)
+        uv = []
+        for u, du in zip(us, wu):
+            for w, dw in zip(ws, ww):
+                if s.classify(u, w) == OUTSIDE:
+                    continue
+                uv.append((u, w))
+                numbers.append(s.number)
+                weights.append(du * dw)
+        if uv:   # D2 at every node at once (compiled where the face allows)
+            derivs.extend(face_derivatives(s, np.array(uv)))
+    if not derivs:
+        raise InputError(f"faces {', '.join(map(str, faces))}: no sample inside their trims")
+    d = np.array(derivs)                                   # (N, 6, 3)
+    c = np.cross(d[:, 1], d[:, 2])
+    area = np.linalg.norm(c, axis=1)
+    scale = (d[:, 1] ** 2).sum(1) + (d[:, 2] ** 2).sum(1) + 1e-300
+    tol = {s.number: s.tol.singular for s in surfs}
+    sign = {s.number: s.normal_sign for s in surfs}
+    numbers = np.array(numbers)
+    # a pole (|r_u x r_w| / (|r_u|^2 + |r_w|^2) below the face's tolerance, as
+    # FaceSurface.singularity): no normal; its cell has no area either
+    keep = area / scale >= np.array([tol[n] for n in numbers])
+    if not keep.any():
+        raise InputError(f"faces {', '.join(map(str, faces))}: no sample inside their trims")
+    d, c, area, numbers = d[keep], c[keep], area[keep], numbers[keep]
+    normals = np.array([sign[n] for n in numbers])[:, None] * c / area[:, None]
+    return FaceSamples(d[:, 0], normals, d[:, 1], d[:, 2], d[:, 3], d[:, 4], d[:, 5],
+                       numbers, area * np.array(weights)[keep], spacing)
+
+
+def _nodes(t0: float, t1: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """n + 1 nodes from t0 to t1 and their trapezoid weights (summing to t1 - t0)."""
+    w = np.full(n + 1, (t1 - t0) / n)
+    w[[0, -1]] *= 0.5
+    return np.linspace(t0, t1, n + 1), w
+
+
+def plane_normal(angle_deg: float) -> np.ndarray:
+    """(3,) the guide planes' unit normal for pass angle A: (-sin A, cos A, 0)."""
+    a = math.radians(angle_deg)
+    return np.array([-math.sin(a), math.cos(a), 0.0])
+
+
+def across(samples: FaceSamples, normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(k, g), each (N,): the normal curvature (1/mm, < 0 convex) of each sample in the
+    direction across the passes (the planes' ``normal`` projected on the tangent plane),
+    and g = |that projection| = sqrt(1 - (normal . N)^2) (0 on a wall parallel to them)."""
+    nn = samples.normals
+    e = normal[None, :] - (nn @ normal)[:, None] * nn
+    g = np.linalg.norm(e, axis=1)
+    ru, rw = samples.ru, samples.rw
+    E, F, G = (ru * ru).sum(1), (ru * rw).sum(1), (rw * rw).sum(1)
+    L, M, N = ((samples.ruu * nn).sum(1), (samples.ruw * nn).sum(1),
+               (samples.rww * nn).sum(1))
+    tu, tw = (ru * e).sum(1), (rw * e).sum(1)
+    det = E * G - F * F
+    a, b = (G * tu - F * tw) / det, (E * tw - F * tu) / det
+    den = E * a * a + 2 * F * a * b + G * b * b
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = np.where(den > 0, (L * a * a + 2 * M * a * b + N * b * b) / den, 0.0)
+    return k, g
+
+
+def centre_chord(h, k, radius: float, allowance: float = 0.0):
+    """The distance (mm) between neighbouring ball centres across the passes that leaves a
+    cusp ``h`` mm high on a surface of normal curvature ``k`` (1/mm, < 0 convex) across
+    them, ball ``radius`` R with ``allowance`` C (the module doc's c; exact for a circular
+    cross-section). 0 where the ball does not fit (R' k >= 1). Arrays broadcast."""
+    h, k = np.asarray(h, float), np.asarray(k, float)
+    r1 = radius + allowance
+    w = 2.0 * radius * h - h * h
+    A = np.abs(1.0 - (allowance + h) * k)
+    B = 1.0 - r1 * k
+    fits = B > 0
+    B = np.where(fits, B, 1.0)
+    s2 = np.minimum(w * k * k / (4.0 * A * B), 0.5)  # at most a quarter turn apart
+    return np.where(fits, 2.0 * np.sqrt(w * B / A * (1.0 - s2)), 0.0)
+
+
+def stepover_scallop(stepover: float, radius: float) -> float:
+    """The cusp height (mm) of passes ``stepover`` mm apart on a flat floor, ball R."""
+    half = min(stepover / 2.0, radius)
+    return radius - math.sqrt(radius * radius - half * half)
+
+
+@dataclass
+class PlanePlan:
+    """The guide planes of one operation: ``angle`` (deg), ``offsets`` (P,) ascending (mm
+    along ``normal``); per sample its centre coordinate ``f`` (N,) and ``reason``
+    (N,) ("" a sample the planes serve; "unreachable", "too tight", "parallel wall")."""
+
+    angle: float
+    normal: np.ndarray
+    offsets: np.ndarray
+    f: np.ndarray
+    reason: np.ndarray
+    spacing: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    """(N,) the plane spacing each sample allows (mm; scallop mode, else empty)."""
+
+
+def sample_reasons(samples: FaceSamples, k, g, offset: float) -> np.ndarray:
+    """(N,) why the planes cannot serve each sample ("" when they can)."""
+    reason = np.full(len(samples), "", dtype=object)
+    reason[g < math.sin(math.radians(PARALLEL_DEG))] = "parallel wall"
+    reason[k * offset >= 1.0] = "too tight"
+    reason[samples.normals[:, 2] < DOWN_NZ] = "unreachable"
+    return reason
+
+
+def plan_planes(samples: FaceSamples, radius: float, allowance: float, angle: float, *,
+                stepover: float | None = None, scallop: float | None = None) -> PlanePlan:
+    """The guide planes over ``samples`` (see the module doc)."""
+    r1 = radius + allowance
+    n = plane_normal(angle)
+    k, g = across(samples, n)
+    f = (samples.points + r1 * samples.normals) @ n
+    reason = sample_reasons(samples, k, g, r1)
+    reach = reason != "unreachable"
+    if not reach.any():
+        return PlanePlan(angle, n, np.zeros(0), f, reason)
+    lo, hi = float(f[reach].min()), float(f[reach].max())
+    if stepover is not None:
+        count = max(1, math.ceil((hi - lo) / stepover - 1e-9))
+        first = 0.5 * (lo + hi) - 0.5 * (count - 1) * stepover
+        return PlanePlan(angle, n, first + stepover * np.arange(count), f, reason)
+    spacing = np.where(reason == "", centre_chord(scallop, k, radius, allowance) * g, np.inf)
+    return PlanePlan(angle, n, adaptive_offsets(f, spacing, lo, hi), f, reason, spacing)
+
+
+def adaptive_offsets(f: np.ndarray, spacing: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """Plane offsets from ``lo`` to ``hi`` (mm): the first within half the spacing its
+    samples allow of ``lo``, each next as far from the last as the smallest ``spacing``
+    (N,) of the samples whose ``f`` (N,) lies between them, the last within half a spacing
+    of ``hi``."""
+    order = np.argsort(f)
+    fs, sp = f[order], spacing[order]
+    finite = sp[np.isfinite(sp)]
+    if not len(finite):
+        return np.array([0.5 * (lo + hi)])
+    widest = float(finite.max())
+
+    def allowed(a: float) -> float:
+        """The smallest spacing of the samples in [a, a + d], shrinking d to it."""
+        d = widest
+        for _ in range(60):
+            i, j = np.searchsorted(fs, a), np.searchsorted(fs, a + d, side="right")
+            m = float(sp[i:j].min()) if j > i else math.inf
+            if m >= d:
+                return d
+            d = m
+        return d
+
+    first = lo + 0.5 * allowed(lo)
+    out = [first]
+    while True:
+        d = allowed(out[-1])
+        if out[-1] + 0.5 * d >= hi or len(out) > 1_000_000:
+            break
+        out.append(out[-1] + d)
+    return np.array(out)

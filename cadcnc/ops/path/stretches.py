@@ -1,0 +1,370 @@
+"""Every feasible stretch of a corner: where along a shared concave edge the ball can sit.
+
+A *feasible* ball position of a pair (i, j) is a centre touching both offset surfaces
+(Newton, :func:`~cadcnc.interp.tangency.solve_tangency`) whose feet lie on the trimmed
+faces (inside or on the boundary), where the faces are not tangent, where neither
+contact's concave curvature along the path is tighter than the ball (R' k <= 1, up to
+the spec's 1 um), and where the ball and its shank clear the rest of the part
+(:class:`~cadcnc.guard.clearance.ClearanceGuard`). A *stretch* is a maximal
+connected piece of the offset intersection curve made of feasible positions.
+
+Method: tangency samples anchored on planes normal to the edge, every ``spacing`` mm of
+edge (0.4 mm, at least 9 per edge) and continued ``R' + 1`` mm beyond each end of an
+open edge along its end tangent; a sample interval whose centres are more than
+``MAX_CHORD`` apart is split until they are not. Each change feasible/infeasible
+between neighbouring samples is located by bisection on the anchor's arc length until
+the feasible and the infeasible centres are less than ``LIMIT_TOL`` apart; the limit is
+the feasible one, its rule the one that fails beside it.
+
+Guarantee: neighbouring samples' centres are at most MAX_CHORD = 0.45 mm apart, so a
+stretch (or a gap between stretches) can be missed only if it is shorter than the
+curve between two samples: under 0.5 mm wherever the curve turns less than ~50 deg
+over 0.45 mm. Intervals where a sample has no tangency, or could not be refined to
+MAX_CHORD, are counted in ``EdgeStretches.missed`` (a stretch of any length may hide
+there); they are never reported as feasible.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ...errors import GeometryError, StartPointError
+from ...guard.clearance import ClearanceGuard
+from ...geometry.edge_curve import EdgeCurve
+from ...geometry.part import CONCAVE
+from ...interp.cycle import Contact
+from ...interp.stepper import Tangency
+from ...interp.tangency import solve_tangency
+from ...job import Job
+from ...tolerances import Tolerances
+from ...guard import guard_for
+
+SPACING = 0.4       # mm of edge between samples (refined to MAX_CHORD of centres)
+MIN_SAMPLES = 9     # per edge
+MAX_CHORD = 0.45    # mm: neighbouring sample centres are refined to at most this apart
+LIMIT_TOL = 1e-7    # mm: a limit is located until its two sides are this close
+MAX_SPLITS = 6      # halvings of a sample interval whose centres are too far apart
+
+FEASIBLE = "feasible"
+BOUNDARY, COLLISION, CURVATURE, TANGENT = "boundary", "collision", "curvature", "tangent"
+UNSOLVED = "unsolved"   # no tangency found from the sample's anchor
+SEARCH = "search"       # the stretch goes on past the searched extension of the edge
+CLOSED = "closed"       # a closed edge feasible all around
+
+REASONS = {
+    BOUNDARY: "a contact lies off its face",
+    COLLISION: "a third face (or the shank) is in the way",
+    CURVATURE: "concave curvature tighter than the ball",
+    TANGENT: "the faces are tangent",
+    UNSOLVED: "no ball position touches both faces",
+}
+
+
+@dataclass(frozen=True)
+class Sample:
+    """One ball position tried at arc length ``s`` (mm) along the edge, and its verdict."""
+
+    s: float
+    rule: str                       # FEASIBLE or the first rule that fails
+    detail: str
+    tangency: Tangency | None       # None when no tangency was found
+    tangent: tuple[float, float, float]   # the edge's unit tangent at the anchor
+
+    @property
+    def ok(self) -> bool:
+        return self.rule == FEASIBLE
+
+
+@dataclass(frozen=True)
+class Limit:
+    """One end of a stretch: the last feasible position and the rule that fails past it."""
+
+    tangency: Tangency
+    rule: str        # BOUNDARY, COLLISION, CURVATURE, TANGENT, UNSOLVED, SEARCH, CLOSED
+    detail: str
+    s: float         # arc length of the anchor along the edge, mm
+
+    @property
+    def p(self) -> tuple[float, float, float]:
+        return self.tangency.p
+
+
+@dataclass(frozen=True)
+class Stretch:
+    """A maximal feasible piece of the offset intersection curve along edge ``edge``.
+
+    ``direction`` is the edge's tangent at the start (the path runs start to end);
+    ``length`` the centre polyline's length over the samples, mm.
+    """
+
+    edge: int
+    start: Limit
+    end: Limit
+    direction: tuple[float, float, float]
+    length: float
+    closed: bool = False
+
+
+@dataclass
+class EdgeStretches:
+    """The stretches of one shared concave edge (0-based index among the pair's concave
+    edges), its samples, the intervals where a stretch may have been missed, and, when
+    it has no stretch, the reason."""
+
+    edge: int
+    length: float = 0.0   # mm of edge; samples with 0 <= s <= length lie on the edge itself
+    stretches: list[Stretch] = field(default_factory=list)
+    samples: list[Sample] = field(default_factory=list)
+    missed: int = 0
+
+    @property
+    def refusal(self) -> str | None:
+        """Why no position of this edge is feasible (the rule failing at most samples on
+        the edge itself, with an example), or None when it has a stretch."""
+        if self.stretches:
+            return None
+        on_edge = [x for x in self.samples if 0.0 <= x.s <= self.length] or self.samples
+        counts: dict[str, int] = {}
+        for x in on_edge:
+            counts[x.rule] = counts.get(x.rule, 0) + 1
+        rule = max(counts, key=counts.get)
+        failing = [x for x in on_edge if x.rule == rule]
+        example = failing[len(failing) // 2]   # the middle one: away from the edge's ends
+        return (f"edge {self.edge + 1}: no feasible ball position: {REASONS.get(rule, rule)}"
+                f" ({example.detail}; at {counts[rule]} of {len(on_edge)} samples on the "
+                "edge)")
+
+
+class Feasibility:
+    """The verdict on a ball position of a pair: tangency, trims, curvature, clearance."""
+
+    def __init__(self, s1, s2, job: Job, guard: ClearanceGuard | None):
+        self.s1, self.s2, self.job = s1, s2, job
+        self.offsets = job.offsets
+        self.tol = job.tolerances
+        self.guard = guard
+        self.max_reach = 10.0 * max(max(self.offsets), 1e-3)   # mm from the anchor
+
+    def sample(self, s: float, anchor, tangent, seed: Tangency | None = None) -> Sample:
+        """Solve the tangency in the plane through ``anchor`` normal to ``tangent`` (seeded
+        from ``seed`` or the projections of the anchor) and judge it."""
+        tangent = tuple(map(float, tangent))
+        try:
+            seeds = ([seed.uv1, seed.uv2] if seed is not None else
+                     [_project(s, anchor) for s in (self.s1, self.s2)])
+            tan = solve_tangency(self.s1, self.s2, self.offsets, *seeds, anchor,
+                                 direction=tangent, tol=self.tol, what="sample")
+        except (StartPointError, GeometryError, ArithmeticError) as exc:
+            return Sample(s, UNSOLVED, str(exc), None, tangent)
+        if np.linalg.norm(np.subtract(tan.p, anchor)) > self.max_reach:
+            return Sample(s, UNSOLVED, "the tangency found is far from the edge", None,
+                          tangent)
+        rule, detail = self.judge(tan)
+        return Sample(s, rule, detail, tan, tangent)
+
+    def judge(self, tan: Tangency) -> tuple[str, str]:
+        """(FEASIBLE, "") or the first failing rule and a detail naming the face."""
+        c1 = Contact(self.s1, self.offsets[0], *tan.uv1)
+        c2 = Contact(self.s2, self.offsets[1], *tan.uv2)
+        t = np.cross(c1.n, c2.n)
+        sin = float(np.linalg.norm(t))
+        if sin < self.tol.tangent_sin:
+            return TANGENT, f"|n1 x n2| = {sin:.3g}"
+        off = [f"face {s.number}" for s, uv in ((self.s1, tan.uv1), (self.s2, tan.uv2))
+               if not s.contains(*uv)]
+        if off:
+            return BOUNDARY, "contact off " + " and ".join(off)
+        t = tuple(t / sin)
+        for c, s in ((c1, self.s1), (c2, self.s2)):
+            k = c.curvature(t)
+            if too_tight(c.offset * k, c.offset, self.tol):
+                return CURVATURE, f"face {s.number}: R' k = {c.offset * k:.4g} > 1"
+        if self.guard is not None:
+            m, detail = self.guard.margin(tan.p)
+            if m < 0.0:
+                return COLLISION, f"{detail} ({-m:.4g} mm too near)"
+        return FEASIBLE, ""
+
+
+def too_tight(rk: float, offset: float, tol: Tolerances) -> bool:
+    """Whether a concave curvature k with R' k = ``rk`` is tighter than a ball of offset
+    R' (mm) can follow. R' k = 1 is a tie: the ball fits the face exactly (a hole of its
+    own radius) and does not cut it; past 1 + gouge / 2 R' it cuts the face deeper than
+    the spec's 1 um (a cylinder of radius R'/(R' k) is cut by ~2 R' (R' k - 1))."""
+    return rk > 1.0 + tol.gouge / (2.0 * offset)
+
+
+def _project(surface, point) -> tuple[float, float]:
+    """(u, w) of the surface point nearest ``point``: in the face's parameter box, else
+    on the whole surface (anchors past the edge's ends may project outside the box)."""
+    try:
+        return surface.project(point)[:2]
+    except GeometryError:
+        return surface.project(point, within_face_box=False)[:2]
+
+
+def edge_stretches(feas: Feasibility, shared_edge, edge: int,
+                   spacing: float = SPACING, extend: tuple[bool, bool] = (True, True)
+                   ) -> EdgeStretches:
+    """Every stretch along one shared concave edge (see the module's method).
+
+    ``extend``: whether to search past the edge's start and end; not where another
+    concave edge of the same pair continues it (that edge's own search covers it, and two
+    cuts would overlap)."""
+    curve = EdgeCurve(shared_edge)
+    ext = 0.0 if curve.closed else max(feas.offsets) + 1.0
+    n = max(MIN_SAMPLES, int(math.ceil(curve.length / spacing)) + 1)
+    grid = np.linspace(0.0, curve.length, n)
+    if curve.closed:
+        grid = grid[:-1]
+    # past the ends at the search's own spacing, however short the edge (a 1 um edge's
+    # in-edge step would give tens of thousands of samples)
+    step = max(grid[1] - grid[0], spacing)
+    k_ext = int(math.ceil(ext / step)) if ext > 0 else 0
+    k_lo, k_hi = (k_ext if go else 0 for go in extend)
+    grid = np.concatenate([-step * np.arange(k_lo, 0, -1), grid,
+                           curve.length + step * np.arange(1, k_hi + 1)])
+    out = EdgeStretches(edge, curve.length)
+    samples: list[Sample] = []
+    for s in grid:   # each seeded from the last solved sample: stays on one branch
+        last = next((x for x in reversed(samples[-1:]) if x.tangency is not None), None)
+        samples.append(_at(feas, curve, float(s), last))
+    samples = _refine(feas, curve, samples, out)
+    out.samples = samples
+    out.stretches = _stretches(feas, curve, samples, edge)
+    return out
+
+
+def _at(feas: Feasibility, curve: EdgeCurve, s: float, seed: Sample | None) -> Sample:
+    anchor, tangent = curve.point_tangent(s)
+    tan = seed.tangency if seed is not None else None
+    got = feas.sample(s, anchor, tangent, tan)
+    if got.rule == UNSOLVED and tan is not None:   # the seed may mislead: try the anchor
+        got = feas.sample(s, anchor, tangent, None)
+    return got
+
+
+def _refine(feas, curve, samples: list[Sample], out: EdgeStretches) -> list[Sample]:
+    """Split intervals whose centres are more than MAX_CHORD apart (to SPACING /
+    2**MAX_SPLITS of edge); count in ``out.missed`` the intervals where a stretch may
+    hide: still too far apart, or no tangency at either end on the edge itself."""
+    floor = SPACING / 2 ** MAX_SPLITS
+    result = [samples[0]]
+    for b in samples[1:]:
+        stack = [b]
+        while stack:
+            a, b = result[-1], stack[-1]
+            if a.tangency is None or b.tangency is None:
+                if a.tangency is None and b.tangency is None and b.s > 0.0 \
+                        and a.s < curve.length:
+                    out.missed += 1
+            elif np.linalg.norm(np.subtract(a.tangency.p, b.tangency.p)) > MAX_CHORD:
+                if b.s - a.s > floor:
+                    # seeded from a's tangency, feasible or not, as the grid is: from the
+                    # anchor alone Newton may land on another branch of the curve (15 mm
+                    # off on r0901_ec 67/377), and every halving would land there again
+                    stack.append(_at(feas, curve, 0.5 * (a.s + b.s), a))
+                    continue
+                out.missed += 1
+            result.append(stack.pop())
+    return result
+
+
+def _locate(feas, curve, good: Sample, bad: Sample) -> tuple[Sample, Sample]:
+    """Bisection on arc length between a feasible and an infeasible sample, until their
+    centres are LIMIT_TOL apart (or the anchors 1e-12 mm): (last feasible, first failing)."""
+    for _ in range(80):
+        if bad.tangency is not None and np.linalg.norm(
+                np.subtract(good.tangency.p, bad.tangency.p)) < LIMIT_TOL:
+            break
+        if abs(bad.s - good.s) < 1e-12:
+            break
+        mid = _at(feas, curve, 0.5 * (good.s + bad.s), good)
+        if mid.ok:
+            good = mid
+        else:
+            bad = mid
+    return good, bad
+
+
+def _limit(feas, curve, good: Sample, bad: Sample | None) -> Limit:
+    """The limit between a feasible sample and its infeasible neighbour (None: the end of
+    the searched extension). On a closed edge the neighbour across the seam is moved by
+    one period of arc length, so that the bisection runs between the two."""
+    if bad is None:
+        return Limit(good.tangency, SEARCH, "the stretch goes on past the searched "
+                     "extension of the edge", good.s)
+    if curve.closed and abs(bad.s - good.s) > 0.5 * curve.length:
+        bad = replace(bad, s=bad.s + math.copysign(curve.length, good.s - bad.s))
+    good, bad = _locate(feas, curve, good, bad)
+    return Limit(good.tangency, bad.rule, bad.detail, good.s)
+
+
+def _stretches(feas, curve, samples: list[Sample], edge: int) -> list[Stretch]:
+    """Runs of feasible samples, each with both limits located."""
+    ok = [x.ok for x in samples]
+    if curve.closed and all(ok):
+        first = samples[0]
+        lim = Limit(first.tangency, CLOSED, "feasible all around the closed edge", first.s)
+        pts = [x.tangency for x in samples + [first]]
+        return [Stretch(edge, lim, lim, first.tangent, _polyline(pts), True)]
+    order = list(range(len(samples)))
+    if curve.closed:   # start the walk at an infeasible sample, wrapping around
+        k = ok.index(False)
+        order = order[k:] + order[:k]
+    runs, run = [], []
+    for idx in order:
+        if ok[idx]:
+            run.append(idx)
+        elif run:
+            runs.append(run)
+            run = []
+    if run:
+        runs.append(run)
+    out = []
+    n = len(samples)
+    for run in runs:
+        first, last = run[0], run[-1]
+        before = (first - 1) % n if curve.closed or first > 0 else None
+        after = (last + 1) % n if curve.closed or last < n - 1 else None
+        start = _limit(feas, curve, samples[first], None if before is None else
+                       samples[before])
+        end = _limit(feas, curve, samples[last], None if after is None else samples[after])
+        pts = [start.tangency] + [samples[i].tangency for i in run] + [end.tangency]
+        out.append(Stretch(edge, start, end, samples[first].tangent, _polyline(pts)))
+    return out
+
+
+def _polyline(tangencies: list[Tangency]) -> float:
+    """Length of the polyline through the tangencies' centres, mm."""
+    pts = np.array([t.p for t in tangencies])
+    return float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
+
+
+def pair_stretches(s1, s2, job: Job, guard: ClearanceGuard | None = None,
+                   spacing: float = SPACING) -> list[EdgeStretches]:
+    """Every stretch of every shared concave edge of two faces of one part.
+
+    ``guard`` defaults to the job's tool (R', shank length, tolerance ``hit``).
+    """
+    part = s1.part
+    edges = [e for e in part.shared_edges(s1.number, s2.number) if e.edge_class == CONCAVE]
+    if guard is None:
+        guard = guard_for(part, (s1.number, s2.number), job)
+    feas = Feasibility(s1, s2, job, guard)
+    return [edge_stretches(feas, e, k, spacing, (not _continued(e.start, e, edges),
+                                                 not _continued(e.end, e, edges)))
+            for k, e in enumerate(edges)]
+
+
+JOIN = 1e-6  # mm: edge ends closer than this are one vertex
+
+
+def _continued(point, edge, edges) -> bool:
+    """Whether another of the pair's concave edges starts or ends at ``point``."""
+    p = np.asarray(point, dtype=float)
+    return any(min(np.linalg.norm(p - np.asarray(o.start)), np.linalg.norm(
+        p - np.asarray(o.end))) <= JOIN for o in edges if o is not edge and not o.closed)
