@@ -212,6 +212,7 @@ class FeedPlan:
     pieces: list
     profiles: list[Profile]
     machine: Machine
+    planned: bool = True   # False: at the programmed feed, the limits ignored
 
     @property
     def starts(self) -> np.ndarray:
@@ -248,4 +249,4 @@ def plan_feed(pieces: list[Piece], machine: Machine, planned: bool = True) -> Fe
     if not pieces:
         raise InputError("the program has nothing to stream (no cut or move)")
     make = plan_piece if planned else constant_piece
-    return FeedPlan(pieces, [make(p, machine) for p in pieces], machine)
+    return FeedPlan(pieces, [make(p, machine) for p in pieces], machine, planned)
