@@ -30,6 +30,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from ..errors import InputError
 from .machine import Machine
@@ -149,6 +150,17 @@ def _knotted(piece: Piece, v_lim: np.ndarray):
     return ss, vv, n
 
 
+@njit(cache=True)
+def _passes(ss: np.ndarray, w: np.ndarray, a: float) -> None:
+    """Forward and backward passes on squared speeds ``w`` (in place): v^2 changes by at
+    most 2 a per mm between knots ``ss``. A loop: cumulative forms lose v^2 near the ends
+    to round-off when a L is large."""
+    for i in range(1, len(w)):
+        w[i] = min(w[i], w[i - 1] + 2.0 * a * (ss[i] - ss[i - 1]))
+    for i in range(len(w) - 2, -1, -1):
+        w[i] = min(w[i], w[i + 1] + 2.0 * a * (ss[i + 1] - ss[i]))
+
+
 def _time_law(ss: np.ndarray, w: np.ndarray):
     """t, v, a and the integral S on knots ``ss`` of squared speeds ``w`` (v^2 linear in s
     between knots: constant acceleration)."""
@@ -189,9 +201,7 @@ def plan_piece(piece: Piece, machine: Machine) -> Profile:
     ss, vv, _ = _knotted(piece, v_lim)
     w = vv ** 2
     w[0] = w[-1] = 0.0   # from rest, to rest
-    w = np.minimum(w, 2.0 * a_t * ss + np.minimum.accumulate(w - 2.0 * a_t * ss))
-    back = (w + 2.0 * a_t * ss)[::-1]
-    w = np.minimum(w, -2.0 * a_t * ss + np.minimum.accumulate(back)[::-1])
+    _passes(ss, w, a_t)
     t, v, a, S = _time_law(ss, w)
     return Profile(t, ss, v, a, S, window, v_lim)
 

@@ -84,18 +84,19 @@ def _distinct(points: np.ndarray):
 
 def _step_caps(seg, machine: Machine, mask: np.ndarray) -> np.ndarray | None:
     """Per kept point, the speed (mm/s) whose step at the machine's period stays within
-    ACCURACY_SHARE of what the accuracy rule allowed the program there; None if no cap."""
-    job = seg.path.job
-    commanded = np.asarray(seg.path.commanded, dtype=float)
+    ACCURACY_SHARE of what the accuracy rule allowed the program there; None if no cap.
+    The last step (landed on the end or a limit, not shortened for accuracy) is not one."""
+    path = seg.path
+    job = path.job
     full = job.step
+    commanded = np.asarray(path.commanded, dtype=float)
     n = len(commanded)
-    limit = np.full(n, math.inf)
-    short = commanded[1:] < full * (1.0 - 1e-9)   # step k -> k + 1 shortened
-    if machine.period > job.period:   # no step longer than the program's was ever tried
-        limit[:] = full
-    lim_steps = np.where(short, commanded[1:], math.inf)
-    limit[:-1] = np.minimum(limit[:-1], lim_steps)
-    limit[1:] = np.minimum(limit[1:], lim_steps)
+    limit = np.full(n, full if machine.period > job.period else math.inf)
+    if path.accuracy_cycles:
+        short = commanded[1:-1] < full * (1.0 - 1e-9)   # step k -> k + 1 shortened
+        steps = np.where(short, commanded[1:-1], math.inf)
+        limit[:-2] = np.minimum(limit[:-2], steps)
+        limit[1:-1] = np.minimum(limit[1:-1], steps)
     limit = limit[mask]
     if not np.isfinite(limit).any():
         return None
