@@ -16,6 +16,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
+import math
+
 import numpy as np
 
 from ..errors import GeometryError
@@ -129,7 +131,6 @@ def _kernel(stepper, piece: Piece, s: np.ndarray, period: float, what: str) -> n
     a few 1e-7 of its length longer or shorter than the program's points say: over the
     last BLEND mm the target moves smoothly onto the distance left to the cut's last
     point, so the stream lands on it without a jump."""
-    out = np.empty((len(s), 3))
     end, length = piece.points[-1], piece.length
     ds = np.diff(np.r_[0.0, s])
     kappa = np.interp(s, piece.s, piece.kappa)
@@ -138,25 +139,30 @@ def _kernel(stepper, piece: Piece, s: np.ndarray, period: float, what: str) -> n
     x = np.clip(1.0 - left / BLEND, 0.0, 1.0)
     weight = x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)   # C2 from 0 to 1
     k_end = float(piece.kappa[-1])
+    weight, left = weight.tolist(), left.tolist()
     to_feed = 60.0 / period
-    p = np.asarray(stepper.p, dtype=float)
-    for n, target in enumerate(chords):
+    ex, ey, ez = map(float, end)
+    x, y, z = map(float, stepper.p)
+    rows = []
+    for n, target in enumerate(chords.tolist()):
         if stepper.stop_reason is None:
             f = target - stepper.travelled
             w = weight[n]
             if w > 0.0:
-                d = float(np.linalg.norm(end - p))
+                d = math.sqrt((ex - x) ** 2 + (ey - y) ** 2 + (ez - z) ** 2)
                 f = (1.0 - w) * f + w * (d * (1.0 + k_end * k_end * d * d / 24.0) - left[n])
-            if left[n] <= 0.0:
-                f = max(f, float(np.linalg.norm(end - p)) * (1.0 + LANDING) + 1e-12)
+                if left[n] <= 0.0:
+                    f = max(f, d * (1.0 + LANDING) + 1e-12)
             if f > 0.0:
                 dp = stepper.step(f * to_feed)
                 if dp is not None:
-                    p = p + dp
+                    x, y, z = x + dp[0], y + dp[1], z + dp[2]
                 elif stepper.stop_reason not in (END, CLOSED):
                     raise GeometryError(f"{what}: the stepper stopped while streaming "
                                         f"({stepper.stop_reason}: {stepper.stop_detail})")
-        out[n] = p
+        rows.append((x, y, z))
+    out = np.array(rows, dtype=float).reshape(-1, 3)
+    p = out[-1] if len(rows) else np.array([x, y, z])
     for _ in range(3):   # the rest of the cut lies between two periods: land on its end
         if stepper.stop_reason is not None:
             break
