@@ -128,9 +128,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plunge-feed", metavar="F",
                    help="feed of the links' plunge moves, mm/min (default: the feed)")
 
-    from . import finish, pencil  # light: their commands import the library when run
+    from . import finish, pencil, stream  # light: their commands import the library when run
     pencil.add_parser(add, _flip_option, _gouge_options, _gcode_options)
     finish.add_parser(add, _flip_option, _gouge_options, _gcode_options)
+    stream.add_parser(add, _flip_option, _gouge_options)
 
     p = add("run", "execute an APT-like part program (PATH = P/[...])",
             "Execute an APT-like part program (grammar: docs/cli.md). Prints a summary per "
@@ -209,8 +210,10 @@ def main(argv: list[str] | None = None) -> int:
 
             from .finish import finish_command
             from .pencil import pencil_command
+            from .stream import stream_command
 
-        run = {"pencil": pencil_command, "finish": finish_command}.get(
+        run = {"pencil": pencil_command, "finish": finish_command,
+               "stream": stream_command}.get(
             args.command) or commands.COMMANDS[args.command]
         return int(run(args) or 0)
     except KeyboardInterrupt:

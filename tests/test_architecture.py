@@ -80,6 +80,19 @@ def test_interpolation_core_imports_no_occt(name):
             assert top in sys.stdlib_module_names or top in THIRD_PARTY_OK_IN_CORE, (name, mod)
 
 
+@pytest.mark.parametrize("name", sorted(n for n in MODULES if n.startswith("cadcnc.controller")))
+def test_controller_imports_no_occt_and_no_hal(name):
+    """The controller (feed planning, stream) takes steppers from its caller: no OCCT, no
+    HAL; it reads the interpolation core, programs and the shared vocabulary."""
+    for mod in imports(name):
+        top = mod.split(".")[0]
+        if top == "cadcnc":
+            assert mod.startswith(("cadcnc.controller", "cadcnc.interp", "cadcnc.program")) \
+                or mod in KERNEL_FREE_TOP, (name, mod)
+        else:
+            assert top in sys.stdlib_module_names or top in THIRD_PARTY_OK_IN_CORE, (name, mod)
+
+
 def test_kernel_free_top_level_modules_import_no_occt():
     for name in KERNEL_FREE_TOP & set(MODULES):
         for mod in imports(name):

@@ -1,0 +1,139 @@
+"""A program cut into the pieces the feed planner plans one by one (no OCCT).
+
+A piece is one cut (the kernel's points, which the stream re-interpolates) or one
+straight move of a link. Pieces meet at rest: a link's moves turn by 90° and a cut meets
+its links at a corner, so a stop there costs little and keeps every axis within its
+limits. Arrays: ``points`` (n, 3) mm, ``s`` (n,) arc length (chord sum) from the piece's
+start, mm; speeds mm/s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..job import check_number
+from ..program.program import Program
+from .machine import Machine
+
+DUPLICATE = 1e-12   # mm: consecutive points this close are one point
+ACCURACY_SHARE = 0.9
+"""The planned step stays within this share of the step the accuracy rule allowed the
+program (``accuracy_cycles``): the kernel then never shortens a planned step."""
+
+
+@dataclass
+class Piece:
+    """One cut or one straight link move, planned as one motion from rest to rest.
+
+    ``cap`` (mm/s): the programmed speed (inf for a rapid: the axes' limits alone);
+    ``step_cap`` (n,) mm/s or None: per point, the speed at which the machine's period
+    stays within the step the accuracy rule allowed; ``segment`` the index in
+    ``program.segments``, ``cut`` the index among ``program.cuts`` (None for a link)."""
+
+    points: np.ndarray
+    s: np.ndarray
+    cap: float
+    segment: int
+    cut: int | None = None
+    step_cap: np.ndarray | None = None
+    kappa: np.ndarray | None = None   # (n,) curvature 1/mm through each point and its two
+
+
+    @property
+    def length(self) -> float:
+        return float(self.s[-1])
+
+    @property
+    def rapid(self) -> bool:
+        return math.isinf(self.cap)
+
+
+def curvature(points: np.ndarray) -> np.ndarray:
+    """(n,) the curvature (1/mm) of the circle through each point and its neighbours
+    (the ends take their neighbour's; 0 for fewer than 3 points)."""
+    n = len(points)
+    if n < 3:
+        return np.zeros(n)
+    a, b = points[1:-1] - points[:-2], points[2:] - points[1:-1]
+    c = points[2:] - points[:-2]
+    area2 = np.linalg.norm(np.cross(a, b), axis=1)
+    k = 2.0 * area2 / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1)
+                       * np.linalg.norm(c, axis=1))
+    return np.r_[k[:1], k, k[-1:]]
+
+
+def arc_lengths(points: np.ndarray, kappa: np.ndarray) -> np.ndarray:
+    """(n,) arc length from the first point: each chord h of a curve of curvature k is
+    an arc of h (1 + k^2 h^2 / 24); the kernel re-run at shorter steps follows the arc."""
+    h = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    k2 = 0.5 * (kappa[:-1] ** 2 + kappa[1:] ** 2)
+    return np.r_[0.0, np.cumsum(h * (1.0 + k2 * h * h / 24.0))]
+
+
+def _distinct(points: np.ndarray):
+    """Points without consecutive duplicates, their arc length, curvature, kept mask."""
+    h = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    mask = np.r_[True, h > DUPLICATE]
+    pts = points[mask]
+    kappa = curvature(pts)
+    return pts, arc_lengths(pts, kappa), kappa, mask
+
+
+def _step_caps(seg, machine: Machine, mask: np.ndarray) -> np.ndarray | None:
+    """Per kept point, the speed (mm/s) whose step at the machine's period stays within
+    ACCURACY_SHARE of what the accuracy rule allowed the program there; None if no cap.
+    The last step (landed on the end or a limit, not shortened for accuracy) is not one."""
+    path = seg.path
+    job = path.job
+    full = job.step
+    commanded = np.asarray(path.commanded, dtype=float)
+    n = len(commanded)
+    limit = np.full(n, full if machine.period > job.period else math.inf)
+    if path.accuracy_cycles:
+        short = commanded[1:-1] < full * (1.0 - 1e-9)   # step k -> k + 1 shortened
+        steps = np.where(short, commanded[1:-1], math.inf)
+        limit[:-2] = np.minimum(limit[:-2], steps)
+        limit[1:-1] = np.minimum(limit[1:-1], steps)
+    limit = limit[mask]
+    if not np.isfinite(limit).any():
+        return None
+    return ACCURACY_SHARE * limit / machine.period
+
+
+def pieces_of(program: Program, machine: Machine, feed: float | None = None) -> list[Piece]:
+    """The program's pieces in machining order. ``feed`` (mm/min) replaces the program's
+    feed for cuts and the links' feed moves; rapids go as fast as the axes allow."""
+    feed = program.job.feed if feed is None else check_number("feed", feed, "mm/min")
+    pieces: list[Piece] = []
+    cut = 0
+    for k, seg in enumerate(program.segments):
+        if seg.kind == "cut":
+            pts, s, kappa, mask = _distinct(np.asarray(seg.points, dtype=float))
+            if s[-1] > DUPLICATE:
+                pieces.append(Piece(pts, s, feed / 60.0, k, cut, _step_caps(seg, machine, mask),
+                                    kappa))
+            cut += 1
+            continue
+        for a, b, rapid in zip(seg.points[:-1], seg.points[1:], seg.rapid):
+            pts, s, _, _ = _distinct(np.array([a, b], dtype=float))
+            if s[-1] > DUPLICATE:
+                pieces.append(Piece(pts, s, math.inf if rapid else feed / 60.0, k))
+    return pieces
+
+
+def programmed_time(pieces: list[Piece], machine: Machine) -> float:
+    """Seconds at the programmed feed, rapids at the axes' velocity, no ramps: the time a
+    stream at constant feed takes, and what the planned stream is measured against."""
+    return float(sum(p.length / constant_speed(p, machine) for p in pieces))
+
+
+def constant_speed(piece: Piece, machine: Machine) -> float:
+    """The programmed speed (mm/s); a rapid's is the fastest every axis allows along it."""
+    if not piece.rapid:
+        return piece.cap
+    u = np.abs(piece.points[-1] - piece.points[0]) / piece.length
+    with np.errstate(divide="ignore"):
+        return float(np.min(np.asarray(machine.max_velocity) / u))

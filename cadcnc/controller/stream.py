@@ -1,0 +1,213 @@
+"""A whole program as one position per servo period, at the planned feed (no OCCT).
+
+:func:`stream_program` plans the feed (:mod:`.feed_plan`), then computes each period's
+position on the exact path: a cut's by its own stepper re-run with the per-cycle feed
+override (the kernel computes every position; the step commanded each period is the
+planned arc length minus the distance the kernel has travelled), a link move's in closed
+form. The steppers come from the caller (``steppers(cut_index, segment, period)``, built
+where the part's faces are, e.g. :func:`cadcnc.ops.stream_steppers.stepper_factory`); a
+cut without one (a convex roll-over arc) is interpolated from its own points by a cubic
+Hermite in arc length. Positions: (N, 3) float64, absolute X Y Z in mm; row 0 is the
+program's first point at t = 0, row n the position at n Ts.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import math
+
+import numpy as np
+
+from ..errors import GeometryError
+from ..interp.cycle import CLOSED, END
+from ..program.program import Program
+from .feed_plan import FeedPlan, plan_feed
+from .machine import AXES, Machine
+from .pieces import Piece, pieces_of, programmed_time
+
+StepperFactory = Callable[[int, object, float], object]
+"""steppers(cut_index, cut_segment, period) -> a fresh stepper from the cut's first point
+landing on its last (record off), or None when the cut has none."""
+LANDING = 1e-6   # relative: the last step of a cut commanded this much past its end
+BLEND = 0.2      # mm before a cut's end where the target moves onto the distance left
+
+
+@dataclass
+class Stream:
+    """The positions of every period, the plan they follow and where each piece's rows
+    are. ``kernel_cuts`` / ``hermite_cuts``: cuts positioned by the kernel / by their
+    points."""
+
+    positions: np.ndarray
+    plan: FeedPlan
+    programmed_time: float
+    rows: np.ndarray          # (N,) the piece of each row
+    kernel_cuts: int = 0
+    hermite_cuts: int = 0
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def machine(self) -> Machine:
+        return self.plan.machine
+
+    @property
+    def periods(self) -> int:
+        return len(self.positions) - 1
+
+    @property
+    def cycle_time(self) -> float:
+        return self.periods * self.machine.period
+
+    def derivatives(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Finite-difference velocity, acceleration and jerk of the positions (mm/s...)."""
+        ts, x = self.machine.period, self.positions
+        return (np.diff(x, axis=0) / ts, np.diff(x, 2, axis=0) / ts ** 2,
+                np.diff(x, 3, axis=0) / ts ** 3)
+
+    def shares(self) -> dict[str, tuple[float, float, float]]:
+        """Per axis, the largest |v|, |a|, |j| of the positions as a share of the limits."""
+        m = self.machine
+        out = {}
+        for name, d, lim in zip(("velocity", "acceleration", "jerk"), self.derivatives(),
+                                (m.max_velocity, m.max_acceleration, m.max_jerk)):
+            peak = np.abs(d).max(axis=0) if len(d) else np.zeros(3)
+            out[name] = tuple(float(p / q) for p, q in zip(peak, lim))
+        return out
+
+    def segment_moves(self, program: Program) -> list[np.ndarray]:
+        """Per program segment, the streamed positions inside it, led by the row before
+        (so every chord of the stream belongs to exactly one segment): the gate's moves."""
+        seg_of_row = np.array([p.segment for p in self.plan.pieces])[self.rows]
+        seg_of_row[0] = 0
+        out, prev = [], self.positions[0]
+        for k in range(len(program.segments)):
+            mine = self.positions[seg_of_row == k]
+            if k == 0:
+                mine = mine[1:]
+            out.append(np.vstack([prev[None], mine]))
+            if len(mine):
+                prev = mine[-1]
+        return out
+
+    def summary(self) -> dict:
+        """Cycle time, periods, shares of the limits per axis, time lost to the limits."""
+        shares = self.shares()
+        return {
+            "periods": self.periods, "period_s": self.machine.period,
+            "cycle_time_s": self.cycle_time, "programmed_time_s": self.programmed_time,
+            "time_lost_s": self.cycle_time - self.programmed_time,
+            **{f"max_{k}_share": dict(zip(AXES, v)) for k, v in shares.items()},
+            "kernel_cuts": self.kernel_cuts, "hermite_cuts": self.hermite_cuts,
+            "machine": self.machine.source}
+
+
+def _line(piece: Piece, s: np.ndarray) -> np.ndarray:
+    a, b = piece.points[0], piece.points[-1]
+    return a + np.outer(s / piece.length, b - a)
+
+
+def _hermite(piece: Piece, s: np.ndarray) -> np.ndarray:
+    """Cubic Hermite in arc length through the piece's points, tangents by central
+    differences: positions at ``s`` (mm)."""
+    p, ss = piece.points, piece.s
+    if len(p) < 3:
+        return _line(piece, s)
+    d = np.gradient(p, ss, axis=0)
+    k = np.clip(np.searchsorted(ss, s, side="right") - 1, 0, len(ss) - 2)
+    h = ss[k + 1] - ss[k]
+    x = ((s - ss[k]) / h)[:, None]
+    h00, h10 = 2 * x ** 3 - 3 * x ** 2 + 1, x ** 3 - 2 * x ** 2 + x
+    h01, h11 = -2 * x ** 3 + 3 * x ** 2, x ** 3 - x ** 2
+    return h00 * p[k] + h10 * h[:, None] * d[k] + h01 * p[k + 1] + h11 * h[:, None] * d[k + 1]
+
+
+def _kernel(stepper, piece: Piece, s: np.ndarray, period: float, what: str) -> np.ndarray:
+    """Positions at arc lengths ``s`` (nondecreasing) from ``stepper`` on the piece's cut.
+
+    Each period commands the step target - travelled (per-cycle feed override), the
+    target being the planned arc length as the kernel's chord sum. The kernel's path is
+    a few 1e-7 of its length longer or shorter than the program's points say: over the
+    last BLEND mm the target moves smoothly onto the distance left to the cut's last
+    point, so the stream lands on it without a jump."""
+    end, length = piece.points[-1], piece.length
+    ds = np.diff(np.r_[0.0, s])
+    kappa = np.interp(s, piece.s, piece.kappa)
+    chords = np.cumsum(ds * (1.0 - kappa ** 2 * ds ** 2 / 24.0))   # the kernel's travel
+    left = length - s
+    x = np.clip(1.0 - left / BLEND, 0.0, 1.0)
+    weight = x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)   # C2 from 0 to 1
+    k_end = float(piece.kappa[-1])
+    weight, left = weight.tolist(), left.tolist()
+    to_feed = 60.0 / period
+    ex, ey, ez = map(float, end)
+    x, y, z = map(float, stepper.p)
+    rows = []
+    for n, target in enumerate(chords.tolist()):
+        if stepper.stop_reason is None:
+            f = target - stepper.travelled
+            w = weight[n]
+            if w > 0.0:
+                d = math.sqrt((ex - x) ** 2 + (ey - y) ** 2 + (ez - z) ** 2)
+                f = (1.0 - w) * f + w * (d * (1.0 + k_end * k_end * d * d / 24.0) - left[n])
+                if left[n] <= 0.0:
+                    f = max(f, d * (1.0 + LANDING) + 1e-12)
+            if f > 0.0:
+                dp = stepper.step(f * to_feed)
+                if dp is not None:
+                    x, y, z = x + dp[0], y + dp[1], z + dp[2]
+                elif stepper.stop_reason not in (END, CLOSED):
+                    raise GeometryError(f"{what}: the stepper stopped while streaming "
+                                        f"({stepper.stop_reason}: {stepper.stop_detail})")
+        rows.append((x, y, z))
+    out = np.array(rows, dtype=float).reshape(-1, 3)
+    p = out[-1] if len(rows) else np.array([x, y, z])
+    for _ in range(3):   # the rest of the cut lies between two periods: land on its end
+        if stepper.stop_reason is not None:
+            break
+        dp = stepper.step(float(np.linalg.norm(end - p)) * (1.0 + LANDING) * to_feed + 1e-9)
+        p = p if dp is None else p + dp
+    if stepper.stop_reason not in (END, CLOSED) or np.linalg.norm(p - end) > 1e-9:
+        raise GeometryError(f"{what}: the stepper did not land on the cut's last point "
+                            f"(stopped: {stepper.stop_reason}; {np.linalg.norm(p - end):.3g} "
+                            "mm from it)")
+    return out
+
+
+def stream_program(program: Program, machine: Machine, steppers: StepperFactory | None = None,
+                   *, feed: float | None = None, planned: bool = True) -> Stream:
+    """Every period's position of ``program`` on ``machine`` (see the module doc).
+
+    ``feed`` (mm/min) replaces the program's feed; ``planned=False`` streams at the
+    programmed feed ignoring the limits (a comparison, not for a machine)."""
+    pieces = pieces_of(program, machine, feed)
+    plan = plan_feed(pieces, machine, planned)
+    rows, s = plan.targets()
+    positions = np.empty((len(s), 3))
+    cuts = program.cuts
+    kernel = hermite = 0
+    for j, piece in enumerate(pieces):
+        sel = np.flatnonzero(rows == j)
+        if piece.cut is None:
+            positions[sel] = _line(piece, s[sel])
+            continue
+        stepper = None if steppers is None else steppers(piece.cut, cuts[piece.cut],
+                                                         machine.period)
+        if stepper is None:
+            positions[sel] = _hermite(piece, s[sel])
+            hermite += 1
+            continue
+        positions[sel] = _kernel(stepper, piece, s[sel], machine.period,
+                                 f"cut {piece.cut + 1}")
+        kernel += 1
+    positions[0] = pieces[0].points[0]
+    positions[-1] = pieces[-1].points[-1]
+    return Stream(positions, plan, programmed_time(pieces, machine), rows, kernel, hermite)
+
+
+def stream_text(positions: np.ndarray) -> str:
+    """One line per period, ``X Y Z`` in mm with 9 decimals (halstreamer, cfg=fff)."""
+    if not len(positions):
+        return ""
+    return "\n".join(" ".join(f"{v:.9f}" for v in row) for row in positions) + "\n"

@@ -1,0 +1,66 @@
+"""`cadcnc stream` as a user runs it: formats, the gate before writing, Ctrl-C."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from conftest import FIXTURES, cadcnc_cli
+
+BLOCK = FIXTURES / "step_block.step"
+# 4 mm of the block's straight corner (faces 3 and 8): a short program, fast to gate
+SHORT = ["--faces", "3", "8", "--radius", "3", "--start", "19.0919,-23.3345,11",
+         "--end", "16.2635,-20.5061,11"]
+
+
+@pytest.fixture(scope="module")
+def program(tmp_path_factory):
+    d = tmp_path_factory.mktemp("stream")
+    cadcnc_cli("path", BLOCK, *SHORT, "-o", d / "p.json", check=0)
+    return d / "p.json"
+
+
+def test_npy_and_txt_agree_and_gate_passes(program, tmp_path):
+    npy, txt = tmp_path / "s.npy", tmp_path / "s.txt"
+    run = cadcnc_cli("stream", program, "-o", npy, "-o", txt, "--feed", "10000", check=0)
+    x = np.load(npy)
+    assert x.ndim == 2 and x.shape[1] == 3 and x.dtype == np.float64
+    lines = txt.read_text().splitlines()
+    assert len(lines) == len(x)
+    assert all(len(line.split()) == 3 and all(len(v.split(".")[1]) == 9 for v in line.split())
+               for line in lines)
+    assert np.abs(np.loadtxt(txt) - x).max() <= 5e-10
+    assert f"{len(x) - 1} periods" in run.stdout and "max jerk" in run.stdout
+
+
+def test_gate_refusal_writes_nothing(program, tmp_path):
+    """The first link moved to start 3 mm inside the part: the stream's moves there gouge,
+    the gate refuses them (exit 5) and nothing is written."""
+    data = json.loads(program.read_text())
+    link = data["segments"][0]
+    assert link["kind"] == "link"
+    cut_start = data["segments"][1]["points"][0]
+    link["points"][0] = [cut_start[0], cut_start[1], cut_start[2] - 3.0]
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    out = tmp_path / "s.npy"
+    run = cadcnc_cli("stream", bad, "-o", out)
+    assert run.returncode == 5 and not out.exists(), (run.returncode, run.stderr)
+    assert "nothing written" in run.stderr
+
+
+@pytest.mark.parametrize("where", ["cadcnc.verification.gate_program",
+                                   "cadcnc.io.output_set.os.replace"])
+def test_ctrl_c_leaves_no_file(program, tmp_path, monkeypatch, where):
+    import cadcnc.io.output_set  # noqa: F401 - the module patched by name
+    import cadcnc.verification  # noqa: F401
+
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(where, interrupt)
+    run = cadcnc_cli("stream", program, "-o", tmp_path / "s.npy", "-o", tmp_path / "s.txt")
+    assert run.returncode == 130 and "interrupted" in run.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
