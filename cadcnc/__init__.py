@@ -17,7 +17,7 @@ from .errors import (
     CadcncError, FaceNumberError, FacePairError, GeometryError, InputError, OutputError,
     SingularPointError, StartPointError, StepFileError,
 )
-from .job import Job, PairPath, Tool
+from .job import Finish, Job, PairPath, Pencil, Tool
 from .tolerances import Tolerances
 
 __version__ = "0.1.0"
@@ -34,12 +34,15 @@ _LAZY = {
     "pencil": "ops.pencil.pencil", "finish": "ops.finish.finish", "Program": "program.program",
     "to_cq": "io.program_cq", "to_cq_compound": "io.program_cq",
     "show_program": "io.program_cq",
+    "run": "ops.run", "program_for_job": "ops.path.pair_program",
+    "pencil_program": "ops.pencil.pencil", "finish_program": "ops.finish.finish",
+    "gate_program": "verification", "read_program": "io.program_json",
 }
 
 __all__ = [
     "CadcncError", "FaceNumberError", "FacePairError", "GeometryError", "InputError",
     "OutputError", "SingularPointError", "StartPointError", "StepFileError", "Job",
-    "PairPath", "Tool", "Tolerances", *_LAZY,
+    "PairPath", "Pencil", "Finish", "Tool", "Tolerances", *_LAZY,
 ]
 
 

@@ -6,17 +6,27 @@ uses ``assert`` for input validation.
 
 from __future__ import annotations
 
+# Exit codes, the one definition (docs/reliability.md): every command returns one of these.
+EXIT_OK = 0              # a complete program that passed the gouge gate, written
+EXIT_INTERNAL = 1        # an internal error (a bug: please report it)
+EXIT_INPUT = 2           # bad command line or input (file, face, parameter)
+EXIT_NOTHING = 3         # no program from valid input: nothing to cut or reach, no start
+EXIT_OUTPUT = 4          # an output cannot be written
+EXIT_GOUGE = 5           # the gate found a gouge: nothing written unless allowed
+EXIT_PARTIAL = 6         # the program stops short of what was asked
+EXIT_INTERRUPTED = 130   # interrupted (Ctrl-C)
+
 
 class CadcncError(Exception):
     """Root of every error cadcnc raises on purpose."""
 
-    exit_code = 1
+    exit_code = EXIT_INTERNAL
 
 
 class InputError(CadcncError):
     """A parameter given by the user is invalid (names the parameter and its unit)."""
 
-    exit_code = 2
+    exit_code = EXIT_INPUT
 
 
 class StepFileError(InputError):
@@ -34,7 +44,7 @@ class FacePairError(InputError):
 class GeometryError(CadcncError):
     """The geometry forbids a computation (singular point, tangent faces, no convergence)."""
 
-    exit_code = 3
+    exit_code = EXIT_NOTHING
 
 
 class SingularPointError(GeometryError):
@@ -53,7 +63,13 @@ class StartPointError(GeometryError):
 class OutputError(CadcncError):
     """An output file could not be written (unknown format, unwritable place)."""
 
-    exit_code = 4
+    exit_code = EXIT_OUTPUT
+
+
+class NothingToCutError(CadcncError):
+    """Valid input, and no program: no corner to cut, nothing reachable, no pass."""
+
+    exit_code = EXIT_NOTHING
 
 
 class ProgramSyntaxError(InputError):

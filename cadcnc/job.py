@@ -1,8 +1,9 @@
 """What the user asked for: one typed, validated record per machining job.
 
 A :class:`Job` holds what every operation shares (the part's source, the tool, feed,
-period, clearance height, tolerances) and one operation record (:class:`PairPath`, the
-path along the intersection of two faces; :class:`Finish`, raster finishing of faces). It is
+plunge feed, spindle speed, period, clearance height, tolerances) and one operation record
+(:class:`PairPath`, the path along the intersection of two faces; :class:`Pencil`, every
+inner corner of a part; :class:`Finish`, raster finishing of faces). It is
 validated once, where it is built; everything downstream (the API, the toolpath, the
 APT-like programs, the CLI, the JSON writer and reader) reads its fields, never string
 keys. Units: lengths mm, feed mm/min, period s.
@@ -163,6 +164,57 @@ class PairPath:
         """Each surface's offset in mm, None resolved to the tool's R'."""
         return tuple(tool.offset if o is None else o for o in self.offsets)
 
+    def to_inputs(self) -> dict:
+        return dict(operation="path", faces=list(self.faces),
+                    start=None if self.start is None else list(self.start),
+                    end=None if self.end is None else list(self.end), edge=self.edge,
+                    stretch=self.stretch)
+
+
+SIDES = ("climb", "conventional")
+
+
+def check_faces(faces) -> tuple[int, ...]:
+    """Face numbers (integers from 1) as a tuple, each once, in the order given."""
+    try:
+        items = tuple(faces)
+    except TypeError:
+        raise InputError(f"faces must be face numbers, got {_show(faces)}") from None
+    if not items:
+        raise InputError("no face given: give at least one face number")
+    for n in items:
+        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 1:
+            raise InputError(f"face numbers are integers from 1, got {_show(n)}")
+    return tuple(dict.fromkeys(int(n) for n in items))
+
+
+@dataclass(frozen=True)
+class Pencil:
+    """The ``pencil`` operation: every inner corner of the part a ball can clean.
+
+    ``faces``: only corners whose two faces are among these numbers (None: every corner);
+    ``side``: "climb" (the material on the right of the travel, for a clockwise spindle)
+    or "conventional".
+    """
+
+    faces: tuple[int, ...] | None = None
+    side: str = "climb"
+
+    def __post_init__(self):
+        if self.faces is not None:
+            object.__setattr__(self, "faces", check_faces(self.faces))
+        if self.side not in SIDES:
+            raise InputError(f"side must be one of {', '.join(SIDES)}, got "
+                             f"{_show(self.side)}")
+
+    def resolved_offsets(self, tool: Tool) -> tuple[float, float]:
+        """(R', R'): the ball touches both faces of every corner."""
+        return (tool.offset, tool.offset)
+
+    def to_inputs(self) -> dict:
+        return dict(operation="pencil",
+                    faces=None if self.faces is None else list(self.faces), side=self.side)
+
 
 FINISH_PATTERNS = ("zigzag", "oneway")
 
@@ -185,17 +237,9 @@ class Finish:
     pattern: str = "zigzag"
 
     def __post_init__(self):
-        try:
-            faces = tuple(self.faces)
-        except TypeError:
-            raise InputError(f"faces must be face numbers, got {_show(self.faces)}") from None
-        if not faces:
+        if isinstance(self.faces, (tuple, list)) and not self.faces:
             raise InputError("finishing needs at least one face")
-        for n in faces:
-            if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 1:
-                raise InputError(f"face numbers are integers from 1, got {_show(n)}")
-        faces = tuple(dict.fromkeys(int(n) for n in faces))  # each face once, in order
-        object.__setattr__(self, "faces", faces)
+        object.__setattr__(self, "faces", check_faces(self.faces))
         if (self.stepover is None) == (self.scallop is None):
             raise InputError("give exactly one of stepover (the planes' spacing, mm) and "
                              "scallop (the largest scallop height, mm)"
@@ -229,19 +273,23 @@ class Job:
     """One machining job: tool, feed (mm/min), period (s), operation, part, tolerances.
 
     ``source``: the part's STEP file (None for a CadQuery object). ``clearance``: the Z
-    height (mm) of rapid moves, None for the part's top plus a margin. ``flip_material``:
+    height (mm) of rapid moves, None for the part's top plus SAFE_MARGIN. ``flip_material``:
     the part is read with its material side inverted (``--flip-material``,
     docs/notes/surface_models.md), so that a saved path is verified on the same side.
+    ``plunge_feed`` (mm/min): the feed of the links' plunges (None: the feed);
+    ``spindle`` (rpm): written as ``S.. M3`` in the G-code (None: no spindle word).
     """
 
     tool: Tool
     feed: float
     period: float
-    operation: PairPath | Finish = field(default_factory=PairPath)
+    operation: PairPath | Pencil | Finish = field(default_factory=PairPath)
     source: str | None = None
     clearance: float | None = None
     tolerances: Tolerances = DEFAULT
     flip_material: bool = False
+    plunge_feed: float | None = None
+    spindle: float | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "feed", check_number("feed", self.feed, "mm/min"))
@@ -254,6 +302,18 @@ class Job:
             object.__setattr__(self, "clearance", float(c))
         if self.source is not None:
             object.__setattr__(self, "source", str(self.source))
+        for name, kinds in (("tool", (Tool,)), ("operation", (PairPath, Pencil, Finish)),
+                            ("tolerances", (Tolerances,))):
+            if not isinstance(getattr(self, name), kinds):
+                names = " or ".join(k.__name__ for k in kinds)
+                raise InputError(f"{name} must be a {names} record, got "
+                                 f"{type(getattr(self, name)).__name__}")
+        if self.plunge_feed is not None:
+            object.__setattr__(self, "plunge_feed", check_number(
+                "plunge feed", self.plunge_feed, "mm/min"))
+        if self.spindle is not None:
+            object.__setattr__(self, "spindle", check_number("spindle speed", self.spindle,
+                                                             "rpm"))
 
     @property
     def step(self) -> float:
@@ -266,38 +326,45 @@ class Job:
         return self.operation.resolved_offsets(self.tool)
 
     def to_inputs(self) -> dict:
-        """The JSON ``inputs`` object (keys of format version 1, plus the newer ones)."""
-        op = self.operation
+        """The JSON ``inputs`` object (keys of format version 1, plus the newer ones and
+        the operation's kind, so that a saved program reads back as what it was)."""
         common = dict(radius=self.tool.radius, allowance=self.tool.allowance,
                       feed=self.feed, period=self.period, offsets=list(self.offsets),
                       source=self.source, shank_length=self.tool.shank_length,
-                      clearance=self.clearance, flip_material=self.flip_material)
-        if isinstance(op, Finish):
-            return {**common, **op.to_inputs()}
-        return {**common, "start": None if op.start is None else list(op.start),
-                "end": None if op.end is None else list(op.end), "edge": op.edge,
-                "stretch": op.stretch}
+                      clearance=self.clearance, flip_material=self.flip_material,
+                      plunge_feed=self.plunge_feed, spindle=self.spindle)
+        return {**common, **self.operation.to_inputs()}
 
     @classmethod
     def from_inputs(cls, inputs: dict, faces=(None, None)) -> "Job":
         """The job recorded in a toolpath JSON's ``inputs`` (InputError if malformed)."""
+        if not isinstance(inputs, dict):
+            raise InputError(f"the recorded job must be an object, got "
+                             f"{type(inputs).__name__}")
         try:
             tool = Tool(inputs["radius"], inputs.get("allowance", 0.0),
                         inputs.get("shank_length"))
-            if inputs.get("operation") == "finish":
+            kind = inputs.get("operation", "path")
+            if kind == "finish":
                 op = Finish(inputs["faces"], inputs.get("stepover"), inputs.get("scallop"),
                             inputs.get("angle", 0.0), inputs.get("pattern", "zigzag"))
-                return cls(tool, inputs["feed"], inputs["period"], op, inputs.get("source"),
-                           inputs.get("clearance"),
-                           flip_material=bool(inputs.get("flip_material", False)))
-            # offsets are recorded resolved: R' itself means "the tool's offset"
-            offsets = tuple(None if o == tool.offset else o
-                            for o in (inputs.get("offsets") or (None, None)))
-            op = PairPath(faces=tuple(faces), offsets=offsets,
-                          start=inputs.get("start"), end=inputs.get("end"),
-                          edge=inputs.get("edge", 0), stretch=inputs.get("stretch"))
+            elif kind == "pencil":
+                op = Pencil(inputs.get("faces"), inputs.get("side", "climb"))
+            elif kind == "path":
+                # offsets are recorded resolved: R' itself means "the tool's offset"
+                offsets = tuple(None if o == tool.offset else o
+                                for o in (inputs.get("offsets") or (None, None)))
+                op = PairPath(faces=tuple(inputs.get("faces") or faces), offsets=offsets,
+                              start=inputs.get("start"), end=inputs.get("end"),
+                              edge=inputs.get("edge", 0), stretch=inputs.get("stretch"))
+            else:
+                raise InputError(f"the recorded job's operation {_show(kind)} is not one of "
+                                 "path, pencil, finish")
             return cls(tool, inputs["feed"], inputs["period"], op, inputs.get("source"),
                        inputs.get("clearance"),
-                       flip_material=bool(inputs.get("flip_material", False)))
+                       flip_material=bool(inputs.get("flip_material", False)),
+                       plunge_feed=inputs.get("plunge_feed"), spindle=inputs.get("spindle"))
         except KeyError as e:
             raise InputError(f"the recorded job has no {e.args[0]!r}") from None
+        except TypeError as e:
+            raise InputError(f"the recorded job is malformed: {e}") from None

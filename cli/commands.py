@@ -7,7 +7,6 @@ propagate to :func:`cadcnc.cli.app.main`, which prints them on one line.
 from __future__ import annotations
 
 import json
-import math
 import sys
 from pathlib import Path
 
@@ -15,18 +14,15 @@ import cadcnc
 from cadcnc import apt
 from cadcnc.errors import InputError
 from cadcnc.geometry.report import concave_edges, faces_report
+from cadcnc.errors import EXIT_PARTIAL
 from cadcnc.io.output_set import OutputSet, check_destination
-from cadcnc.io.gcode import written_moves
 from cadcnc.io.outputs import SUFFIXES, render
-from cadcnc.io.summary import summary
-from cadcnc.verification import gouge_gate
+from cadcnc.ops.common import single_cut_program
+from cadcnc.verification.judgement import judge
 
 from . import demo as demo_command, program_commands
 from .feedback import progress, say_error, stage_progress
-from .options import clearance, gcode_options, tolerances
-
-GOUGE_REFUSED = 5  # exit code: the whole-part check found a gouge deeper than the limit
-PARTIAL = 6  # exit code: the path stopped before its intended end
+from .options import clearance, gcode_keywords, tolerances, wants_gcode
 
 
 # -- faces -----------------------------------------------------------------------------------
@@ -65,50 +61,11 @@ def _angles(rng) -> str:
     return f"{lo:.1f}" if abs(hi - lo) < 0.05 else f"{lo:.1f}..{hi:.1f}"
 
 
-# -- path (programs: cli/program_commands.py) ------------------------------------------
-def judge(args, tp, part, what: str, gopts: dict | None = None) -> tuple[bool, int]:
-    """(write it?, exit code) for a computed path: the exit code is 0 only for a complete
-    path that passed the whole-part gouge gate. With G-code options ``gopts`` (a program is
-    written), the gate checks the moves as written: points dropped, rounded, tool-tip
-    offset taken back, approach and retract.
-
-    A partial path exits 6 and is written only with ``--allow-partial``; a gouging one
-    exits 5 and is written only with ``--allow-gouge``. Messages go to stderr.
-    """
-    write, code = True, 0
-    if not tp.complete:
-        write, code = args.allow_partial, PARTIAL
-        say_error(f"cadcnc: {what}: partial: {tp.partial_reason}"
-                  + ("" if write else "; nothing written (--allow-partial writes it)"))
-    if write:
-        moves = None if gopts is None else written_moves(tp, **gopts)
-        gate = gouge_gate(tp, part, tp.job.tolerances, moves=moves,
-                          blend_mm=0.0 if gopts is None else gopts["blend"],
-                          progress=stage_progress(args, f"{what}: gouge check", after_s=1.0))
-        if not gate.ok:
-            write, code = args.allow_gouge, GOUGE_REFUSED
-            if write:
-                what_cut = gate.message.replace("refused: ", "").replace("; nothing written", "")
-                say_error(f"cadcnc: {what}: {what_cut}; written anyway (--allow-gouge)")
-            else:
-                say_error(f"cadcnc: {what}: {gate.message}. {_hint(tp, gate, gopts)}"
-                          "--allow-gouge writes it")
-    return write, code
-
-
-def _hint(tp, gate, gopts) -> str:
-    """What may help: fewer dropped points when only the moves between the written points
-    cut (the centres are clear); a smaller ball for a side cut, not for a centre on or in
-    the part."""
-    if gopts and gopts.get("tolerance") and not any(
-            h.depth_mm > gate.limit_mm for h in gate.hits):
-        return "A smaller --tolerance (fewer points dropped) may pass; "
-    shallow = math.isfinite(gate.depth_mm) and gate.depth_mm < tp.job.tool.offset
-    return "A smaller --radius may fit; " if shallow and not gate.in_material else ""
-
-
 # -- run -------------------------------------------------------------------------------------
 def run(args) -> int:
+    """Execute an APT-like program: each PATH as a program of one cut, judged by the
+    library's gate; .json/.csv/.png/.glb one file per path, .ngc one program of every
+    cut, linked at the highest safe height."""
     requested = args.output or []
     if args.stream and requested:
         raise InputError("--stream prints increments instead of writing files: give "
@@ -123,38 +80,53 @@ def run(args) -> int:
     checked = apt.check(entries, source)
     if args.stream:
         return _stream(args, checked, source)
-    paths, status = [], 0
-    ngc = [out for out in names if Path(out).suffix.lower() == ".ngc"]
-    gopts = (gcode_options(args, checked[0][0].job.clearance, [p for _, p in checked])
-             if ngc else None)
+    gcode = gcode_keywords(args) if wants_gcode(requested) else None
+    programs, status = [], 0
     for entry, part in checked:
         tp = apt.run_job(entry, part, progress(args, f"PATH {entry.name}"), source)
-        paths.append(tp)
+        program = single_cut_program(part, entry.job, tp)
+        programs.append((program, part))
         if not args.quiet:
-            print(f"PATH {entry.name} (line {entry.line}): " + summary(tp, entry.job.source))
-        if not requested:
-            status = status or (0 if tp.complete else PARTIAL)
+            print(f"PATH {entry.name} (line {entry.line}): "
+                  + program.summary(Path(entry.job.source or "").name))
+        if not requested:   # a summary only: nothing is written, nothing to gate
+            status = status or (0 if program.complete else EXIT_PARTIAL)
             continue
-        write, code = judge(args, tp, part, f"{source}:{entry.line}: PATH {entry.name}",
-                            gopts)
-        if not write:
-            return code
-        status = status or code
+        verdict = judge(program, part, f"cadcnc: {source}:{entry.line}: PATH {entry.name}",
+                        gcode=gcode, allow_partial=args.allow_partial,
+                        allow_gouge=args.allow_gouge, progress=stage_progress(
+                            args, f"PATH {entry.name}: gouge check", after_s=1.0))
+        for line in verdict.messages:
+            say_error(line)
+        if not verdict.write:
+            return verdict.code
+        status = status or verdict.code
     contents = {}
     for out, group in names.items():
-        if out in ngc:
-            contents[out] = render(paths, out, title=title or Path(source).name, **gopts)
+        if Path(out).suffix.lower() == ".ngc":
+            contents[out] = render(_whole(programs), out, None, title or Path(source).name,
+                                   **gcode)
         else:
-            contents.update({name: render([tp], name) for name, tp in zip(group, paths)})
+            contents.update({name: render(p, name, part, title or Path(source).name)
+                             for name, (p, part) in zip(group, programs)})
     outputs.write(contents)
-    for out, group in names.items():
-        if not args.quiet:
-            print(f"wrote {', '.join(group)}")
+    if requested and not args.quiet:
+        print(f"wrote {', '.join(n for group in names.values() for n in group)}")
     return status
 
 
+def _whole(programs):
+    """One program of every path's cut, in order, linked at the highest safe height."""
+    from cadcnc.program.linking import linked
+    from cadcnc.program.program import Program
+
+    z = max(max(s.points[:, 2].max() for s in p.links) for p, _ in programs)
+    cuts = [c for p, _ in programs for c in p.cuts]
+    return Program(programs[0][0].job, linked(cuts, z))
+
+
 def _output_names(requested, entries) -> dict[str, list[str]]:
-    """{OUT: files}: .ngc holds every path; .json/.csv one file per path (OUT-NAME.json
+    """{OUT: files}: .ngc holds every path; the others one file per path (OUT-NAME.json
     when the program has several)."""
     names = {}
     for out in requested:
@@ -172,10 +144,14 @@ def _stream(args, checked, source: str) -> int:
     write, status = sys.stdout.write, 0
     for entry, part in checked:
         tp = apt.run_job(entry, part, None, source)
-        ok, code = judge(args, tp, part, f"{source}:{entry.line}: PATH {entry.name}")
-        if not ok:
-            return code
-        status = status or code
+        verdict = judge(single_cut_program(part, entry.job, tp), part,
+                        f"cadcnc: {source}:{entry.line}: PATH {entry.name}",
+                        allow_partial=args.allow_partial, allow_gouge=args.allow_gouge)
+        for line in verdict.messages:
+            say_error(line)
+        if not verdict.write:
+            return verdict.code
+        status = status or verdict.code
         stepper, increments = apt.stream_job(entry, part, source)
         i, j = entry.job.operation.faces
         write(f"# PATH {entry.name}: faces {i} {j}, period {entry.job.period:g} s, start "

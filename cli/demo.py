@@ -7,14 +7,16 @@ from dataclasses import replace
 from pathlib import Path
 
 import cadcnc
-from cadcnc.errors import OutputError, StepFileError
+from cadcnc.errors import EXIT_GOUGE, OutputError, StepFileError
+from cadcnc.io.gcode import blend_for
 from cadcnc.io.output_set import OutputSet
 from cadcnc.io.outputs import SUFFIXES, render
-from cadcnc.io.plot import PICTURE_SUFFIXES, picture_bytes
-from cadcnc.io.summary import summary
-from cadcnc.job import SAFE_MARGIN, Job, PairPath, Tool
+from cadcnc.job import Job, PairPath, Pencil, Tool
+from cadcnc.ops.common import single_cut_program
 from cadcnc.ops.path.pair_path import path_for_job
+from cadcnc.ops.run import run
 from cadcnc.verification import verify
+from cadcnc.verification.judgement import judge
 
 from .feedback import progress
 
@@ -53,37 +55,37 @@ def demo(args) -> int:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise OutputError(f"{out}: cannot create the demo folder ({e.strerror})") from e
-    outputs = OutputSet([out / name for name in FILES],
-                        SUFFIXES + PICTURE_SUFFIXES + (".apt", ".txt"), inputs=[step])
+    outputs = OutputSet([out / name for name in FILES], SUFFIXES + (".apt", ".txt"),
+                        inputs=[step])
     say = (lambda *a: None) if args.quiet else print
     job = replace(JOB, source=str(step))
     i, j = job.operation.faces
     say(f"cadcnc demo: faces {i} (B-spline top) and {j} (cylindrical boss) of {step}")
     part = cadcnc.load_step(step)
     tp = path_for_job(part, job, progress=progress(args, "demo"))
-    say(summary(tp, step.name))
+    program = single_cut_program(part, job, tp)
+    say(program.summary(step.name))
     report = verify(tp, part)
     d = report.to_dict()
     say(f"  verified   max over-cut {d['max_overcut_mm']:.3g} mm, max under-cut "
         f"{d['max_undercut_mm']:.3g} mm, Hausdorff to OCCT {d['hausdorff_mm']:.3g} mm")
+    verdict = judge(program, part, "cadcnc: demo", gcode=dict(blend=blend_for(
+        job.tolerances.gouge)))
+    for line in verdict.messages:
+        say(line)
     title = f"demo: faces {i} {j} of {step.name}"
-    contents = {out / name: render([tp], name, title=title, safe_z=part.top + SAFE_MARGIN)
-                for name in ("path.json", "path.csv", "path.ngc")}
+    contents = {out / name: render(program, name, part, title,
+                                   **(dict(blend=blend_for(job.tolerances.gouge))
+                                      if name.endswith(".ngc") else {}))
+                for name in ("path.json", "path.csv", "path.ngc", "path.png")}
     contents[out / "demo.apt"] = demo_program(step, job)
     contents[out / "verification.txt"] = report.format_table() + "\n"
     contents[out / "verification.json"] = json.dumps(d, indent=1) + "\n"
-    contents[out / "path.png"] = picture_bytes(tp, part, "path.png",
-                                               title=f"demo: faces {i} and {j} of {step.name}")
-    from cadcnc.io.program_json import program_json
-    from cadcnc.io.program_plot import program_picture_bytes
-    from cadcnc.ops.pencil.pencil import pencil
-
-    pen = pencil(part, radius=job.tool.radius)  # every corner of the part, linked
+    pen = run(part, replace(job, operation=Pencil()))  # every corner of the part, linked
     say(f"pencil R {job.tool.radius:g}: {len(pen.cuts)} cuts, {pen.cut_length:.1f} mm cut, "
         f"{pen.link_length:.1f} mm of links, {len(pen.skipped)} corners skipped")
-    contents[out / "pencil.json"] = program_json(pen)
-    contents[out / "pencil.png"] = program_picture_bytes(pen, part, "pencil.png",
-                                                         f"demo: pencil of {step.name}")
+    contents[out / "pencil.json"] = render(pen, "pencil.json")
+    contents[out / "pencil.png"] = render(pen, "pencil.png", part, f"demo: pencil of {step.name}")
     outputs.write(contents)
     say(f"wrote {out}/: " + ", ".join(sorted(FILES)))
-    return 0 if report.ok() else 5
+    return verdict.code if report.ok() else EXIT_GOUGE

@@ -10,13 +10,9 @@ anyway.
 from __future__ import annotations
 
 import time
-from pathlib import Path
-
-from cadcnc.errors import InputError  # light: OCCT is imported in finish_command
-from cadcnc.units import parse_duration, parse_feed, parse_length
 
 from .feedback import say_error
-from .operation import SUFFIXES, add_operation_options, gate_and_write, skipped_line
+from .operation import add_operation_options, operation_command
 
 PROGRESS_EVERY_S = 1.0  # s between two progress lines on stderr
 
@@ -29,8 +25,8 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
             "faces while its centre stays on vertical guide planes at --angle to X, spaced "
             "by --stepover or so that the scallop stays within --scallop; zigzag or one-way, "
             "linked; gate the whole program and write it: .json (program), .ngc, .csv (a "
-            "row per cut point), .png or .glb (picture). Exit 0 complete and verified, 2 "
-            "bad input, 5 gouge, 6 partial.")
+            "row per cycle of every cut), .png or .glb (picture). Exit codes: "
+            "docs/reliability.md.")
     p.add_argument("step", metavar="PART.step", help="the part (STEP file, mm)")
     p.add_argument("--faces", nargs="+", type=int, required=True, metavar="N",
                    help="the faces to finish, numbered as `cadcnc faces`")
@@ -52,43 +48,10 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
     gcode(p)
 
 
-def _angle(text: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        raise InputError(f"--angle: expected degrees, got {text!r}") from None
-
-
 def finish_command(args) -> int:
-    import cadcnc
-    from cadcnc.io.output_set import OutputSet
-    from cadcnc.ops.finish.finish import JOIN, finish
+    from .options import finish_job
 
-    from .options import clearance, tolerances
-
-    outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])
-    radius = parse_length(args.radius, "radius", allow_zero=False)
-    allowance = parse_length(args.allowance, "allowance")
-    spacing = dict(stepover=None if args.stepover is None else parse_length(
-        args.stepover, "stepover", allow_zero=False), scallop=None if args.scallop is None
-        else parse_length(args.scallop, "scallop", allow_zero=False))
-    feed, period = parse_feed(args.feed), parse_duration(args.period)
-    tol = tolerances(args)
-    t0 = time.monotonic()
-    part = cadcnc.load_step(args.step, flip_material=args.flip_material)
-    for n in args.faces:
-        part.face(n)  # face numbers checked before anything is computed
-    program = finish(part, args.faces, radius=radius, allowance=allowance,
-                     angle=_angle(args.angle), pattern=args.pattern, feed=feed,
-                     period=period, clearance=clearance(args), tol=tol,
-                     progress=_progress(args), **spacing)
-    t_cut = time.monotonic() - t0
-    if not program.cuts:
-        raise InputError(f"{args.step}: no pass cuts faces {' '.join(map(str, args.faces))}"
-                         f" with a {radius:g} mm ball ({skipped_line(program) or 'nothing'})")
-    title = f"finish R {radius:g} of {Path(args.step).name}"
-    return gate_and_write(args, program, part, outputs, "finish", title, JOIN,
-                          lambda p: _summary(p, args.step, time.monotonic() - t0, t_cut))
+    return operation_command(args, "finish", finish_job, progress=_progress(args))
 
 
 def _progress(args):
@@ -105,27 +68,3 @@ def _progress(args):
             say_error(f"cadcnc: finish: plane {done}/{total} ({what})")
 
     return report
-
-
-def _summary(program, step: str, seconds: float, t_cut: float) -> str:
-    job = program.job
-    op = job.operation
-    links = program.links[1:-1]  # between cuts: not the first approach nor the last retract
-    down = sum(1 for s in links if len(s.points) == 2 and not s.rapid.any())
-    t = program.totals()
-    spacing = (f"stepover {op.stepover:g} mm" if op.stepover is not None
-               else f"scallop {op.scallop:g} mm")
-    return "\n".join([
-        f"{Path(step).name}: finish faces {' '.join(map(str, op.faces))}, ball R "
-        f"{job.tool.radius:g} mm + allowance {job.tool.allowance:g} mm, {spacing}, angle "
-        f"{op.angle:g} deg, {op.pattern}, feed {job.feed:g} mm/min, period "
-        f"{job.period * 1000:g} ms (step {job.step:.3g} mm)",
-        f"  passes     {len(program.cuts)} cuts; {down} links between them stay down, "
-        f"{len(links) - down} retract; skipped {len(program.skipped)}"
-        + (f" ({skipped_line(program)})" if program.skipped else ""),
-        *[f"  {n}" for n in program.notes],
-        f"  lengths    cut {t['cut_length_mm']:.1f} mm, links {t['link_length_mm']:.1f} mm; "
-        f"time at feed {t['time_at_feed_s']:.1f} s",
-        f"  status     {'complete' if program.complete else 'partial'}; computed in "
-        f"{t_cut:.1f} s, gated and written in {seconds - t_cut:.1f} s",
-    ])

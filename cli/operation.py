@@ -1,18 +1,18 @@
-"""What the operation commands (``pencil``, ``finish``) share: their feed and output
-options, and the end of the command (cut back, gate the whole program, summary, write)."""
+"""What the operation commands (``path``, ``pencil``, ``finish``) share: their feed and
+output options, and the command itself: options to a Job, one library call, the library's
+verdict, the summary, the outputs written all at once, the library's exit code."""
 
 from __future__ import annotations
 
-import csv
-import io
+import time
 from pathlib import Path
 
-from cadcnc.errors import InputError  # light: OCCT is imported inside the functions
 from cadcnc.job import DEFAULT_FEED as FEED, DEFAULT_PERIOD as PERIOD
 
-SUFFIXES = (".json", ".ngc", ".csv", ".png", ".glb")
 DEFAULT_FEED = f"{FEED:g}"  # the job's defaults as the options' text
 DEFAULT_PERIOD = f"{PERIOD * 1000:g}ms"
+OUTPUT_HELP = ("output: .json (the program), .csv (a row per cycle of every cut), .ngc "
+               "(G-code), .png or .glb (a picture); repeat for several")
 
 
 def add_operation_options(p, allowance_help: str) -> None:
@@ -28,66 +28,57 @@ def add_operation_options(p, allowance_help: str) -> None:
     p.add_argument("--plunge-feed", metavar="F",
                    help="feed of the plunges in the links, mm/min (default: --feed)")
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
-                   help="output: .json, .ngc, .csv, .png or .glb; repeat for several")
+                   help=OUTPUT_HELP)
 
 
-def program_csv(program) -> str:
-    """One row per cut point: segment number (1-based among all segments), faces, x y z."""
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["segment", "face_i", "face_j", "x_mm", "y_mm", "z_mm"])
-    for k, seg in enumerate(program.segments, 1):
-        if seg.kind != "cut":
-            continue
-        i, j = seg.path.faces
-        for p in seg.points:
-            w.writerow([k, i, j, f"{p[0]:.6f}", f"{p[1]:.6f}", f"{p[2]:.6f}"])
-    return buf.getvalue()
+def operation_command(args, what: str, job_of, *, progress=None,
+                      times: dict | None = None) -> int:
+    """Run one operation from the command line (module doc). ``job_of(args, source)``
+    builds its Job; ``progress``: the operation's progress callback; ``times``: per-stage
+    seconds (pencil)."""
+    import cadcnc
+    from cadcnc.errors import NothingToCutError
+    from cadcnc.io.output_set import OutputSet
+    from cadcnc.io.outputs import SUFFIXES, render
+    from cadcnc.ops.common import safe_height
+    from cadcnc.ops.run import cut_back_gap
+    from cadcnc.verification.judgement import judge, settle
 
+    from .feedback import say_error, stage_progress
+    from .options import gcode_keywords, wants_gcode
 
-def gate_and_write(args, program, part, outputs, what: str, title: str, join: float,
-                   summary) -> int:
-    """The end of an operation's command: cut gouging cuts back (unless --allow-gouge),
-    gate the whole program as written, print ``summary(program)``, write the outputs by
-    suffix; returns the exit code (0, 5 gouge, 6 partial)."""
-    from cadcnc.io.program_gcode import program_ngc
-    from cadcnc.io.program_json import program_json
-    from cadcnc.io.program_plot import program_picture_bytes
-    from cadcnc.ops.path.pair_program import safe_height
-    from cadcnc.verification.cut_back import cut_back
-
-    from .options import program_gcode_options
-    from .program_commands import judge_program
-
-    gopts = program_gcode_options(args)
-    if not args.allow_gouge:  # a gouging cut is cut back and listed, not the program lost
-        program = cut_back(program, part, safe_height(part, program.job), join)
-        if not program.cuts:
-            raise InputError(f"{args.step}: every cut gouges the part: "
-                             f"{skipped_line(program)}")
-    ngc = program_ngc(program, title=title, **gopts)
-    write, code = judge_program(args, program, part, what, gopts)
+    outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])  # checked before computing
+    job = job_of(args, args.step)
+    t0 = time.monotonic()
+    part = cadcnc.load_step(args.step, flip_material=job.flip_material)
+    for n in getattr(job.operation, "faces", None) or ():
+        if n is not None:
+            part.face(n)   # face numbers checked before anything is computed
+    program = cadcnc.run(part, job, progress=progress, times=times)
+    t_cut = time.monotonic() - t0
+    name = Path(args.step).name
+    join = cut_back_gap(job)
+    if join is not None:
+        program = settle(program, part, safe_height(part, job), join, f"{args.step}: {what}",
+                         args.allow_gouge)
+    elif not program.cuts:
+        raise NothingToCutError(f"{args.step}: {what}: nothing to cut")
+    gcode = gcode_keywords(args) if wants_gcode(args.output) else None
+    verdict = judge(program, part, f"cadcnc: {what}", gcode=gcode,
+                    allow_partial=args.allow_partial, allow_gouge=args.allow_gouge,
+                    progress=stage_progress(args, f"{what}: gouge check", after_s=1.0))
+    for line in verdict.messages:
+        say_error(line)
     if not args.quiet:
-        print(summary(program))
-    if not write:
-        return code
-    contents = {}
-    for out in args.output:
-        suffix = Path(out).suffix.lower()
-        contents[out] = (program_json(program) if suffix == ".json" else ngc
-                         if suffix == ".ngc" else program_csv(program) if suffix == ".csv"
-                         else program_picture_bytes(program, part, out, title))
-    outputs.write(contents)
-    if not args.quiet:
-        print(f"  wrote      {', '.join(args.output)}")
-    return code
-
-
-def skipped_line(program) -> str:
-    """Skipped corners or passes counted by reason: "2 no_fit, 1 tangent"."""
-    counts: dict[str, int] = {}
-    for s in program.skipped:
-        counts[s.reason] = counts.get(s.reason, 0) + 1
-    return ", ".join(f"{n} {r}" for r, n in sorted(counts.items()))
-
-
+        print(program.summary(name))
+        staged = "" if not times else "; " + ", ".join(f"{k} {v:.1f} s"
+                                                       for k, v in times.items())
+        print(f"  time       computed in {t_cut:.1f} s, gated in "
+              f"{time.monotonic() - t0 - t_cut:.1f} s{staged}")
+    if verdict.write:
+        title = f"{what} R {job.tool.radius:g} of {name}"
+        outputs.write({out: render(program, out, part, title, **(gcode or {}))
+                       for out in args.output})
+        if not args.quiet:
+            print(f"  wrote      {', '.join(args.output)}")
+    return verdict.code

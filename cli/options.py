@@ -1,4 +1,5 @@
-"""Command-line strings to the library's typed records: the Job, tolerances, G-code options."""
+"""Command-line strings to the library's typed records: a Job for every command, the
+tolerances and the G-code writer's keywords."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from pathlib import Path
 
 from cadcnc.errors import InputError
 from cadcnc.io.gcode import blend_for
-from cadcnc.job import SAFE_MARGIN, Job, PairPath, Tool, check_number
+from cadcnc.job import Finish, Job, PairPath, Pencil, Tool, check_number
 from cadcnc.tolerances import DEFAULT, Tolerances
 from cadcnc.units import parse_duration, parse_feed, parse_length, parse_point
 
@@ -21,8 +22,22 @@ def tolerances(args) -> Tolerances:
     return dataclasses.replace(DEFAULT, gouge=gouge)
 
 
-def job_from_args(args, source: str) -> Job:
-    """The :class:`Job` of ``path``/``verify``'s options (mm, mm/min, s), validated once."""
+def job_of(args, operation, source: str) -> Job:
+    """The :class:`Job` of the options every command shares (mm, mm/min, s) with
+    ``operation``, validated once."""
+    tool = Tool(parse_length(args.radius, "radius", allow_zero=False),
+                parse_length(args.allowance, "allowance"))
+    plunge = getattr(args, "plunge_feed", None)
+    spindle = getattr(args, "spindle", None)
+    return Job(tool, parse_feed(args.feed), parse_duration(args.period), operation,
+               source=source, clearance=clearance(args), tolerances=tolerances(args),
+               flip_material=getattr(args, "flip_material", False),
+               plunge_feed=None if plunge is None else parse_feed(plunge, "plunge feed"),
+               spindle=None if spindle is None else check_number("--spindle", spindle, "rpm"))
+
+
+def path_job(args, source: str) -> Job:
+    """The :class:`Job` of ``path``/``verify``'s options."""
     missing = [f"--{n}" for n in JOB_OPTIONS if getattr(args, n) is None]
     if missing:
         raise InputError(f"computing a path needs {', '.join(missing)}")
@@ -31,14 +46,29 @@ def job_from_args(args, source: str) -> Job:
     stretch = getattr(args, "stretch", None)
     if stretch is not None and stretch < 1:
         raise InputError(f"--stretch numbers the stretches of an edge from 1, got {stretch}")
-    tool = Tool(parse_length(args.radius, "radius"), parse_length(args.allowance, "allowance"))
     op = PairPath(faces=tuple(args.faces),
                   start=None if args.start is None else parse_point(args.start, "start"),
                   end=None if args.end is None else parse_point(args.end, "end"),
                   edge=None if args.edge is None else args.edge - 1, stretch=stretch)
-    return Job(tool, parse_feed(args.feed), parse_duration(args.period), op, source=source,
-               clearance=clearance(args), tolerances=tolerances(args),
-               flip_material=getattr(args, "flip_material", False))
+    return job_of(args, op, source)
+
+
+def pencil_job(args, source: str) -> Job:
+    """The :class:`Job` of ``pencil``'s options."""
+    return job_of(args, Pencil(args.faces, args.side), source)
+
+
+def finish_job(args, source: str) -> Job:
+    """The :class:`Job` of ``finish``'s options."""
+    spacing = {name: None if getattr(args, name) is None else
+               parse_length(getattr(args, name), name, allow_zero=False)
+               for name in ("stepover", "scallop")}
+    try:
+        angle = float(args.angle)
+    except ValueError:
+        raise InputError(f"--angle: expected degrees, got {args.angle!r}") from None
+    return job_of(args, Finish(args.faces, angle=angle, pattern=args.pattern, **spacing),
+                  source)
 
 
 def clearance(args) -> float | None:
@@ -58,24 +88,9 @@ def wants_gcode(outputs) -> bool:
     return any(Path(o).suffix.lower() == ".ngc" for o in outputs or ())
 
 
-def gcode_options(args, clearance_z: float | None, parts) -> dict:
-    """Keyword arguments of :func:`cadcnc.io.to_ngc`: chord tolerance, tool tip, rapid
-    height (the clearance given, else the highest part's top plus the safe margin)."""
+def gcode_keywords(args) -> dict:
+    """Keyword arguments of :func:`cadcnc.io.program_gcode.program_ngc` besides the job's
+    (spindle and plunge feed are in the job): chord tolerance, tool tip, G64 P blending."""
     tol = None if args.tolerance is None else parse_length(args.tolerance, "tolerance", False)
-    if clearance_z is None:
-        clearance_z = max(part.top for part in parts) + SAFE_MARGIN
-    spindle = None if args.spindle is None else check_number("--spindle", args.spindle, "rpm")
-    return dict(tolerance=tol, tool_tip=args.tool_tip, safe_z=clearance_z, spindle=spindle,
-                blend=blend_for(tolerances(args).gouge))
-
-
-def program_gcode_options(args) -> dict:
-    """Keyword arguments of :func:`cadcnc.io.program_gcode.program_ngc`: chord tolerance,
-    tool tip, spindle, plunge feed (default the feed). The links' height is the job's
-    clearance (``--clearance``), else the part's top plus the safe margin."""
-    tol = None if args.tolerance is None else parse_length(args.tolerance, "tolerance", False)
-    spindle = None if args.spindle is None else check_number("--spindle", args.spindle, "rpm")
-    plunge = getattr(args, "plunge_feed", None)
-    plunge = None if plunge is None else parse_feed(plunge, "plunge feed")
-    return dict(tolerance=tol, tool_tip=args.tool_tip, spindle=spindle, plunge_feed=plunge,
+    return dict(tolerance=tol, tool_tip=args.tool_tip,
                 blend=blend_for(tolerances(args).gouge))

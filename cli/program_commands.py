@@ -12,90 +12,24 @@ import math
 from pathlib import Path
 
 import cadcnc
-from cadcnc.errors import InputError
+from cadcnc.errors import EXIT_GOUGE, InputError
 from cadcnc.io.output_set import OutputSet
 from cadcnc.io.plot import PICTURE_SUFFIXES
-from cadcnc.io.program_gcode import program_written_moves
 from cadcnc.io.program_json import read_program
-from cadcnc.io.program_outputs import PROGRAM_SUFFIXES, render_program
 from cadcnc.io.program_plot import program_picture_bytes
-from cadcnc.io.program_summary import program_summary
 from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.verification import gate_program, verify as run_verify
 from cadcnc.verification.program_gate import cut_label
 
 from .feedback import progress, say_error, stage_progress
-from .options import job_from_args, program_gcode_options, tolerances, wants_gcode
-
-GOUGE_REFUSED = 5  # exit code: the whole-part check found a gouge deeper than the limit
-PARTIAL = 6  # exit code: the program stopped before its intended end
+from .operation import operation_command
+from .options import path_job, tolerances
 
 
 # -- path ------------------------------------------------------------------------------------
 def path(args) -> int:
-    outputs = OutputSet(args.output, PROGRAM_SUFFIXES, inputs=[args.step])
-    job = job_from_args(args, args.step)
-    part = cadcnc.load_step(args.step, flip_material=job.flip_material)
-    for n in job.operation.faces:  # face numbers checked before anything is computed
-        part.face(n)
-    gopts = program_gcode_options(args) if wants_gcode(args.output) else None
-    i, j = job.operation.faces
-    program = program_for_job(part, job, progress=progress(args, f"faces {i} {j}"))
-    write, code = judge_program(args, program, part, "path", gopts)
-    if not write:
-        return code
-    title = f"faces {i} {j} of {Path(args.step).name}"
-    outputs.write({out: render_program(program, out, part, title, **(gopts or {}))
-                   for out in args.output})
-    if not args.quiet:
-        print(program_summary(program, args.step))
-        print(f"  wrote      {', '.join(args.output)}")
-    return code
-
-
-def judge_program(args, program, part, what: str, gopts: dict | None) -> tuple[bool, int]:
-    """(write it?, exit code): 0 only for a complete program whose every cut and move
-    passed the gouge gate. With G-code options ``gopts`` the gate checks the moves as
-    written (points dropped, rounded, tool-tip offset taken back, links); else the
-    program's own points (cuts and links). Partial: exit 6, written only with
-    ``--allow-partial``; gouge: exit 5, written only with ``--allow-gouge``."""
-    write, code = True, 0
-    if not program.complete:
-        write, code = args.allow_partial, PARTIAL
-        why = "; ".join(program.partial_reasons or [
-            s.detail for s in program.skipped if s.reason == "stopped short"])
-        say_error(f"cadcnc: {what}: partial: {why}"
-                  + ("" if write else "; nothing written (--allow-partial writes it)"))
-    if not write:
-        return write, code
-    moves = None if gopts is None else program_written_moves(program, **gopts)
-    gate = gate_program(program, part, program.job.tolerances, moves=moves,
-                        blend_mm=0.0 if gopts is None else gopts["blend"],
-                        progress=stage_progress(args, f"{what}: gouge check", after_s=1.0))
-    if gate.ok:
-        return write, code
-    write, code = args.allow_gouge, GOUGE_REFUSED
-    if write:
-        say_error(f"cadcnc: {what}: {gate.message.replace('refused: ', '')}; written "
-                  "anyway (--allow-gouge)")
-    else:
-        say_error(f"cadcnc: {what}: refused: {gate.message.replace('refused: ', '')}; "
-                  f"nothing written. {_hint(program, gate, gopts)}--allow-gouge writes it")
-    return write, code
-
-
-def _hint(program, gate, gopts) -> str:
-    """What may help: fewer dropped points when only moves between written points cut;
-    a smaller ball for a shallow side cut of a cut (not for a link, nor in the material)."""
-    if any(gate.link_failed):
-        return "A higher --clearance (links above the part) may pass; "
-    bad = [(seg, r) for seg, r in zip(program.cuts, gate.results) if not r.ok]
-    if gopts and gopts.get("tolerance") and not any(
-            h.depth_mm > r.limit_mm for _, r in bad for h in r.hits):
-        return "A smaller --tolerance (fewer points dropped) may pass; "
-    shallow = all(math.isfinite(r.depth_mm) and r.depth_mm < program.job.tool.offset
-                  and not r.in_material and r.hits for _, r in bad)
-    return "A smaller --radius may fit; " if bad and shallow else ""
+    i, j = args.faces
+    return operation_command(args, "path", path_job, progress=progress(args, f"faces {i} {j}"))
 
 
 # -- plot and verify of saved programs -------------------------------------------------------
@@ -137,7 +71,7 @@ def verify(args) -> int:
     else:
         if args.part is not None:
             raise InputError("--part is for a saved PATH.json; a STEP input is the part")
-        job = job_from_args(args, args.input)
+        job = path_job(args, args.input)
         part = cadcnc.load_step(args.input, flip_material=job.flip_material)
         program = program_for_job(part, job, progress=progress(args, "verify"))
     if not program.cuts:
@@ -153,11 +87,11 @@ def verify(args) -> int:
     else:
         for lab, r in zip(labels, reports):
             print((f"{lab}\n" if len(reports) > 1 else "") + r.format_table(tol.gouge))
-    code = 0
+    code = _links_verdict(program, part, tol, args)
     for lab, r in zip(labels, reports):
         if r.ok(tol.gouge):
             continue
-        code = GOUGE_REFUSED
+        code = EXIT_GOUGE
         where = f"{lab}: " if len(reports) > 1 else ""
         if not math.isfinite(r.max_gouge_mm):
             say_error(f"cadcnc: verify: {where}the gouge depth could not be measured")
@@ -166,3 +100,18 @@ def verify(args) -> int:
         say_error(f"cadcnc: verify: {where}failed " + "; ".join(
             f"{c.name} {c.value:.4g} (limit {c.limit:g})" for c in failed))
     return code
+
+
+def _links_verdict(program, part, tol, args) -> int:
+    """The whole program's links by the operations' gate (a report covers the cuts
+    only): 0 when every link move is clear, else the exit code of a gouge, said on
+    stderr. A program of cuts alone has no link to judge."""
+    if not program.links:
+        return 0
+    gate = gate_program(program, part, tol,
+                        progress=stage_progress(args, "verify: links", after_s=1.0))
+    bad = [lab for lab, failed in zip(gate.labels, gate.link_failed) if failed]
+    if not bad:
+        return 0
+    say_error(f"cadcnc: verify: links fail the gouge gate: {gate.message}")
+    return EXIT_GOUGE

@@ -40,7 +40,7 @@ def test_outputs_agree(slab_run):
                             if s["kind"] == "cut"])
     assert cut_z.min() > 3.0 - 2.0 and len(prog.cuts) >= 15
     rows = list(csv.DictReader(cs.open()))
-    pts = np.array([[float(r[k]) for k in ("x_mm", "y_mm", "z_mm")] for r in rows])
+    pts = np.array([[float(r[k]) for k in ("x", "y", "z")] for r in rows])
     np.testing.assert_allclose(pts, np.vstack([c.points for c in prog.cuts]), atol=1e-6)
     assert "F300" in ngc.read_text()
     assert png.read_bytes()[:4] == b"\x89PNG"

@@ -50,7 +50,7 @@ def test_outputs_agree(block_run):
     assert {s["kind"] for s in data["segments"]} == {"cut", "link"}
     assert len(prog.cuts) == 1 and prog.cut_length > 50  # the step's one 60 mm corner
     rows = list(csv.DictReader(cs.open()))
-    pts = np.array([[float(r[k]) for k in ("x_mm", "y_mm", "z_mm")] for r in rows])
+    pts = np.array([[float(r[k]) for k in ("x", "y", "z")] for r in rows])
     np.testing.assert_allclose(pts, np.vstack([c.points for c in prog.cuts]), atol=1e-6)
     moves, want = programmed_moves(ngc.read_text()), commanded(prog)
     np.testing.assert_allclose(moves[-len(want):], want, atol=1e-3)
@@ -87,5 +87,5 @@ def test_bad_input_writes_nothing(tmp_path):
     run = cadcnc_cli("pencil", BLOCK, "--radius", "3", "--faces", "99", "-o", out)
     assert run.returncode == 2 and "99" in run.stderr
     run = cadcnc_cli("pencil", BLOCK, "--radius", "3", "--faces", "1", "2", "-o", out)
-    assert run.returncode == 2 and "no corner" in run.stderr
+    assert run.returncode == 3 and "no cut left" in run.stderr   # valid input, no program
     assert not out.exists()

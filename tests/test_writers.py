@@ -12,8 +12,9 @@ from cadcnc.interp.error_bounds import SurfaceBounds
 from cadcnc.errors import InputError, OutputError
 from cadcnc.io import (
     ARRAYS, CSV_COLUMNS, atomic_write, check_output, read_csv, read_json, toolpath_from_dict,
-    toolpath_to_dict, write_csv, write_json, write_toolpaths,
+    toolpath_to_dict, write_csv, write_json,
 )
+from cadcnc.io.program_gcode import write_ngc
 
 from conftest import fixture_path
 
@@ -108,7 +109,7 @@ def test_atomic_write_leaves_nothing_on_failure(tmp_path):
 def test_failed_gcode_write_leaves_no_file(saddle, tmp_path):
     out = tmp_path / "p.ngc"
     with pytest.raises(InputError, match="safe Z"):
-        write_toolpaths([saddle], out, safe_z=0.0)
+        write_ngc([saddle], out, safe_z=0.0)
     assert not list(tmp_path.iterdir())
 
 
@@ -120,8 +121,3 @@ def test_failed_gcode_write_leaves_no_file(saddle, tmp_path):
 def test_check_output(tmp_path, name, message):
     with pytest.raises(OutputError, match=message):
         check_output(tmp_path / name)
-
-
-def test_json_holds_one_path(saddle, tmp_path):
-    with pytest.raises(OutputError, match="one path"):
-        write_toolpaths([saddle, saddle], tmp_path / "two.json")

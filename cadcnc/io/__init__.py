@@ -1,8 +1,8 @@
-"""Outputs: atomic files, toolpath JSON and CSV, G-code, plots; written by suffix."""
+"""Outputs: atomic files and output sets; programs written by suffix (JSON version 2, CSV,
+G-code, pictures); the toolpath JSON and CSV readers of format version 1."""
 
 from .atomic import atomic_write, write_bytes, write_text
-from .gcode import to_ngc, write_ngc
-from .outputs import SUFFIXES, check_output, write_toolpaths
+from .outputs import PROGRAM_CSV_COLUMNS, SUFFIXES, check_output, program_csv, render
 from .plot import write_picture
 from .toolpath_csv import CSV_COLUMNS, read_csv, toolpath_csv, write_csv
 from .toolpath_json import (
@@ -10,8 +10,8 @@ from .toolpath_json import (
 )
 
 __all__ = [
-    "atomic_write", "write_bytes", "write_text", "to_ngc", "write_ngc", "SUFFIXES",
-    "check_output", "write_toolpaths", "write_picture", "CSV_COLUMNS", "read_csv",
+    "atomic_write", "write_bytes", "write_text", "SUFFIXES", "check_output", "render",
+    "program_csv", "PROGRAM_CSV_COLUMNS", "write_picture", "CSV_COLUMNS", "read_csv",
     "toolpath_csv", "write_csv", "ARRAYS", "FORMAT", "VERSION", "read_json",
     "toolpath_from_dict", "toolpath_to_dict", "write_json",
 ]

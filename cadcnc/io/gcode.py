@@ -1,6 +1,7 @@
-"""RS274/NGC (LinuxCNC dialect, plain enough for most 3-axis controls) from toolpaths.
+"""The conventions of cadcnc's G-code (LinuxCNC dialect, plain enough for most 3-axis
+controls), shared by its one writer (:mod:`cadcnc.io.program_gcode`) and its readers.
 
-Conventions (docs/cli.md "G-code"): mm (G21), absolute (G90), XY plane (G17), feed per
+Conventions (docs/program.md "G-code"): mm (G21), absolute (G90), XY plane (G17), feed per
 minute (G94), path blending ``G64 P<blend>`` (a tenth of the gouge limit, counted by the gate);
 the part's +Z is the spindle axis and the path is reached from above: rapid to a safe Z, rapid over the first point, rapid down to
 ``clearance`` above it, feed down onto it, one ``G1`` per kept point, rapid back up to the
@@ -24,11 +25,9 @@ import re
 import numpy as np
 
 from ..errors import InputError
-from ..job import SAFE_MARGIN, check_number
 from ..tolerances import DEFAULT as _DEFAULT_TOLERANCES
 
 DEFAULT_GOUGE = _DEFAULT_TOLERANCES.gouge  # mm: the default gouge limit
-from .atomic import write_text
 
 DEFAULT_TOLERANCE = 0.001  # mm
 BLEND_SHARE = 0.1
@@ -116,85 +115,12 @@ def programmed_points(path, tool_tip: bool = False) -> np.ndarray:
     return pts
 
 
-def to_ngc(paths, *, tolerance: float | None = None, tool_tip: bool = False,
-           safe_z: float | None = None, clearance: float = CLEARANCE,
-           spindle: float | None = None, blend: float | None = None, title: str = "") -> str:
-    """One RS274/NGC program machining ``paths`` (Toolpath objects) in order.
-
-    ``tolerance`` (mm): drop points (see module doc); None keeps every point. ``safe_z``
-    (mm, programmed coordinates): rapid height; default the highest programmed point plus
-    10 mm (give the part's top plus a margin when the part rises above the path).
-    ``spindle`` (rpm): emit ``S.. M3`` / ``M5``.
-    """
-    paths = list(paths)
-    if not paths:
-        raise InputError("no toolpath to write")
-    tol = DEFAULT_TOLERANCE if tolerance is None else float(tolerance)
-    digits = digits_for(tol)
-    check_number("G-code approach clearance", clearance, "mm", allow_zero=True)
-    if spindle is not None:
-        check_number("spindle speed", spindle, "rpm")
-    programmed = [programmed_points(p, tool_tip) for p in paths]
-    for k, (path, pts) in enumerate(zip(paths, programmed), 1):
-        if not np.all(np.isfinite(pts)):
-            raise InputError(f"path {k} has a non-finite point: nothing written")
-        if float(num(path.job.feed, 3)) <= 0:
-            raise InputError(f"path {k}: feed {path.job.feed:g} mm/min prints as F0: too "
-                             "slow for G-code")
-    top = max(float(p[:, 2].max()) for p in programmed)
-    if safe_z is None:
-        safe_z = top + SAFE_MARGIN
-    elif not math.isfinite(safe_z):
-        raise InputError(f"rapid height must be a finite Z in mm, got {safe_z}")
-    elif safe_z < top + clearance:
-        raise InputError(f"safe Z {safe_z:g} mm is below the path's highest point "
-                         f"{top:g} mm plus the clearance {clearance:g} mm")
-    n = lambda v: num(v, digits)  # noqa: E731
-    point_name = "tool tip (ball centre Z - R)" if tool_tip else "ball centre"
-    lines = [
-        "%",
-        comment(f"cadcnc {title}".strip()),
-        comment(f"programmed point: {point_name}; units mm; +Z is the spindle axis"),
-        comment(f"tolerance {tol:g} mm ({'points dropped' if tolerance else 'every point kept'}"
-                 f"); {digits} decimals"),
-        "G17 G21 G40 G90 G94",
-        blend_word(blend_for(DEFAULT_GOUGE) if blend is None else blend),
-        f"G0 Z{n(safe_z)}",
-    ]
-    if spindle:
-        lines.append(f"S{num(spindle, 0)} M3")
-    for k, (path, pts) in enumerate(zip(paths, programmed), 1):
-        keep = simplify(pts, tolerance) if tolerance else np.arange(len(pts))
-        r, c = path.job.tool.radius, path.job.tool.allowance
-        lines.append(comment(
-            f"path {k}: faces {path.faces[0]} {path.faces[1]}, ball R {r:g} mm, allowance "
-            f"{c:g} mm, {len(keep)} of {len(pts)} points, stop: {path.stop_reason}"))
-        first = pts[0]
-        lines += [
-            f"G0 X{n(first[0])} Y{n(first[1])}",
-            f"G0 Z{n(first[2] + clearance)}",
-            f"F{num(path.job.feed, 3)}",
-            f"G1 Z{n(first[2])}",
-        ]
-        lines += [f"G1 X{n(x)} Y{n(y)} Z{n(z)}" for x, y, z in pts[keep[1:]]]
-        lines.append(f"G0 Z{n(safe_z)}")
-    if spindle:
-        lines.append("M5")
-    lines += ["M2", "%"]
-    return "\n".join(lines) + "\n"
-
-
-def write_ngc(paths, out, **options) -> None:
-    """Write :func:`to_ngc` to ``out`` atomically."""
-    write_text(out, to_ngc(paths, **options))
-
-
 WORD = re.compile(r"([XYZ])(-?\d+(?:\.\d*)?)")
 
 
 def programmed_moves(text: str, tool_tip_offset: float = 0.0) -> np.ndarray:
     """(M, 3) ball-centre positions of every G0/G1 move of a program written by
-    :func:`to_ngc`, in order, as the machine will execute them (rounding included).
+    :func:`~cadcnc.io.program_gcode.program_ngc`, in order, as the machine will execute them (rounding included).
 
     ``tool_tip_offset`` (mm): R when the program gives the ball's tip, added back to Z.
     Moves before the first complete X, Y, Z position are skipped (the first rapid gives Z
@@ -210,11 +136,3 @@ def programmed_moves(text: str, tool_tip_offset: float = 0.0) -> np.ndarray:
         if not any(math.isnan(v) for v in pos):
             out.append((pos[0], pos[1], pos[2] + tool_tip_offset))
     return np.array(out, dtype=float).reshape(-1, 3)
-
-
-def written_moves(path, **options) -> np.ndarray:
-    """(M, 3) ball-centre positions the machine is commanded to visit for ``path`` alone,
-    written with :func:`to_ngc` ``options``: points dropped, rounded, the tool-tip offset
-    taken back, the approach and retract included. What the gouge gate must check."""
-    text = to_ngc([path], **options)
-    return programmed_moves(text, path.job.tool.radius if options.get("tool_tip") else 0.0)

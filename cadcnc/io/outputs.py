@@ -1,39 +1,62 @@
-"""Toolpaths rendered by the output file's suffix: .json, .csv or .ngc."""
+"""A program rendered by the output file's suffix: .json (version 2), .csv, .ngc, .png, .glb.
+
+Every operation's program is written here, by one suffix list (:data:`SUFFIXES`). CSV of a
+program: the toolpath CSV's columns (:data:`~cadcnc.io.toolpath_csv.CSV_COLUMNS`)
+after a first column ``segment``, the 1-based index of the cut in the program's
+``segments`` (links included in the count, so segment numbers match the JSON and the
+G-code comments). One row per cycle of every cut, in machining order; links have no row
+(they carry no contacts: their moves are in the JSON and the G-code).
+"""
 
 from __future__ import annotations
 
+import csv
+import io
 from pathlib import Path
 
 from ..errors import OutputError
-from ..program.toolpath import Toolpath
-from .gcode import to_ngc
-from .output_set import check_destination, write_one
-from .toolpath_csv import toolpath_csv
-from .toolpath_json import toolpath_json
+from ..program.program import Program
+from .program_gcode import program_ngc
+from .program_json import program_json
+from .program_plot import program_picture_bytes
+from .output_set import check_destination
+from .toolpath_csv import CSV_COLUMNS, toolpath_rows
 
-SUFFIXES = (".json", ".csv", ".ngc")
+SUFFIXES = (".json", ".csv", ".ngc", ".png", ".glb")
+"""The outputs every command writes, by suffix."""
+PROGRAM_CSV_COLUMNS = ["segment", *CSV_COLUMNS]
+
+
+def program_csv(program: Program) -> str:
+    """One row per cycle of every cut (see the module doc)."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(PROGRAM_CSV_COLUMNS)
+    for k, seg in enumerate(program.segments, 1):
+        if seg.kind != "cut":
+            continue
+        for row in toolpath_rows(seg.path):
+            w.writerow([str(k), str(int(row[0]))] + [repr(float(v)) for v in row[1:]])
+    return buf.getvalue()
+
+
+def render(program: Program, out, part=None, title: str = "", **gcode) -> str | bytes:
+    """The content of ``out`` by its suffix. ``gcode``: :func:`program_ngc` keywords
+    (tolerance, tool_tip, spindle, plunge_feed); ``part`` is needed for pictures."""
+    kind = Path(out).suffix.lower()
+    if kind == ".json":
+        return program_json(program)
+    if kind == ".csv":
+        return program_csv(program)
+    if kind == ".ngc":
+        return program_ngc(program, title=title, **gcode)
+    if kind in (".png", ".glb"):
+        return program_picture_bytes(program, part, out, title)
+    raise OutputError(f"{out}: unknown output format {kind!r}; use one of "
+                      f"{', '.join(SUFFIXES)}")
 
 
 def check_output(out, inputs=()) -> str:
     """The format of ``out`` from its suffix, or OutputError (checked before computing)."""
     check_destination(out, SUFFIXES, inputs)
     return Path(out).suffix.lower()[1:]
-
-
-def render(paths: list[Toolpath], out, **gcode_options) -> str:
-    """The text of ``out`` by its suffix: one G-code program for all paths; JSON and CSV
-    hold exactly one path."""
-    kind = Path(out).suffix.lower()[1:]
-    if kind == "ngc":
-        return to_ngc(paths, **gcode_options)
-    if kind not in ("json", "csv"):
-        raise OutputError(f"{out}: unknown output format {kind!r}; use one of "
-                          f"{', '.join(SUFFIXES)}")
-    if len(paths) != 1:
-        raise OutputError(f"{out}: {kind.upper()} holds one path, got {len(paths)}")
-    return (toolpath_json if kind == "json" else toolpath_csv)(paths[0])
-
-
-def write_toolpaths(paths: list[Toolpath], out, **gcode_options) -> None:
-    """Write one file by suffix, atomically (see :func:`render`)."""
-    write_one(out, render(paths, out, **gcode_options), SUFFIXES)

@@ -19,10 +19,13 @@ import numpy as np
 
 from ..errors import InputError
 from ..job import check_number
-from ..program.program import Program
+from ..job import SAFE_MARGIN
+from ..program.linking import linked
+from ..program.program import CutSegment, Program
+from .atomic import write_text
 from .gcode import (
     WORD, DEFAULT_GOUGE, DEFAULT_TOLERANCE, comment, num, blend_for, blend_word, digits_for,
-    simplify,
+    programmed_moves, programmed_points, simplify,
 )
 
 
@@ -30,12 +33,14 @@ def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: b
                 spindle: float | None = None, plunge_feed: float | None = None,
                 blend: float | None = None, title: str = "") -> str:
     """One RS274/NGC program for ``program`` (see the module doc); InputError on a point
-    or word that cannot be written."""
+    or word that cannot be written. ``spindle`` and ``plunge_feed`` default to the job's."""
     if not program.segments:
         raise InputError("the program has no segment: nothing to write")
     tol = DEFAULT_TOLERANCE if tolerance is None else float(tolerance)
     digits = digits_for(tol)
     feed = program.job.feed
+    plunge_feed = program.job.plunge_feed if plunge_feed is None else plunge_feed
+    spindle = program.job.spindle if spindle is None else spindle
     plunge = feed if plunge_feed is None else check_number("plunge feed", plunge_feed,
                                                             "mm/min")
     if spindle is not None:
@@ -74,9 +79,10 @@ def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: b
             lines.append(comment(
                 f"segment {k}: cut, faces {path.faces[0]} {path.faces[1]}, {len(keep)} of "
                 f"{len(seg.points)} points, stop: {path.stop_reason}"))
-            if current != feed:
-                lines.append(f"F{num(feed, 3)}")
-                current = feed
+            cut_feed = path.job.feed   # each cut at its own job's feed (APT programs)
+            if current != cut_feed:
+                lines.append(f"F{num(cut_feed, 3)}")
+                current = cut_feed
             lines += [f"G1 {xyz(p)}" for p in seg.points[keep[1:]]]
             continue
         lines.append(comment(f"segment {k}: link"))
@@ -123,3 +129,34 @@ def program_written_moves(program: Program, **options) -> list[np.ndarray]:
     commands (see :func:`segment_moves`): what the whole-program gouge gate checks."""
     text = program_ngc(program, **options)
     return segment_moves(text, program.job.tool.radius if options.get("tool_tip") else 0.0)
+
+
+def to_ngc(paths, *, safe_z: float | None = None, **options) -> str:
+    """The G-code of toolpaths machined in order: :func:`program_ngc` of their program,
+    each reached from and left to ``safe_z`` (mm, programmed coordinates; default the
+    highest programmed point plus SAFE_MARGIN). ``options``: :func:`program_ngc`'s."""
+    paths = list(paths)
+    if not paths:
+        raise InputError("no toolpath to write")
+    top = max(float(programmed_points(p, options.get("tool_tip", False))[:, 2].max())
+              for p in paths)
+    if safe_z is None:
+        safe_z = top + SAFE_MARGIN
+    elif not math.isfinite(safe_z) or safe_z < top:
+        raise InputError(f"safe Z {safe_z:g} mm is below the path's highest point {top:g} mm")
+    dz = paths[0].job.tool.radius if options.get("tool_tip") else 0.0
+    program = Program(paths[0].job, linked([CutSegment(p) for p in paths], safe_z + dz))
+    return program_ngc(program, **options)
+
+
+def write_ngc(paths, out, **options) -> None:
+    """Write :func:`to_ngc` to ``out`` atomically."""
+    write_text(out, to_ngc(paths, **options))
+
+
+def written_moves(path, **options) -> np.ndarray:
+    """(M, 3) ball-centre positions the machine is commanded to visit for ``path`` alone,
+    written with :func:`to_ngc` ``options`` (dropped, rounded, tool tip taken back, the
+    approach and retract included): what the gouge gate must check."""
+    text = to_ngc([path], **options)
+    return programmed_moves(text, path.job.tool.radius if options.get("tool_tip") else 0.0)

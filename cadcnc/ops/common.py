@@ -1,9 +1,12 @@
-"""What the operations share: the height of link moves and running one stretch's cut."""
+"""What the operations share: the height of link moves, running one stretch's cut, and the
+program of a single path."""
 
 from __future__ import annotations
 
 from ..errors import GeometryError
 from ..job import SAFE_MARGIN, Job
+from ..program.linking import linked
+from ..program.program import CutSegment, Program
 from ..program.toolpath import Toolpath, toolpath_from_record
 from .path.pair_path import PathPlan, stepper_for
 
@@ -25,3 +28,9 @@ def run_stretch(plan: PathPlan, guard, max_cycles: int, progress,
                             f"({stepper.stop_reason}): {stepper.stop_detail}")
     return toolpath_from_record(stepper.record, plan.job, stepper.stop_reason,
                                 stepper.stop_detail, plan.edge_length)
+
+
+def single_cut_program(part, job: Job, path: Toolpath) -> Program:
+    """The program of one path: its cut, reached from and left to the safe height. It is
+    complete when the path is (a path stopped by a boundary is partial here, as asked)."""
+    return Program(job, linked([CutSegment(path)], safe_height(part, job)))

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..job import Job
+from .summary import program_summary
 from .toolpath import Toolpath
 
 
@@ -180,6 +181,10 @@ class Program:
         return {"cut_length_mm": self.cut_length, "link_length_mm": self.link_length,
                 "time_at_feed_s": self.time_at_feed, "cuts": len(self.cuts),
                 "links": len(self.links), "skipped": len(self.skipped)}
+
+    def summary(self, part_name: str = "") -> str:
+        """The text summary (:func:`~cadcnc.program.summary.program_summary`)."""
+        return program_summary(self, part_name)
 
     def __repr__(self) -> str:
         return (f"<Program {len(self.cuts)} cuts, {len(self.links)} links, "

@@ -33,7 +33,8 @@ from OCP.TopoDS import TopoDS_Compound
 
 import cadcnc
 from cadcnc.errors import CadcncError
-from cadcnc.io.gcode import programmed_moves, to_ngc
+from cadcnc.io.gcode import programmed_moves
+from cadcnc.io.program_gcode import to_ngc
 from cadcnc.verification import gouge_gate
 
 from conftest import FIXTURES, load_fixture

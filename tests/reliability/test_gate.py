@@ -26,7 +26,8 @@ import pytest
 
 import cadcnc
 from cadcnc.errors import InputError
-from cadcnc.io.gcode import programmed_moves, to_ngc
+from cadcnc.io.gcode import programmed_moves
+from cadcnc.io.program_gcode import to_ngc
 from cadcnc.tolerances import DEFAULT, Tolerances
 from cadcnc.verification import gouge_gate, verify
 from cadcnc.verification import whole_part

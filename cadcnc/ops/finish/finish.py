@@ -55,13 +55,23 @@ def finish(part, faces, *, radius: float, allowance: float = 0.0,
     runs R' = R + C from the faces. Exactly one of ``stepover`` (plane spacing, mm) and
     ``scallop`` (largest scallop height, mm). ``angle``: the passes' direction to +X (deg);
     ``pattern``: "zigzag" or "oneway". ``clearance``: ball-centre Z of the retracts
-    (default the part's top + 10 mm). ``progress(done, total, what)`` after each plane.
+    (default the part's top + 10 mm). ``progress(done, total, what)`` after each plane. A
+    keyword convenience that builds the :class:`~cadcnc.job.Job` of :func:`finish_program`.
     """
     if not isinstance(part, Part):
         part = Part.from_cadquery(part, tol)
     op = Finish(face_numbers(part, faces), stepover, scallop, angle, pattern)
     job = Job(Tool(radius, allowance, shank_length), feed, period, op, source=part.source,
               clearance=clearance, tolerances=tol)
+    return finish_program(part, job, progress=progress)
+
+
+def finish_program(part: Part, job: Job, *, progress=None) -> Program:
+    """The finishing program of a :class:`~cadcnc.job.Finish` ``job`` on ``part``:
+    ``progress(done, total, what)`` after each plane."""
+    op, tol, pattern = job.operation, job.tolerances, job.operation.pattern
+    for n in op.faces:
+        part.face(n)  # FaceNumberError names the range
     plan, samples = plan_for_job(part, job)
     cuts: list[CutSegment] = []
     skipped: list[Skipped] = []

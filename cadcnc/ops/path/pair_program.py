@@ -18,7 +18,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...errors import GeometryError, InputError, StartPointError
+from ...errors import InputError, StartPointError
 from ...interp.cycle import BOUNDARY, COLLISION
 from ...interp.stepper import Tangency
 from ...job import Job

@@ -24,16 +24,16 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...errors import CadcncError, InputError
+from ...errors import CadcncError
 from ...geometry.part import Part
-from ...job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Tool
+from ...job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
 from ...program.linking import linked, order_cuts
 from ...program.program import CutSegment, Program, Skipped
 from ...tolerances import DEFAULT, Tolerances
 from .corners import BLEND, EDGE, find_corners
 from ...guard import guard_for
 from ..common import run_stretch, safe_height
-from ..path.pair_program import CLIMB, CONVENTIONAL, stretch_cuts
+from ..path.pair_program import CLIMB, stretch_cuts
 from ..path.pair_path import plan_path
 from ..path.stretches import Feasibility, edge_stretches, pair_stretches
 
@@ -47,25 +47,38 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
            tol: Tolerances = DEFAULT, progress=None, times: dict | None = None) -> Program:
     """The pencil program of ``part`` (a :class:`~cadcnc.geometry.part.Part`, or a CadQuery
     Workplane or Shape, read with :meth:`Part.from_cadquery`) for a ball of radius
-    ``radius`` (mm) with ``allowance`` (mm): see the module doc.
+    ``radius`` (mm) with ``allowance`` (mm): see the module doc. A keyword convenience
+    that builds the :class:`~cadcnc.job.Job` of :func:`pencil_program`.
 
     ``faces``: face numbers to restrict the corners to (both faces of a corner must be
     among them); ``clearance``: ball-centre Z of the links (default the part's top + 10
     mm); ``side``: "climb" (default: the material on the right of the travel, for a
-    clockwise spindle) or "conventional"; ``progress(done, total, what)`` after each corner.
-    ``times``: a dict to which the seconds spent per stage are added (``edges``: the
-    part's edge classification; ``corners``; ``guards``: building the third-face guards;
-    ``stretches``: the stretch search; ``interpolation``: the stepper along every
-    stretch; ``linking``: reachability from +Z, ordering and links).
+    clockwise spindle) or "conventional"; ``progress``, ``times``: see
+    :func:`pencil_program`.
     """
-    clock = _Clock(times)
-    if side not in (CLIMB, CONVENTIONAL):
-        raise InputError(f"side must be {CLIMB!r} or {CONVENTIONAL!r}, got {side!r}")
     if not isinstance(part, Part):
         part = Part.from_cadquery(part, tol)
-    tool = Tool(radius, allowance, shank_length)
-    job = Job(tool, feed, period, PairPath(edge=None), source=part.source,
-              clearance=clearance, tolerances=tol)
+    job = Job(Tool(radius, allowance, shank_length), feed, period,
+              Pencil(None if faces is None else tuple(sorted(faces)), side),
+              source=part.source, clearance=clearance, tolerances=tol)
+    return pencil_program(part, job, progress=progress, times=times)
+
+
+def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = None
+                   ) -> Program:
+    """The pencil program of a :class:`~cadcnc.job.Pencil` ``job`` on ``part``.
+
+    ``progress(done, total, what)`` after each corner. ``times``: a dict to which the
+    seconds spent per stage are added (``edges``: the part's edge classification;
+    ``corners``; ``guards``: building the third-face guards; ``stretches``: the stretch
+    search; ``interpolation``: the stepper along every stretch; ``linking``: reachability
+    from +Z, ordering and links).
+    """
+    clock = _Clock(times)
+    op, tool = job.operation, job.tool
+    side = op.side
+    faces = None if op.faces is None else set(op.faces)
+    radius, allowance = tool.radius, tool.allowance
     with clock("edges"):
         part.adjacency
     with clock("corners"):

@@ -1,0 +1,42 @@
+"""One entry for every operation: :func:`run` a :class:`~cadcnc.job.Job` on a part."""
+
+from __future__ import annotations
+
+from ..errors import InputError
+from ..geometry.part import Part
+from ..job import Finish, Job, PairPath, Pencil
+from ..program.program import Program
+from .finish.finish import JOIN, finish_program
+from .path.pair_program import program_for_job
+from .pencil.pencil import CHAIN_GAP, pencil_program
+
+
+def run(part, job: Job, *, progress=None, times: dict | None = None) -> Program:
+    """The :class:`~cadcnc.program.program.Program` of ``job`` on ``part`` (a
+    :class:`~cadcnc.geometry.part.Part`, or a CadQuery Workplane or Shape): the pair's
+    corner for :class:`~cadcnc.job.PairPath` (every feasible stretch, cut and linked),
+    every inner corner for :class:`~cadcnc.job.Pencil`, the raster passes for
+    :class:`~cadcnc.job.Finish`. ``progress``: the operation's progress callback
+    (:func:`program_for_job`: ``(cycles, mm)``; pencil and finish: ``(done, total,
+    what)``); ``times``: pencil's seconds per stage
+    (:func:`pencil_program`). The program is not gated: see :func:`cadcnc.verification.gate_program`."""
+    if not isinstance(job, Job):
+        raise InputError(f"job must be a cadcnc.Job, got {type(job).__name__}")
+    if not isinstance(part, Part):
+        part = Part.from_cadquery(part, job.tolerances)
+    op = job.operation
+    if isinstance(op, PairPath):
+        return program_for_job(part, job, progress=progress)
+    if isinstance(op, Pencil):
+        return pencil_program(part, job, progress=progress, times=times)
+    if isinstance(op, Finish):
+        return finish_program(part, job, progress=progress)
+    raise InputError(f"unknown operation {type(op).__name__}")
+
+
+def cut_back_gap(job: Job) -> float | None:
+    """The chain gap (mm) with which a program of ``job`` is relinked once its gouging cuts
+    are cut back to their last verified point (pencil, finish), or None: a path follows
+    the pair the user named and is judged whole."""
+    op = job.operation
+    return CHAIN_GAP if isinstance(op, Pencil) else JOIN if isinstance(op, Finish) else None

@@ -1,0 +1,89 @@
+"""The policy that decides what a command writes and which exit code it returns, for every
+operation: cut gouging cuts back (pencil, finish), gate the whole program as written, and
+judge partial and gouging programs (refused unless the user allows them).
+
+Exit codes (docs/reliability.md) are those of :mod:`cadcnc.errors`: 0 only for a complete
+program whose every cut and every written move passed the gouge gate; 5 a gouge; 6 partial.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from ..errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL, NothingToCutError
+from ..io.program_gcode import program_written_moves
+from ..program.program import STOPPED_SHORT, Program
+from ..program.summary import skipped_counts
+from .cut_back import cut_back
+from .program_gate import ProgramGate, gate_program
+
+
+@dataclass
+class Verdict:
+    """``write``: whether the outputs may be written; ``code``: the exit code; ``messages``:
+    sentences for the user (stderr); ``gate``: the whole-program gate (None when not run)."""
+
+    write: bool
+    code: int
+    messages: list[str] = field(default_factory=list)
+    gate: ProgramGate | None = None
+
+
+def settle(program: Program, part, z_safe: float, join: float, what: str,
+           allow_gouge: bool = False) -> Program:
+    """The program with each gouging cut cut back to its last verified point and the rest
+    listed as skipped (unless ``allow_gouge``); NothingToCutError when no cut is left."""
+    if not allow_gouge:
+        program = cut_back(program, part, z_safe, join)
+    if not program.cuts:
+        raise NothingToCutError(f"{what}: no cut left: "
+                                f"{skipped_counts(program) or 'nothing to cut'}")
+    return program
+
+
+def judge(program: Program, part, what: str, *, gcode: dict | None = None,
+          allow_partial: bool = False, allow_gouge: bool = False, progress=None) -> Verdict:
+    """The :class:`Verdict` on ``program``. With G-code options ``gcode`` (keywords of
+    :func:`~cadcnc.io.program_gcode.program_ngc`) the gate checks the moves as written
+    (points dropped, rounded, tool-tip offset taken back, links); else the program's own
+    points. A partial program exits 6 and is written only with ``allow_partial``; a
+    gouging one exits 5 and is written only with ``allow_gouge``."""
+    verdict = Verdict(True, EXIT_OK)
+    if not program.complete:
+        verdict.write, verdict.code = allow_partial, EXIT_PARTIAL
+        why = "; ".join(program.partial_reasons + [
+            s.detail for s in program.skipped if s.reason == STOPPED_SHORT
+        ]) or "a cut stopped short of its end"
+        verdict.messages.append(f"{what}: partial: {why}" + (
+            "" if allow_partial else "; nothing written (--allow-partial writes it)"))
+    if not verdict.write:
+        return verdict
+    moves = None if gcode is None else program_written_moves(program, **gcode)
+    gate = gate_program(program, part, program.job.tolerances, moves=moves,
+                        blend_mm=0.0 if gcode is None else gcode["blend"], progress=progress)
+    verdict.gate = gate
+    if gate.ok:
+        return verdict
+    verdict.write, verdict.code = allow_gouge, EXIT_GOUGE
+    why = gate.message.replace("refused: ", "")
+    if allow_gouge:
+        verdict.messages.append(f"{what}: {why}; written anyway (--allow-gouge)")
+    else:
+        verdict.messages.append(f"{what}: refused: {why}; nothing written. "
+                                f"{_hint(program, gate, gcode)}--allow-gouge writes it")
+    return verdict
+
+
+def _hint(program: Program, gate: ProgramGate, gcode: dict | None) -> str:
+    """What may help, only where it can: fewer dropped points when only moves between
+    written points cut; a smaller ball for a shallow side cut (not in the material)."""
+    bad = [(seg, r) for seg, r in zip(program.cuts, gate.results) if not r.ok]
+    if any(gate.link_failed):
+        return ""
+    if gcode and gcode.get("tolerance") and not any(
+            h.depth_mm > r.limit_mm for _, r in bad for h in r.hits):
+        return "A smaller --tolerance (fewer points dropped) may pass; "
+    shallow = all(math.isfinite(r.depth_mm) and r.depth_mm < program.job.tool.offset
+                  and not r.in_material and r.hits for _, r in bad)
+    return "A smaller --radius may fit; " if bad and shallow else ""
