@@ -60,7 +60,10 @@ def read_stream(stream: Any) -> np.ndarray:
     """An (N, 3) float64 array from an array, a ``.npy`` or a ``.txt`` stream."""
     if isinstance(stream, (str, Path)):
         p = Path(stream)
-        arr = np.load(p) if p.suffix == ".npy" else np.loadtxt(p, ndmin=2)
+        try:
+            arr = np.load(p) if p.suffix == ".npy" else np.loadtxt(p, ndmin=2)
+        except (OSError, ValueError) as e:
+            raise HalError(f"cannot read the stream {p}: {e}") from None
     else:
         arr = np.asarray(stream, dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] != 3 or len(arr) < 2 or not np.isfinite(arr).all():

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import fcntl
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -68,6 +69,16 @@ def _tail(path: Path, lines: int = 12) -> str:
         return ""
     kept = [t for t in text if "fallback_uid" not in t and t.strip()]
     return "\n".join(kept[-lines:])
+
+
+def _file_error(log: Path, name: str) -> str | None:
+    """The first ``NAME:LINE: message`` halcmd printed for the .hal file, if any."""
+    try:
+        text = log.read_text(errors="replace")
+    except OSError:
+        return None
+    found = re.search(rf"^\S*{re.escape(name)}:\d+: .*$", text, re.MULTILINE)
+    return found.group(0) if found else None
 
 
 class HalSession:
@@ -157,6 +168,9 @@ class HalSession:
             if self._halrun.poll() is not None:
                 raise HalError(f"HAL did not start (halrun exit {self._halrun.returncode}):\n"
                                + _tail(self.log))
+            failed = _file_error(self.log, hal_file.name)
+            if failed:  # halrun -I stays at its prompt after an error in the file
+                raise HalError(f"HAL did not start: {failed}\n" + _tail(self.log))
             try:
                 if self.get(ready_signal, "s").upper() == "TRUE":
                     return
