@@ -82,7 +82,8 @@ def _file_error(log: Path, name: str) -> str | None:
 
 
 class HalSession:
-    """A HAL started from a .hal file; use as a context manager (teardown always runs)."""
+    """A HAL started from a .hal file (or by ``linuxcnc``); a context manager whose
+    teardown always runs."""
 
     def __init__(self, hal_text: str, workdir: Path, *, lock_timeout: float = 120.0,
                  start_timeout: float = 30.0):
@@ -149,8 +150,12 @@ class HalSession:
         return proc
 
     # -- life cycle ----------------------------------------------------------------
-    def start(self, ready_signal: str = "cadcnc-ready") -> None:
-        """Lock, check no HAL runs, start ``halrun -I -f``, wait for ``ready_signal``."""
+    def start(self, ready_signal: str = "cadcnc-ready", argv: list[str] | None = None) -> None:
+        """Lock, check no HAL runs, start HAL, wait for ``ready_signal`` to be TRUE.
+
+        HAL starts as ``halrun -I -f`` on :attr:`hal_text`, or as ``argv`` (``linuxcnc
+        FILE.ini``, whose own .hal files set ``ready_signal``).
+        """
         self._prepare()
         self._lock()
         others = rtapi_pids()
@@ -158,15 +163,16 @@ class HalSession:
             raise HalError(f"a HAL is already running (rtapi_app pid {others}); cadcnc does "
                            "not share it: stop it first (halrun -U)")
         hal_file = self.workdir / "cadcnc.hal"
-        hal_file.write_text(self.hal_text)
+        if argv is None:
+            hal_file.write_text(self.hal_text)
+            argv = ["halrun", "-I", "-f", str(hal_file)]
         with open(self.log, "wb") as log:
-            self._halrun = self.spawn(["halrun", "-I", "-f", str(hal_file)],
-                                      stdin=subprocess.PIPE, stdout=log, stderr=log,
+            self._halrun = self.spawn(argv, stdin=subprocess.PIPE, stdout=log, stderr=log,
                                       cwd=self.workdir)
         deadline = time.monotonic() + self.start_timeout
         while True:
             if self._halrun.poll() is not None:
-                raise HalError(f"HAL did not start (halrun exit {self._halrun.returncode}):\n"
+                raise HalError(f"HAL did not start ({argv[0]} exit {self._halrun.returncode}):\n"
                                + _tail(self.log))
             failed = _file_error(self.log, hal_file.name)
             if failed:  # halrun -I stays at its prompt after an error in the file
