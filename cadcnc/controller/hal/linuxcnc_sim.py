@@ -34,7 +34,7 @@ class BaselineRun:
     """Positions LinuxCNC commanded, one row per servo period from the start of ``run``."""
 
     period: float  # s
-    positions: np.ndarray  # (M, 3) mm, joint position commands (X Y Z)
+    positions: np.ndarray  # (M, 3) mm, joint position commands (X Y Z), 1e-9 mm steps
     line: np.ndarray  # (M,) motion.program-line per period
     wall_time: float  # s, from ``set run`` to the program's end
     error: str  # linuxcncrsh's ``get error`` after the run ("OK" when none)
@@ -198,7 +198,7 @@ def run_ngc(ngc: Path, machine: Any, *, workdir: Path | None = None,
             problems = session.stop()
         if problems:
             raise HalError("LinuxCNC stopped uncleanly: " + "; ".join(problems))
-    return BaselineRun(period=machine.period, positions=data[:, :3],
+    return BaselineRun(period=machine.period, positions=data[:, :3] / 1e3,
                        line=data[:, 3].astype(np.int64), wall_time=wall, error=error)
 
 

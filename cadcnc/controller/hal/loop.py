@@ -22,7 +22,7 @@ import numpy as np
 
 from .session import HalError, HalInterrupted, HalSession
 
-SAMPLE_RES = 1e-6  # halsampler prints 6 decimals (mm)
+SAMPLE_RES = 1e-9  # mm: halsampler prints 6 decimals of the µm the sampler holds
 WIDE = 1e20  # limit3's own "no limit"
 MAX_DEPTH = 2_000_000  # FIFO rows held in shared memory (~48 MB for the streamer)
 
@@ -185,7 +185,7 @@ def _result(rows: np.ndarray, s: np.ndarray, period: float, wall: float) -> HalL
     n = len(rows)
     tags = s[:, 0].astype(np.int64)
     overruns = int(np.sum(np.diff(tags) - 1)) if len(tags) > 1 else 0
-    cmd, exe, under = s[:, 1:4], s[:, 4:7], s[:, 7].astype(np.int64)
+    cmd, exe, under = s[:, 1:4] / 1e3, s[:, 4:7] / 1e3, s[:, 7].astype(np.int64)
     m = min(n, len(s))
     off = np.abs(exe - cmd).max(axis=1) > SAMPLE_RES * 0.5
     return HalLoopResult(
