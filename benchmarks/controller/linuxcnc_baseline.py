@@ -13,7 +13,7 @@ samples the joint commands every period and measures:
 
 The column "constant feed, limit3" streams the exact curve at the programmed feed from the
 first period (no planning) through HAL with ``limit3`` at the machine's limits, and is
-measured the same way. Writes ``results.json`` and each run's sampled positions (.npy) to
+measured the same way. Writes ``results_<polyline>.json`` and each run's sampled positions (.npy) to
 ``--out``.
 
     .venv/bin/python benchmarks/controller/linuxcnc_baseline.py [--out DIR] [--quick]
@@ -92,10 +92,14 @@ class Exact:
         return best
 
 
-def polyline(exact: Exact, tol: float = 1e-3) -> np.ndarray:
-    """Points on the exact curve every 0.01 mm, simplified to ``tol`` (cadcnc's simplify)."""
+def polyline(exact: Exact, mode: str, feed: float, period: float) -> np.ndarray:
+    """The G1 points: ``dp``, points every 0.01 mm simplified to 1 µm (cadcnc's simplify);
+    ``step``, one point per period at the feed (cadcnc's G-code with no tolerance)."""
+    if mode == "step":
+        return exact.at_length(np.append(np.arange(0, exact.length, feed / 60 * period),
+                                         exact.length))
     pts = exact.at_length(np.linspace(0, exact.length, int(exact.length / 0.01) + 1))
-    return pts[simplify(pts, tol)]
+    return pts[simplify(pts, 1e-3)]
 
 
 def write_ngc(points: np.ndarray, feed: float, p: float, path: Path) -> int:
@@ -138,30 +142,33 @@ def constant_feed(exact: Exact, feed: float, m) -> np.ndarray:
     return exact.at_length(s)
 
 
-def run_case(name: str, feed: float, ps: list[float], m, out: Path) -> list[dict]:
+def run_case(name: str, feed: float, ps: list[float], m, out: Path,
+             mode: str = "dp", constant: bool = True) -> list[dict]:
     """Every P for one curve and feed, then the constant-feed stream; a row each."""
     exact = Exact(CURVES[name])
-    pts = polyline(exact)
+    pts = polyline(exact, mode, feed, m.period)
     rows = []
     for p in ps:
-        ngc = out / f"{name}_F{feed:g}_P{p:g}.ngc"
+        ngc = out / f"{name}_F{feed:g}_P{p:g}_{mode}.ngc"
         first_g1 = write_ngc(pts, feed, p, ngc)
         t0 = time.monotonic()
         r = run_ngc(ngc, m)
         start = int(np.argmax(r.line >= first_g1))
         np.save(ngc.with_suffix(".npy"), r.positions)
         row = {"curve": name, "feed": feed, "method": f"LinuxCNC G64 P{p:g}",
-               "segments": len(pts) - 1, "error": r.error,
+               "polyline": mode, "segments": len(pts) - 1, "error": r.error,
                "wall_s": round(time.monotonic() - t0, 2),
                **measure(r.positions, start, exact, m, pts[-1])}
         rows.append(row)
         print(_line(row), flush=True)
+    if not constant:
+        return rows
     stream = constant_feed(exact, feed, m)
     t0 = time.monotonic()
     h = run_hal_loop(stream, m, limits="machine", tail=int(3 / m.period))
     np.save(out / f"{name}_F{feed:g}_constant_limit3.npy", h.executed)
     row = {"curve": name, "feed": feed, "method": "constant feed, limit3",
-           "segments": len(stream) - 1, "error": f"clipped {h.clipped}, underruns "
+           "polyline": "stream", "segments": len(stream) - 1, "error": f"clipped {h.clipped}, underruns "
            f"{h.underruns}", "wall_s": round(time.monotonic() - t0, 2),
            **measure(h.executed, 0, exact, m, stream[-1])}
     rows.append(row)
@@ -171,7 +178,7 @@ def run_case(name: str, feed: float, ps: list[float], m, out: Path) -> list[dict
 
 def _line(r: dict) -> str:
     return (f"{r['curve']:9s} F{r['feed']:<6g} {r['method']:22s} T {r['cycle_time_s']:7.3f} s "
-            f"err max {r['contour_max_mm']:.2e} p99 {r['contour_p99_mm']:.2e} mm  "
+            f"[{r['polyline']:6s} {r['segments']:5d}] err max {r['contour_max_mm']:.2e} p99 {r['contour_p99_mm']:.2e} mm  "
             f"over v/a/j {r['v_over']}/{r['a_over']}/{r['j_over']} "
             f"(peak {r['v_peak_share']:.2f}/{r['a_peak_share']:.2f}/{r['j_peak_share']:.1f})"
             f"  [{r['error']}]")
@@ -192,6 +199,9 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=Path("/tmp/cadcnc-linuxcnc-baseline"))
     ap.add_argument("--quick", action="store_true", help="circle only, P 0.001 only")
     ap.add_argument("--feeds", type=float, nargs="+", default=[1500.0, 10000.0])
+    ap.add_argument("--polyline", choices=["dp", "step"], default="dp",
+                    help="G1 points: simplified to 1 µm (dp) or one per period (step)")
+    ap.add_argument("--no-constant", action="store_true", help="skip the limit3 column")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     m = machine_under_test(args)
@@ -201,11 +211,11 @@ def main() -> None:
     rows = []
     for name in (["circle"] if args.quick else list(CURVES)):
         for feed in args.feeds:
-            rows += run_case(name, feed, ps, m, args.out)
-    (args.out / "results.json").write_text(json.dumps(
+            rows += run_case(name, feed, ps, m, args.out, args.polyline, not args.no_constant)
+    (args.out / f"results_{args.polyline}.json").write_text(json.dumps(
         {"machine": {k: getattr(m, k) for k in ("period", "max_velocity", "max_acceleration",
                                                  "max_jerk")}, "rows": rows}, indent=1))
-    print(f"wrote {args.out / 'results.json'}")
+    print(f"wrote {args.out / f'results_{args.polyline}.json'}")
 
 
 if __name__ == "__main__":
