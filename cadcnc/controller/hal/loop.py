@@ -1,0 +1,209 @@
+"""HAL in the loop: a per-period X Y Z stream executed by HAL's ``streamer`` and ``limit3``.
+
+``run_hal_loop(stream, machine)`` writes ``stream_loop.hal`` for the machine's period and
+limits, starts HAL (:class:`~.session.HalSession`), fills the streamer FIFO with
+``halstreamer`` before anything moves, starts streamer and sampler in the same period, reads
+the executed positions back with ``halsampler`` and unloads HAL, also on failure and on
+Ctrl-C. Units: mm, s. The library imports no HAL: everything runs in subprocesses.
+"""
+
+from __future__ import annotations
+
+import string
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .session import HalError, HalInterrupted, HalSession
+
+SAMPLE_RES = 1e-9  # mm: halsampler prints 6 decimals of the µm the sampler holds
+WIDE = 1e20  # limit3's own "no limit"
+MAX_DEPTH = 2_000_000  # FIFO rows held in shared memory (~48 MB for the streamer)
+
+
+@dataclass(frozen=True)
+class HalLoopResult:
+    """What HAL executed. Arrays are (M, 3) mm, one row per servo period from the start."""
+
+    period: float  # s
+    streamed: int  # periods in the program
+    read: int  # samples read back (program plus tail)
+    underruns: int  # streamer underruns between the first and last sample of the program
+    overruns: int  # samples lost by the sampler (gaps in the sample numbers)
+    commanded: np.ndarray  # streamer output, as sampled
+    executed: np.ndarray  # limit3 output, as sampled
+    clipped: int  # program samples where limit3 did not pass its input through (> SAMPLE_RES)
+    clipped_tail: int  # the same after the program's last period (limit3 settling)
+    command_error: float  # max |commanded - stream| over the program, mm
+    tracking_error: float  # max |executed - stream| over the program, mm
+    wall_time: float  # s, from the start gate to the last sample read
+
+    @property
+    def cycle_time(self) -> float:
+        """The program's duration at the servo period, s."""
+        return self.streamed * self.period
+
+
+def write_stream_txt(stream: np.ndarray, path: Path) -> Path:
+    """The ``.txt`` halstreamer reads for ``cfg=fff``: ``X Y Z`` per line, 9 decimals (mm)."""
+    np.savetxt(path, np.asarray(stream, dtype=np.float64), fmt="%.9f", delimiter=" ")
+    return Path(path)
+
+
+def read_stream(stream: Any) -> np.ndarray:
+    """An (N, 3) float64 array from an array, a ``.npy`` or a ``.txt`` stream."""
+    if isinstance(stream, (str, Path)):
+        p = Path(stream)
+        try:
+            arr = np.load(p) if p.suffix == ".npy" else np.loadtxt(p, ndmin=2)
+        except (OSError, ValueError) as e:
+            raise HalError(f"cannot read the stream {p}: {e}") from None
+    else:
+        arr = np.asarray(stream, dtype=np.float64)
+    if arr.ndim != 2 or arr.shape[1] != 3 or len(arr) < 2 or not np.isfinite(arr).all():
+        raise HalError(f"a stream is an (N >= 2, 3) finite array of X Y Z mm; got {arr.shape}")
+    return arr.astype(np.float64)
+
+
+def hal_text(machine: Any, n_rows: int, *, limits: str = "machine", tail: int = 0) -> str:
+    """The .hal file for ``machine`` (period s, max_velocity mm/s, max_acceleration mm/s²).
+
+    ``limits='machine'`` sets each ``limit3`` to the axis's velocity and acceleration;
+    ``'wide'`` leaves limit3's own 1e20 (it then passes every input through).
+    """
+    if limits not in ("machine", "wide"):
+        raise HalError(f"limits is 'machine' or 'wide', not {limits!r}")
+    period_ns = int(round(machine.period * 1e9))
+    if period_ns < 50_000:
+        raise HalError(f"servo period {machine.period} s is under 50 µs: not run here")
+    v = machine.max_velocity if limits == "machine" else (WIDE,) * 3
+    a = machine.max_acceleration if limits == "machine" else (WIDE,) * 3
+    template = resources.files(__package__).joinpath("stream_loop.hal").read_text()
+    return string.Template(template).substitute(
+        period_ns=period_ns, stream_depth=min(n_rows + 16, MAX_DEPTH),
+        sample_depth=min(n_rows + tail + 16, MAX_DEPTH),
+        load_width_ns=3 * period_ns // 2,  # 2 or 3 periods (edge versions differ): >= 2
+        **{f"maxv_{ax}": repr(float(x)) for ax, x in zip("xyz", v)},
+        **{f"maxa_{ax}": repr(float(x)) for ax, x in zip("xyz", a)})
+
+
+def run_hal_loop(stream: Any, machine: Any, *, limits: str = "machine",
+                 tail: int | None = None, workdir: Path | None = None,
+                 timeout: float | None = None, on_started=None) -> HalLoopResult:
+    """Execute ``stream`` (N, 3 mm per period) in HAL at ``machine``'s period and limits.
+
+    ``tail`` periods are sampled after the program (default 0.25 s) so a lagging limit3
+    can be seen settling. ``timeout`` (s, wall) defaults to three times the run plus 30 s.
+    ``on_started`` is called once the stream moves (for tests). Raises HalError, or
+    HalInterrupted on Ctrl-C; HAL is unloaded in every case.
+    """
+    rows = read_stream(stream)
+    n = len(rows)
+    tail = int(round(0.25 / machine.period)) if tail is None else int(tail)
+    total = n + tail
+    timeout = 3 * total * machine.period + 30 if timeout is None else timeout
+    text = hal_text(machine, n, limits=limits, tail=tail)
+    with tempfile.TemporaryDirectory(prefix="cadcnc-hal-") as tmp:
+        work = Path(workdir) if workdir is not None else Path(tmp)
+        work.mkdir(parents=True, exist_ok=True)
+        txt = write_stream_txt(rows, work / "stream.txt")
+        session = HalSession(text, work)
+        started = 0.0
+        try:
+            session.start()
+            out_path = work / "samples.txt"
+            with open(txt, "rb") as src, open(work / "halstreamer.log", "wb") as log:
+                feeder = session.spawn(["halstreamer", "-c", "0"], stdin=src,
+                                       stdout=log, stderr=log)
+            _prefill(session, feeder, min(n, MAX_DEPTH - 16), work)
+            with open(out_path, "wb") as out, open(work / "halsampler.log", "wb") as log:
+                reader = session.spawn(["halsampler", "-c", "0", "-t", "-n", str(total)],
+                                       stdout=out, stderr=log)
+            session.halcmd("sets", "cadcnc-run", "TRUE")
+            started = time.monotonic()
+            if on_started is not None:
+                on_started()
+            _wait(reader, started + timeout, "halsampler", work / "halsampler.log")
+            wall = time.monotonic() - started
+            samples = _parse(out_path, total)
+        except KeyboardInterrupt:
+            session.stop()
+            done = int((time.monotonic() - started) / machine.period) if started else 0
+            raise HalInterrupted(f"HAL run interrupted by Ctrl-C (about {min(done, n)} of {n} "
+                                 "periods executed); HAL unloaded") from None
+        finally:
+            problems = session.stop()
+        if problems:
+            raise HalError("HAL stopped uncleanly: " + "; ".join(problems))
+    return _result(rows, samples, machine.period, wall)
+
+
+def _prefill(session: HalSession, feeder: subprocess.Popen, want: int, work: Path) -> None:
+    """Wait until the streamer FIFO holds ``want`` rows (or halstreamer has written all)."""
+    deadline = time.monotonic() + 60
+    while True:
+        depth = int(session.get("streamer.0.curr-depth"))
+        if depth >= want:
+            return
+        code = feeder.poll()
+        if code is not None and code != 0:
+            raise HalError(f"halstreamer failed (exit {code}): "
+                           + (work / "halstreamer.log").read_text(errors="replace")[-500:])
+        if time.monotonic() > deadline:
+            raise HalError(f"streamer FIFO holds {depth} of {want} rows after 60 s")
+        time.sleep(0.05)
+
+
+def _wait(proc: subprocess.Popen, deadline: float, name: str, log: Path) -> None:
+    """Wait for a helper to finish before ``deadline`` (monotonic s); HalError otherwise."""
+    while proc.poll() is None:
+        if time.monotonic() > deadline:
+            raise HalError(f"{name} did not finish in time")
+        time.sleep(0.05)
+    if proc.returncode != 0:
+        raise HalError(f"{name} exit {proc.returncode}: "
+                       + log.read_text(errors="replace")[-500:])
+
+
+def _parse(path: Path, total: int) -> np.ndarray:
+    """halsampler's tagged lines as a (total, 8) array: tag, cmd XYZ, exec XYZ, underruns."""
+    data = np.loadtxt(path, ndmin=2)
+    if data.shape != (total, 8):
+        raise HalError(f"halsampler gave {data.shape[0]} samples of {data.shape[1]} columns, "
+                       f"expected {total} of 8")
+    return data
+
+
+def _result(rows: np.ndarray, s: np.ndarray, period: float, wall: float) -> HalLoopResult:
+    """Facts of one run from its samples (row k of the program is sample k)."""
+    n = len(rows)
+    tags = s[:, 0].astype(np.int64)
+    overruns = int(np.sum(np.diff(tags) - 1)) if len(tags) > 1 else 0
+    cmd, exe, under = s[:, 1:4] / 1e3, s[:, 4:7] / 1e3, s[:, 7].astype(np.int64)
+    m = min(n, len(s))
+    off = np.abs(exe - cmd).max(axis=1) > SAMPLE_RES * 0.5
+    return HalLoopResult(
+        period=period, streamed=n, read=len(s), underruns=int(under[m - 1] - under[0]),
+        overruns=overruns, commanded=cmd, executed=exe, clipped=int(off[:m].sum()),
+        clipped_tail=int(off[m:].sum()),
+        command_error=float(np.abs(cmd[:m] - rows[:m]).max()),
+        tracking_error=float(np.abs(exe[:m] - rows[:m]).max()), wall_time=wall)
+
+
+def summary(r: HalLoopResult) -> str:
+    """A few lines for a person: samples, underruns, executed minus commanded, clipped."""
+    return "\n".join([
+        f"HAL loop: {r.streamed} periods of {r.period * 1e3:g} ms streamed "
+        f"({r.cycle_time:.3f} s), {r.read} samples read back in {r.wall_time:.2f} s wall",
+        f"underruns within the program: {r.underruns}; sampler overruns: {r.overruns}",
+        f"commanded vs stream: max {r.command_error:.2e} mm; "
+        f"executed vs stream: max {r.tracking_error:.2e} mm",
+        f"samples clipped by limit3: {r.clipped} of {r.streamed} in the program, "
+        f"{r.clipped_tail} of {r.read - r.streamed} after it",
+    ])
