@@ -160,4 +160,4 @@ def test_a_missing_stream_is_a_clear_error(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "cadcnc.controller.hal",
                            str(tmp_path / "none.txt")], capture_output=True, text=True,
                           timeout=60)
-    assert proc.returncode == 7 and "cannot read the stream" in proc.stderr
+    assert proc.returncode == 2 and "cannot read the stream" in proc.stderr

@@ -2,7 +2,7 @@
 
 A stand-alone front end until ``cadcnc stream --hal`` calls :func:`run_hal_loop`. Exit 0
 when the run completed with no underrun within the program and, at the machine's limits,
-no clipped sample; 1 when it completed but some did; 7 when HAL could not run; 130 on
+no clipped sample; 1 when it completed but some did; 2 for an unreadable stream, 1 when HAL could not run; 130 on
 Ctrl-C (HAL unloaded first).
 """
 
@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...errors import CadcncError
 from .loop import run_hal_loop, summary
 from .session import HalError, hal_available
 
@@ -49,7 +50,7 @@ def main(argv: list[str] | None = None) -> int:
         result = run_hal_loop(args.stream, machine, limits="wide" if args.wide else "machine",
                               on_started=lambda: print("HAL running", file=sys.stderr,
                                                        flush=True))
-    except HalError as e:
+    except CadcncError as e:
         print(f"cadcnc: error: {e}", file=sys.stderr)
         return e.exit_code
     print(summary(result))

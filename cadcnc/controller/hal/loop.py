@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from ...errors import InputError
 from .session import HalError, HalInterrupted, HalSession
 
 SAMPLE_RES = 1e-9  # mm: halsampler prints 6 decimals of the µm the sampler holds
@@ -63,7 +64,7 @@ def read_stream(stream: Any) -> np.ndarray:
         try:
             arr = np.load(p) if p.suffix == ".npy" else np.loadtxt(p, ndmin=2)
         except (OSError, ValueError) as e:
-            raise HalError(f"cannot read the stream {p}: {e}") from None
+            raise InputError(f"cannot read the stream {p}: {e}") from None
     else:
         arr = np.asarray(stream, dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] != 3 or len(arr) < 2 or not np.isfinite(arr).all():

@@ -21,22 +21,23 @@ import threading
 import time
 from pathlib import Path
 
-from ...errors import CadcncError
+from ...errors import EXIT_INTERNAL, EXIT_INTERRUPTED, CadcncError
 
 LOCK_PATH = Path(tempfile.gettempdir()) / "cadcnc-hal.lock"
 NOBODY_UID = 65534
 
 
 class HalError(CadcncError):
-    """HAL could not start, run or stop (the message holds the tool's own error text)."""
+    """HAL could not start, run or stop (the message holds the tool's own error text): an
+    error of the machine's controller tools, not of the input."""
 
-    exit_code = 7
+    exit_code = EXIT_INTERNAL
 
 
 class HalInterrupted(HalError):
     """Ctrl-C during a HAL run; HAL was unloaded before this was raised."""
 
-    exit_code = 130
+    exit_code = EXIT_INTERRUPTED
 
 
 def hal_available() -> str | None:
