@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import contextlib
-import importlib.util
+import importlib
 import io
 import json
 import os
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,18 +21,6 @@ CONCAVE_PAIRS = [(name, *p["faces"]) for name in FIXTURE_NAMES
                  for p in SIDECAR[name]["pairs"] if p["class"] == "concave"]
 
 _parts: dict = {}
-
-
-def load_benchmark(name: str):
-    """A benchmarks/ module by file path, registered under its name; benchmarks/ goes at
-    the end of sys.path so that its sibling imports resolve (installed packages first)."""
-    if str(ROOT / "benchmarks") not in sys.path:
-        sys.path.append(str(ROOT / "benchmarks"))
-    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
 
 
 def load_fixture(name: str):

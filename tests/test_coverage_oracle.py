@@ -1,4 +1,4 @@
-"""The coverage benchmark's judge (benchmarks/coverage_oracle.py) against closed forms.
+"""The coverage benchmark's judge (benchmarks/coverage/coverage_oracle.py) against closed forms.
 
 The judge decides which ball positions are feasible along concave edges; coverage figures
 are only as good as it is. On the pocket fixture the floor (z = 15) meets the planar wall
@@ -13,12 +13,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import load_benchmark
+from benchmarks.coverage import coverage_oracle as _oracle, coverage_paths as _paths
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-_oracle, _paths = load_benchmark("coverage_oracle"), load_benchmark("coverage_paths")
 Oracle, read_shape = _oracle.Oracle, _oracle.read_shape
 classify, cut_polylines = _paths.classify, _paths.cut_polylines
 distance_to_polylines = _paths.distance_to_polylines

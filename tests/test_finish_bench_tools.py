@@ -1,6 +1,7 @@
-"""The OpenCAMLib comparison's own tools (benchmarks/freeform_slab.py, finish_bench_tools.py).
+"""The OpenCAMLib comparison's own tools (benchmarks/finishing/: freeform_slab.py,
+finish_bench_tools.py).
 
-The comparison (benchmarks/finish_vs_ocl.py) is not part of the suite and needs
+The comparison (benchmarks/finishing/finish_vs_ocl.py) is not part of the suite and needs
 opencamlib; what it measures with is checked here: the slab is the graph it claims
 (u = x, w = y, hollows wider than the ball), the deviation judge returns a known offset
 with its sign (gouge side negative) and applies the "ball wholly over the face" rule at
@@ -11,12 +12,10 @@ import numpy as np
 import pytest
 
 import cadcnc
-from conftest import load_benchmark
+from benchmarks.finishing import finish_bench_tools as tools, freeform_slab as slab
 
 R = 3.0
 
-
-slab, tools = load_benchmark("freeform_slab"), load_benchmark("finish_bench_tools")
 
 
 @pytest.fixture(scope="module")

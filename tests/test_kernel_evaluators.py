@@ -19,7 +19,7 @@ patch). 1e-12 is some 5000 units of round-off: room for two different operation 
 (OCCT's span-polynomial cache against de Boor's basis functions) and moderately short
 knot spans (the fixtures reach 1e-13). It is not a bound for ill-conditioned spans (spans
 thousands of times shorter than the patch, seen on real parts): there both evaluators lose
-digits, and benchmarks/bench_evaluators.py compares each with exact arithmetic.
+digits, and benchmarks/kernel/bench_evaluators.py compares each with exact arithmetic.
 
 The (u, w) box corners matter: at a box edge on a C1 knot OCCT evaluates the span inside
 the face (LocalD2), and one face here has its box edge on such a knot.

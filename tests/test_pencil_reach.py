@@ -11,7 +11,6 @@ import cadcnc
 from cadcnc.geometry.part import Part
 from cadcnc.ops.pencil.pencil import NOT_REACHABLE
 from cadcnc.verification import gouge_gate
-from conftest import load_benchmark
 
 RADIUS = 1.0   # shank 10 mm, shorter than the 30 mm void
 
@@ -27,7 +26,9 @@ def shape():
 
 
 def _oracle():
-    return load_benchmark("coverage_oracle")
+    from benchmarks.coverage import coverage_oracle
+
+    return coverage_oracle
 
 
 def test_judge_calls_the_void_floor_unreachable(shape):

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from coverage_paths import distance_to_polylines
+from benchmarks.coverage.coverage_paths import distance_to_polylines
 
 COVERED = 5e-3  # mm: a feasible position within this of a cut polyline is covered
 CACHE_ENV = "COVERAGE_JUDGE_CACHE"

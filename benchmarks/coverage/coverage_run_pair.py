@@ -1,7 +1,7 @@
 """One face pair through cadcnc's program pipeline, as ``cadcnc path`` will run it
 (coverage benchmark, ``--via api``; run as a subprocess, one per pair).
 
-    python benchmarks/coverage_run_pair.py STEP I J RADIUS FEED PERIOD_S OUT
+    python -m benchmarks.coverage.coverage_run_pair STEP I J RADIUS FEED PERIOD_S OUT
 
 Builds ``Job(Tool(R), feed, period, PairPath(faces=(I, J), edge=None))``, calls
 ``program_for_job`` (every feasible stretch of every concave edge, cut and linked),

@@ -8,7 +8,7 @@ polyline of its pair. Written paths are judged too: a point whose distance to ei
 its two faces differs from R' by more than 1 um, or that is nearer than R' - 1 um to any
 face, makes the path silent-bad.
 
-    python benchmarks/pair_coverage.py [--fixtures] [--parts DIR] --radius 2 [--radius 3]
+    python -m benchmarks.coverage.pair_coverage [--fixtures] [--parts DIR] --radius 2 [--radius 3]
         [--feed 1500] [--period 4ms] [--json OUT] [--workers 2] [--timeout 120]
         [--max-samples 60] [--max-pairs N]
 
@@ -31,12 +31,11 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from coverage_oracle import TOL, Oracle, read_shape  # noqa: E402
-from coverage_judge import covered, judge_pair_cached, missed_runs  # noqa: E402
-from coverage_paths import classify, run_faces, run_path  # noqa: E402
+from benchmarks import ROOT
+from benchmarks.coverage.coverage_judge import covered, judge_pair_cached, missed_runs
+from benchmarks.coverage.coverage_oracle import TOL, Oracle, read_shape
+from benchmarks.coverage.coverage_paths import classify, run_faces, run_path
 
-ROOT = Path(__file__).resolve().parents[1]
 
 _ORACLES: dict[str, Oracle] = {}
 SHOWN_CORRECTION = 1e-4  # mm: face_distance corrections listed (smaller: far below 1 um)
@@ -293,7 +292,7 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--via", choices=("cli", "api"), default="cli",
                     help="cli: `cadcnc path`; api: the program pipeline (program_for_job, "
-                    "gate per cut) through benchmarks/coverage_run_pair.py")
+                    "gate per cut) through benchmarks/coverage/coverage_run_pair.py")
     ap.add_argument("--json", help="write per-pair records here")
     ap.add_argument("--table", metavar="JSON", nargs="+", help="print the table of earlier "
                     "--json files (merged) instead of running (refusals re-read with today's "

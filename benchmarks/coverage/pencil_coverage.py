@@ -10,7 +10,7 @@ shank: verdict ``unreachable``) are counted apart and left out of coverage (issu
 Written cuts are judged too (silent-bad): every checked point R' +- 1 um from its two
 faces, and no face nearer than R' - 1 um.
 
-    python benchmarks/pencil_coverage.py [PATH ...] [--fixtures] --radius 3 [--radius 2]
+    python -m benchmarks.coverage.pencil_coverage [PATH ...] [--fixtures] --radius 3 [--radius 2]
         [--json OUT] [--timeout 3600] [--check-points 30]
 
 PATH: STEP files or folders of them. Prints, per part and radius: covered / feasible,
@@ -32,15 +32,14 @@ import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from pair_coverage import (  # noqa: E402
+import numpy as np
+
+from benchmarks import ROOT
+from benchmarks.coverage.coverage_judge import covered, judge_pair_cached, missed_runs
+from benchmarks.coverage.coverage_paths import cadcnc_command, classify, distance_to_polylines
+from benchmarks.coverage.pair_coverage import (
     judge_path, oracle_for, pairs_of, spread, unique_corrections)
-from coverage_judge import covered, judge_pair_cached, missed_runs  # noqa: E402
-from coverage_paths import cadcnc_command, classify, distance_to_polylines  # noqa: E402
 
-import numpy as np  # noqa: E402
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def _children_cpu() -> float:

@@ -1,9 +1,9 @@
-"""Measuring tools of the OpenCAMLib comparison (benchmarks/finish_vs_ocl.py).
+"""Measuring tools of the OpenCAMLib comparison (benchmarks/finishing/finish_vs_ocl.py).
 
 - ``tessellate``: the selected faces as triangles by OCCT's BRepMesh_IncrementalMesh, as
   cq-cam feeds them to OpenCAMLib.
 - ``run_ocl``: OpenCAMLib's BatchDropCutter on those triangles, in a subprocess
-  (benchmarks/ocl_worker.py), returning ball centres (OCL's tool tip + R z).
+  (benchmarks/finishing/ocl_worker.py), returning ball centres (OCL's tool tip + R z).
 - ``FaceDistances``: the true deviation of ball centres from the exact offset of the
   selected faces, by OCCT's own projection onto each face (seeded Newton, checked against
   BRepExtrema_DistShapeShape on a sample), and the rule "the ball lies wholly over a face":
@@ -40,7 +40,8 @@ from cadcnc.geometry.mesh import face_triangles
 from cadcnc.trim import INSIDE
 from cadcnc.verification.probe import FaceProbe
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+from benchmarks import ROOT
+
 ANGULAR = 0.1  # rad: cadquery's default angular tolerance of Shape.tessellate
 
 
@@ -73,7 +74,8 @@ def run_ocl(triangles: np.ndarray, points: np.ndarray, radius: float, threads: i
         src, dst = os.path.join(tmp, "in.npz"), os.path.join(tmp, "out.npz")
         np.savez(src, triangles=triangles, points=points, radius=radius, length=length,
                  z0=z0, threads=threads)
-        subprocess.run([sys.executable, os.path.join(HERE, "ocl_worker.py"), src, dst],
+        subprocess.run([sys.executable, "-m", "benchmarks.finishing.ocl_worker", src, dst],
+                       cwd=ROOT,
                        check=True)
         out = np.load(dst)
         cl, seconds, used = out["cl"], out["seconds"], int(out["threads"])

@@ -4,8 +4,8 @@ The same faces, the same pass lines (cadcnc's planes: angle 0, stepover 1 mm), t
 point spacing (cadcnc's step f = F Ts = 0.1 mm; OCL's points 0.1 mm apart along each
 line), ball R = 3 mm: cadcnc's ball centres against OCL's BatchDropCutter on OCCT
 tessellations of the faces at ``--tol`` (1e-2 and 1e-3 mm), one OCL thread, in a
-subprocess (benchmarks/ocl_worker.py). Every ball centre's true deviation from the exact
-offset of the faces is measured with OCCT (benchmarks/finish_bench_tools.py): max, p50,
+subprocess (benchmarks/finishing/ocl_worker.py). Every ball centre's true deviation from the exact
+offset of the faces is measured with OCCT (benchmarks/finishing/finish_bench_tools.py): max, p50,
 p99 of |distance - R'|, gouge side and leave side, and the worst chord midpoint, counted
 where the ball lies wholly over a face (its nearest point inside the face, the ball grown
 by 0.5 mm clear of the face's boundary). Time per point: OCL's with its tessellation
@@ -13,11 +13,11 @@ by 0.5 mm clear of the face's boundary). Time per point: OCL's with its tessella
 planning (reading the part, planes, passes, links, uncut report) and without the gouge
 gate, which is timed separately; where cadcnc's time goes is timed inside it.
 
-    python benchmarks/finish_vs_ocl.py [--slab] [--fixtures [NAME ...]] [--tol 1e-2 1e-3]
+    python -m benchmarks.finishing.finish_vs_ocl [--slab] [--fixtures [NAME ...]] [--tol 1e-2 1e-3]
         [--json OUT] [--png docs/img/finish_vs_ocl.png]
 
 ``--slab`` (default when neither is given): the held-out-like free-form slab of
-benchmarks/freeform_slab.py, 80 x 60 mm, and its picture. ``--fixtures``: the
+benchmarks/finishing/freeform_slab.py, 80 x 60 mm, and its picture. ``--fixtures``: the
 fixtures/finish_*.step named in fixtures/finish_fixtures.json (all, or the NAMEs), on
 their selected faces. Needs ``pip install -e '.[bench]'`` (opencamlib).
 """
@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
 from dataclasses import dataclass
@@ -37,11 +36,10 @@ import numpy as np
 import cadcnc
 from cadcnc.geometry.part import optimal_box
 from cadcnc.verification import gate_program
-from finish_bench_tools import FaceDistances, run_ocl, tessellate
-import freeform_slab
+from benchmarks import ROOT
+from benchmarks.finishing import freeform_slab
+from benchmarks.finishing.finish_bench_tools import FaceDistances, run_ocl, tessellate
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = Path(HERE).parent
 R, FEED, PERIOD = 3.0, 1500.0, 0.004
 SPACING = FEED * PERIOD / 60.0    # 0.1 mm: cadcnc's step, OCL's point spacing
 clock = time.perf_counter

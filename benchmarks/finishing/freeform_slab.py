@@ -1,4 +1,5 @@
-"""A held-out-like free-form slab for the finishing benchmark (benchmarks/finish_vs_ocl.py).
+"""A held-out-like free-form slab for the finishing benchmark
+(benchmarks/finishing/finish_vs_ocl.py).
 
 An 80 x 60 mm block whose top is one smooth bicubic B-spline face z = z(x, y) over
 [0, 80] x [0, 60], with vertical sides and a flat bottom at z = 0. The poles sit on a

@@ -1,9 +1,9 @@
 """OpenCAMLib's drop-cutter on a triangle file, in a process of its own.
 
-Run by benchmarks/finish_vs_ocl.py: opencamlib from PyPI crashed when loaded in the same
+Run by benchmarks/finishing/finish_vs_ocl.py: opencamlib from PyPI crashed when loaded in the same
 process as cadquery's OCCT libraries, so this script imports numpy and opencamlib only.
 
-    python benchmarks/ocl_worker.py IN.npz OUT.npz
+    python -m benchmarks.finishing.ocl_worker IN.npz OUT.npz
 
 IN.npz: ``triangles`` (T, 3, 3) mm, ``points`` (N, 2) x, y of the cutter locations,
 ``radius`` (ball radius R, mm), ``length`` (cutter length, mm), ``z0`` (start height of

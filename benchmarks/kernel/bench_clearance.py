@@ -8,7 +8,7 @@ stepper's own time per cycle and the guard's (median, p99, max, µs), their rati
 the exact OCCT distances per cycle. Ratios in the same process are the figures to
 compare across machines.
 
-    .venv/bin/python benchmarks/bench_clearance.py PART.stp [PART.stp ...] [--pairs N]
+    .venv/bin/python -m benchmarks.kernel.bench_clearance PART.stp [PART.stp ...] [--pairs N]
 """
 
 from __future__ import annotations

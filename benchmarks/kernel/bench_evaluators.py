@@ -11,7 +11,7 @@ Faces above 1e-12 are listed; for B-spline and Bezier faces the listing also giv
 far each evaluation is from the exact one (rational arithmetic on the same knot span), in
 the same relative measure: which of the two loses the digits.
 
-    .venv/bin/python benchmarks/bench_evaluators.py PARTS... [--points N] [--repeat N]
+    .venv/bin/python -m benchmarks.kernel.bench_evaluators PARTS... [--points N] [--repeat N]
         [--faces]   (one line per face as well)
 """
 

@@ -7,7 +7,7 @@ the gate (and its share of the total), the gate's cost per cycle in microseconds
 progress calls, and the process's peak resident memory. Ratios, not absolute times, are
 the figures to compare across machines.
 
-    .venv/bin/python benchmarks/bench_gate.py [--cycles N] [--case torus_cone]
+    .venv/bin/python -m benchmarks.kernel.bench_gate [--cycles N] [--case torus_cone]
 """
 
 from __future__ import annotations
@@ -15,12 +15,12 @@ from __future__ import annotations
 import argparse
 import resource
 import time
-from pathlib import Path
 
 import cadcnc
 from cadcnc.verification import gouge_gate
 
-ROOT = Path(__file__).resolve().parents[1]
+from benchmarks import ROOT
+
 CASES = {  # fixture, faces, ball radius (mm), edge length (mm)
     "torus_cone": ("torus_cone.step", 1, 2, 3.0, 97.78685),
     "bspline_boss": ("bspline_boss.step", 4, 5, 3.0, 50.658454),
@@ -32,36 +32,47 @@ def peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cycles", type=int, default=70_000)
-    ap.add_argument("--case", choices=sorted(CASES), default="torus_cone")
-    args = ap.parse_args()
-    name, i, j, radius, length = CASES[args.case]
+def measure(case: str, cycles: int) -> dict:
+    """The path and its gate on ``case`` with about ``cycles`` cycles: seconds, cycles,
+    progress calls and peak resident memory (MB) before, after the path and the gate."""
+    name, i, j, radius, length = CASES[case]
     part = cadcnc.load_step(ROOT / "fixtures" / name)
-    step = length / args.cycles
+    step = length / cycles
     feed = 60.0 * step / PERIOD
     base = peak_mb()
     t0 = time.perf_counter()
     tp = cadcnc.intersection_path(part.face(i), part.face(j), radius=radius, feed=feed,
-                                  period=PERIOD, max_cycles=10 * args.cycles)
+                                  period=PERIOD, max_cycles=10 * cycles)
     t1 = time.perf_counter()
     after_path = peak_mb()
     calls = []
     gate = gouge_gate(tp, part, progress=lambda *a: calls.append(a))
     t2 = time.perf_counter()
-    path_s, gate_s = t1 - t0, t2 - t1
-    print(f"{args.case} faces {i}/{j}, R {radius} mm, step {step * 1e3:.3f} um "
-          f"(feed {feed:.1f} mm/min at {PERIOD * 1e3:g} ms): {len(tp)} cycles, "
-          f"stop {tp.stop_reason}")
-    print(f"path  {path_s:7.2f} s  ({path_s / len(tp) * 1e6:7.1f} us/cycle)")
-    print(f"gate  {gate_s:7.2f} s  ({gate_s / len(tp) * 1e6:7.1f} us/cycle), "
-          f"{gate_s / (path_s + gate_s):.0%} of the total; ok={gate.ok}, "
-          f"depth {gate.depth_mm:.3g} mm")
-    stages = sorted({c[0] for c in calls})
-    print(f"progress: {len(calls)} calls over stages {', '.join(stages)}")
+    return {"case": case, "faces": (i, j), "radius": radius, "step": step, "feed": feed,
+            "cycles": len(tp), "stop": tp.stop_reason, "path_s": t1 - t0, "gate_s": t2 - t1,
+            "ok": gate.ok, "depth_mm": gate.depth_mm, "progress": len(calls),
+            "stages": sorted({c[0] for c in calls}),
+            "peak_mb": (base, after_path, peak_mb())}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cycles", type=int, default=70_000)
+    ap.add_argument("--case", choices=sorted(CASES), default="torus_cone")
+    args = ap.parse_args()
+    m = measure(args.case, args.cycles)
+    (i, j), n, path_s, gate_s = m["faces"], m["cycles"], m["path_s"], m["gate_s"]
+    print(f"{args.case} faces {i}/{j}, R {m['radius']} mm, step {m['step'] * 1e3:.3f} um "
+          f"(feed {m['feed']:.1f} mm/min at {PERIOD * 1e3:g} ms): {n} cycles, "
+          f"stop {m['stop']}")
+    print(f"path  {path_s:7.2f} s  ({path_s / n * 1e6:7.1f} us/cycle)")
+    print(f"gate  {gate_s:7.2f} s  ({gate_s / n * 1e6:7.1f} us/cycle), "
+          f"{gate_s / (path_s + gate_s):.0%} of the total; ok={m['ok']}, "
+          f"depth {m['depth_mm']:.3g} mm")
+    print(f"progress: {m['progress']} calls over stages {', '.join(m['stages'])}")
+    base, after_path, after_gate = m["peak_mb"]
     print(f"peak RSS: {base:.0f} MB at start, {after_path:.0f} MB after the path, "
-          f"{peak_mb():.0f} MB after the gate")
+          f"{after_gate:.0f} MB after the gate")
 
 
 if __name__ == "__main__":

@@ -9,15 +9,15 @@ classifier, SurfaceData, trim grids and projectors built inside the timed call) 
 offset surfaces, best of 15 interleaved runs each, CPU and wall time, with the trim-grid
 build separately (``--whole``: only this); latency
 p50 / p99 / p99.9 / max over ``--steps`` steps with GC off, measured five ways
-(benchmarks/latency.py: raw, SCHED_FIFO pinned, kernel-only as the minimum of three
+(benchmarks/kernel/latency.py: raw, SCHED_FIFO pinned, kernel-only as the minimum of three
 lockstep replays, CPU time, and this machine's floor); a landing step against the median
 step; memory per cycle
 with the record on, and growth over ``--streamed`` cycles with it off. docs/performance.md
 records a run. Times are minima or percentiles of perf_counter_ns (wall) or thread_time_ns
 (CPU), in microseconds; the latency methods are latency.py's.
 
-    .venv/bin/python benchmarks/bench_kernel.py [--steps 100000] [--streamed 1000000]
-    .venv/bin/python benchmarks/bench_kernel.py --whole
+    .venv/bin/python -m benchmarks.kernel.bench_kernel [--steps 100000] [--streamed 1000000]
+    .venv/bin/python -m benchmarks.kernel.bench_kernel --whole
 """
 
 from __future__ import annotations
@@ -26,7 +26,6 @@ import argparse
 import gc
 import time
 import tracemalloc
-from pathlib import Path
 
 import numpy as np
 from OCP.BRepAdaptor import BRepAdaptor_Surface
@@ -37,9 +36,10 @@ from OCP.gp import gp_Pnt, gp_Vec
 import cadcnc
 from cadcnc.interp.stepper import Stepper
 from cadcnc.ops.path.pair_path import pair_job, plan_path
-from latency import latency, percentiles
 
-ROOT = Path(__file__).resolve().parents[1]
+from benchmarks import ROOT
+from benchmarks.kernel.latency import latency, percentiles
+
 CASES = [("bspline_boss", 4, 5), ("crossing_cylinders", 1, 2), ("sphere_cylinder", 1, 2),
          ("torus_cone", 1, 2)]
 R, FEED, PERIOD = 3.0, 1500.0, 0.004

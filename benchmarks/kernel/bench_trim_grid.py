@@ -8,7 +8,7 @@ the ratios are the figures to compare), and disagreements between ``TrimGrid.cla
 ``FaceSurface.classify`` on ``--points`` random points over the face's (u, w) box enlarged by
 5 % each side. Surface models (no solid) are read face by face.
 
-    .venv/bin/python benchmarks/bench_trim_grid.py PARTS... [--points N] [--max-cells N]
+    .venv/bin/python -m benchmarks.kernel.bench_trim_grid PARTS... [--points N] [--max-cells N]
 """
 
 from __future__ import annotations
