@@ -2,12 +2,19 @@
 
     .venv/bin/python benchmarks/controller/stream_cost.py
 
-Per program: ``plan`` = cutting into pieces, planning every piece and the per-period arc
-lengths, per period of the whole stream; ``drive`` = per period of a cut, the stream's
-loop driving the kernel (feed override, landing, positions), kernel step included;
-``step`` = the same cuts' steppers stepped at the programmed feed from Python, one call
-per period (the bare step); ``on top`` = plan + drive - step, per period; ``ratio`` =
-(plan + drive) / step. Steppers are built outside the timings. Best of 3 runs.
+Per program and feed, µs per period (best of 5, interleaved; steppers built outside
+every timing):
+
+- ``plan``: cutting into pieces, planning every piece and the per-period arc lengths, per
+  period of the whole stream;
+- ``drive``: per period of a cut, the stream's plan for the kernel (``follow_plan``) and
+  the kernel following it (``interp.follow``: the compiled loop, kernel step included);
+- ``step``: the bare step, the same cuts' steppers run at the programmed feed in the
+  compiled loop (``Stepper.run``), per cycle;
+- ``on top`` = plan + drive - step; ``ratio`` = (plan + drive) / step;
+- ``stream``: ``stream_program`` end to end (plan, kernel, links, landing), per period
+  of the whole stream (links need no step: lower than plan + drive);
+- ``py step``: the bare step from Python, one ``step(feed)`` call per period (for scale).
 """
 
 from __future__ import annotations
@@ -19,7 +26,8 @@ import cadcnc
 from cadcnc.controller import Machine, stream_program
 from cadcnc.controller.feed_plan import plan_feed
 from cadcnc.controller.pieces import pieces_of
-from cadcnc.controller.stream import _kernel
+from cadcnc.controller.stream import LANDING, follow_plan
+from cadcnc.interp.follow import follow
 from cadcnc.ops.finish.finish import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
@@ -39,7 +47,10 @@ def programs():
     yield "finish finish_fillet 6 3", part, finish(part, [6, 3], radius=3.0, stepover=10.0)
 
 
-def best(fn, runs: int = 3) -> float:
+RUNS = 5   # interleaved: drive, step, py step, stream; the best of each
+
+
+def best(fn, runs: int = RUNS) -> float:
     times = []
     for _ in range(runs):
         t = time.perf_counter()
@@ -48,58 +59,80 @@ def best(fn, runs: int = 3) -> float:
     return min(times)
 
 
-def bare_steps(program, factory, machine) -> tuple[float, int]:
-    """Seconds and periods of every cut's stepper at the programmed feed, step by step."""
+def steppers(program, factory, machine) -> list:
+    """A fresh stepper per cut (None where a cut has none)."""
+    return [factory(k, seg, machine.period) for k, seg in enumerate(program.cuts)]
+
+
+def bare_steps(program, factory, machine, python: bool = False) -> tuple[float, int]:
+    """Seconds and periods of every cut's stepper at the programmed feed: in the compiled
+    loop (``run``), or from Python one ``step`` call per period."""
     total, periods = 0.0, 0
-    for k, seg in enumerate(program.cuts):
-        st = factory(k, seg, machine.period)
+    for st in steppers(program, factory, machine):
         if st is None:
             continue
         feed = program.job.feed
         t = time.perf_counter()
-        while st.step(feed) is not None:
-            pass
+        if python:
+            while st.step(feed) is not None:
+                pass
+        else:
+            st.run()
         total += time.perf_counter() - t
         periods += st.cycles
     return total, periods
 
 
 def drive(program, factory, machine, feed) -> tuple[float, int]:
-    """Seconds and rows of the stream's kernel loop over every cut (steppers prebuilt)."""
+    """Seconds and rows of the kernel following the plan over every cut."""
     plan = plan_feed(pieces_of(program, machine, feed), machine)
     rows, s = plan.targets()
+    built = steppers(program, factory, machine)
     total, n = 0.0, 0
     for j, piece in enumerate(plan.pieces):
         sel = rows == j
-        if piece.cut is None or not sel.any():
-            continue
-        st = factory(piece.cut, program.cuts[piece.cut], machine.period)
-        if st is None:
+        st = None if piece.cut is None else built[piece.cut]
+        if st is None or not sel.any():
             continue
         t = time.perf_counter()
-        _kernel(st, piece, s[sel], machine.period, "bench")
+        follow(st, follow_plan(piece, s[sel]), piece.points[-1], float(piece.kappa[-1]),
+               LANDING)
         total += time.perf_counter() - t
         n += int(sel.sum())
     return total, n
 
 
+def whole(program, factory, machine, feed) -> float:
+    """Seconds of stream_program with the steppers prebuilt."""
+    built = steppers(program, factory, machine)
+    t = time.perf_counter()
+    stream_program(program, machine, lambda k, seg, period: built[k], feed=feed)
+    return time.perf_counter() - t
+
+
 def main() -> None:
     machine = Machine.default()
     print(f"machine: {machine.summary()}")
-    print(f"{'program':<26} {'feed':>6} {'periods':>8} {'plan us':>8} {'drive us':>9} "
-          f"{'step us':>8} {'on top us':>9} {'ratio':>6}")
+    print(f"{'program':<26} {'feed':>6} {'periods':>8} {'plan':>6} {'drive':>6} {'step':>6} "
+          f"{'on top':>7} {'ratio':>6} {'stream':>7} {'py step':>8}   (us per period)")
     for name, part, program in programs():
         factory = stepper_factory(part)
         stream_program(program, machine, factory)   # warm the compiled code
         for feed in (None, 10_000.0):
             n = stream_program(program, machine, factory, feed=feed).periods
-            plan = best(lambda: plan_feed(pieces_of(program, machine, feed), machine).targets())
-            d_s, d_n = min((drive(program, factory, machine, feed) for _ in range(3)))
-            step_s, step_n = min(bare_steps(program, factory, machine) for _ in range(3))
+            plan = best(lambda: plan_feed(pieces_of(program, machine, feed), machine).targets(),
+                        RUNS)
+            runs = [(drive(program, factory, machine, feed), bare_steps(program, factory, machine),
+                     bare_steps(program, factory, machine, True),
+                     whole(program, factory, machine, feed)) for _ in range(RUNS)]
+            (d_s, d_n), (step_s, step_n), (py_s, py_n) = (min(r[i] for r in runs)
+                                                          for i in range(3))
+            w = min(r[3] for r in runs)
             plan_us, drive_us, step_us = 1e6 * plan / n, 1e6 * d_s / d_n, 1e6 * step_s / step_n
-            print(f"{name:<26} {feed or program.job.feed:>6g} {n:>8} {plan_us:>8.2f} "
-                  f"{drive_us:>9.2f} {step_us:>8.2f} {plan_us + drive_us - step_us:>9.2f} "
-                  f"{(plan_us + drive_us) / step_us:>6.2f}")
+            print(f"{name:<26} {feed or program.job.feed:>6g} {n:>8} {plan_us:>6.2f} "
+                  f"{drive_us:>6.2f} {step_us:>6.2f} {plan_us + drive_us - step_us:>7.2f} "
+                  f"{(plan_us + drive_us) / step_us:>6.2f} {1e6 * w / n:>7.2f} "
+                  f"{1e6 * py_s / py_n:>8.2f}")
 
 
 if __name__ == "__main__":

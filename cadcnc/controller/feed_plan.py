@@ -112,26 +112,40 @@ class Profile:
     def duration(self) -> float:
         return float(self.t[-1]) + self.window
 
-    def _integral(self, tau: np.ndarray) -> np.ndarray:
-        """S(tau) = integral of s from 0 to tau (s = 0 before 0, L after the end)."""
-        t, end = self.t, self.t[-1]
-        k = np.clip(np.searchsorted(t, tau, side="right") - 1, 0, len(t) - 2)
-        x = np.clip(tau, 0.0, end) - t[k]
-        inside = (self.S[k] + self.s[k] * x + self.v[k] * x * x / 2.0
-                  + self.a[k] * x ** 3 / 6.0)
-        return np.where(tau <= 0.0, 0.0, inside + self.length * np.maximum(tau - end, 0.0))
-
     def position(self, tau: np.ndarray) -> np.ndarray:
         """s (mm) at local times ``tau`` (s), clipped to [0, L]."""
-        tau = np.asarray(tau, dtype=float)
-        if self.window > 0.0:
-            s = (self._integral(tau) - self._integral(tau - self.window)) / self.window
+        tau = np.ascontiguousarray(tau, dtype=float)
+        out = np.empty(tau.shape)
+        _positions(self.t, self.s, self.v, self.a, self.S, self.window, tau.ravel(),
+                   out.ravel())
+        return out
+
+
+@njit(cache=True, error_model="numpy")
+def _integral(t, s, v, a, S, tau: float) -> float:
+    """S(tau) = integral of s from 0 to tau (s = 0 before 0, L after the end)."""
+    if tau <= 0.0:
+        return 0.0
+    end = t[-1]
+    k = min(max(np.searchsorted(t, tau, side="right") - 1, 0), len(t) - 2)
+    x = min(tau, end) - t[k]
+    return (S[k] + s[k] * x + v[k] * x * x / 2.0 + a[k] * x ** 3 / 6.0
+            + s[-1] * max(tau - end, 0.0))
+
+
+@njit(cache=True, error_model="numpy")
+def _positions(t, s, v, a, S, window: float, tau, out) -> None:
+    """Profile.position into ``out``: s(t) averaged over ``window`` (or s(t) if 0)."""
+    L = s[-1]
+    for i in range(len(tau)):
+        if window > 0.0:
+            x = (_integral(t, s, v, a, S, tau[i])
+                 - _integral(t, s, v, a, S, tau[i] - window)) / window
         else:
-            t = self.t
-            k = np.clip(np.searchsorted(t, tau, side="right") - 1, 0, len(t) - 2)
-            x = np.clip(tau, 0.0, t[-1]) - t[k]
-            s = self.s[k] + self.v[k] * x + self.a[k] * x * x / 2.0
-        return np.clip(s, 0.0, self.length)
+            k = min(max(np.searchsorted(t, tau[i], side="right") - 1, 0), len(t) - 2)
+            y = min(max(tau[i], 0.0), t[-1]) - t[k]
+            x = s[k] + v[k] * y + a[k] * y * y / 2.0
+        out[i] = min(max(x, 0.0), L)
 
 
 def _knotted(piece: Piece, v_lim: np.ndarray):
@@ -150,7 +164,7 @@ def _knotted(piece: Piece, v_lim: np.ndarray):
     return ss, vv, n
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _passes(ss: np.ndarray, w: np.ndarray, a: float) -> None:
     """Forward and backward passes on squared speeds ``w`` (in place): v^2 changes by at
     most 2 a per mm between knots ``ss``. A loop: cumulative forms lose v^2 near the ends
@@ -161,16 +175,20 @@ def _passes(ss: np.ndarray, w: np.ndarray, a: float) -> None:
         w[i] = min(w[i], w[i + 1] + 2.0 * a * (ss[i + 1] - ss[i]))
 
 
+@njit(cache=True, error_model="numpy")
 def _time_law(ss: np.ndarray, w: np.ndarray):
     """t, v, a and the integral S on knots ``ss`` of squared speeds ``w`` (v^2 linear in s
     between knots: constant acceleration)."""
+    n = len(ss)
     v = np.sqrt(np.maximum(w, 0.0))
-    h = np.diff(ss)
-    dt = 2.0 * h / (v[:-1] + v[1:])
-    a = np.diff(w) / (2.0 * h)
-    t = np.r_[0.0, np.cumsum(dt)]
-    S = np.r_[0.0, np.cumsum(ss[:-1] * dt + v[:-1] * dt ** 2 / 2.0 + a * dt ** 3 / 6.0)]
-    return t, v, np.r_[a, 0.0], S
+    t, a, S = np.zeros(n), np.zeros(n), np.zeros(n)
+    for i in range(n - 1):
+        h = ss[i + 1] - ss[i]
+        dt = 2.0 * h / (v[i] + v[i + 1])
+        a[i] = (w[i + 1] - w[i]) / (2.0 * h)
+        t[i + 1] = t[i] + dt
+        S[i + 1] = S[i] + (ss[i] * dt + v[i] * dt ** 2 / 2.0 + a[i] * dt ** 3 / 6.0)
+    return t, v, a, S
 
 
 def plan_piece(piece: Piece, machine: Machine) -> Profile:

@@ -117,10 +117,12 @@ def pieces_of(program: Program, machine: Machine, feed: float | None = None) -> 
                                     kappa))
             cut += 1
             continue
-        for a, b, rapid in zip(seg.points[:-1], seg.points[1:], seg.rapid):
-            pts, s, _, _ = _distinct(np.array([a, b], dtype=float))
-            if s[-1] > DUPLICATE:
-                pieces.append(Piece(pts, s, math.inf if rapid else feed / 60.0, k))
+        moves = np.asarray(seg.points, dtype=float)
+        lengths = np.linalg.norm(np.diff(moves, axis=0), axis=1).tolist()
+        for m, (h, rapid) in enumerate(zip(lengths, seg.rapid)):
+            if h > DUPLICATE:   # a straight move: its chord is its arc
+                pieces.append(Piece(moves[m:m + 2].copy(), np.array([0.0, h]),
+                                    math.inf if rapid else feed / 60.0, k))
     return pieces
 
 

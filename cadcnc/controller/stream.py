@@ -2,9 +2,10 @@
 
 :func:`stream_program` plans the feed (:mod:`.feed_plan`), then computes each period's
 position on the exact path: a cut's by its own stepper re-run with the per-cycle feed
-override (the kernel computes every position; the step commanded each period is the
-planned arc length minus the distance the kernel has travelled), a link move's in closed
-form. The steppers come from the caller (``steppers(cut_index, segment, period)``, built
+override (the kernel computes every position, following the plan in its compiled loop,
+:mod:`cadcnc.interp.follow`; the step commanded each period is the planned arc length
+minus the distance the kernel has travelled), a link move's in closed form. The steppers
+come from the caller (``steppers(cut_index, segment, period)``, built
 where the part's faces are, e.g. :func:`cadcnc.ops.stream_steppers.stepper_factory`); a
 cut without one (a convex roll-over arc) is interpolated from its own points by a cubic
 Hermite in arc length. Positions: (N, 3) float64, absolute X Y Z in mm; row 0 is the
@@ -16,12 +17,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
-import math
-
 import numpy as np
 
 from ..errors import GeometryError
 from ..interp.cycle import CLOSED, END
+from ..interp.follow import follow
 from ..program.program import Program
 from .feed_plan import FeedPlan, plan_feed
 from .machine import AXES, Machine
@@ -123,46 +123,36 @@ def _hermite(piece: Piece, s: np.ndarray) -> np.ndarray:
     return h00 * p[k] + h10 * h[:, None] * d[k] + h01 * p[k + 1] + h11 * h[:, None] * d[k + 1]
 
 
-def _kernel(stepper, piece: Piece, s: np.ndarray, period: float, what: str) -> np.ndarray:
-    """Positions at arc lengths ``s`` (nondecreasing) from ``stepper`` on the piece's cut.
-
-    Each period commands the step target - travelled (per-cycle feed override), the
-    target being the planned arc length as the kernel's chord sum. The kernel's path is
-    a few 1e-7 of its length longer or shorter than the program's points say: over the
-    last BLEND mm the target moves smoothly onto the distance left to the cut's last
-    point, so the stream lands on it without a jump."""
-    end, length = piece.points[-1], piece.length
+def follow_plan(piece: Piece, s: np.ndarray) -> np.ndarray:
+    """(rows, 3) the per-period plan the kernel follows on a cut (kernel/follow.py): the
+    target length as the kernel's chord sum, the blend weight onto the distance left to
+    the end (C2 from 0 to 1 over the last BLEND mm), and the planned length left."""
     ds = np.diff(np.r_[0.0, s])
     kappa = np.interp(s, piece.s, piece.kappa)
-    chords = np.cumsum(ds * (1.0 - kappa ** 2 * ds ** 2 / 24.0))   # the kernel's travel
-    left = length - s
+    plan = np.empty((len(s), 3))
+    plan[:, 0] = np.cumsum(ds * (1.0 - kappa ** 2 * ds ** 2 / 24.0))   # the kernel's travel
+    plan[:, 2] = left = piece.length - s
     x = np.clip(1.0 - left / BLEND, 0.0, 1.0)
-    weight = x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)   # C2 from 0 to 1
-    k_end = float(piece.kappa[-1])
-    weight, left = weight.tolist(), left.tolist()
-    to_feed = 60.0 / period
-    ex, ey, ez = map(float, end)
-    x, y, z = map(float, stepper.p)
-    rows = []
-    for n, target in enumerate(chords.tolist()):
-        if stepper.stop_reason is None:
-            f = target - stepper.travelled
-            w = weight[n]
-            if w > 0.0:
-                d = math.sqrt((ex - x) ** 2 + (ey - y) ** 2 + (ez - z) ** 2)
-                f = (1.0 - w) * f + w * (d * (1.0 + k_end * k_end * d * d / 24.0) - left[n])
-                if left[n] <= 0.0:
-                    f = max(f, d * (1.0 + LANDING) + 1e-12)
-            if f > 0.0:
-                dp = stepper.step(f * to_feed)
-                if dp is not None:
-                    x, y, z = x + dp[0], y + dp[1], z + dp[2]
-                elif stepper.stop_reason not in (END, CLOSED):
-                    raise GeometryError(f"{what}: the stepper stopped while streaming "
-                                        f"({stepper.stop_reason}: {stepper.stop_detail})")
-        rows.append((x, y, z))
-    out = np.array(rows, dtype=float).reshape(-1, 3)
-    p = out[-1] if len(rows) else np.array([x, y, z])
+    plan[:, 1] = x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)
+    return plan
+
+
+def _kernel(stepper, piece: Piece, s: np.ndarray, what: str) -> np.ndarray:
+    """Positions at arc lengths ``s`` (nondecreasing) from ``stepper`` on the piece's cut.
+
+    Each period commands the step target - travelled (the stepper follows the plan in
+    the kernel's compiled loop: :func:`cadcnc.interp.follow.follow`), the target being
+    the planned arc length as the kernel's chord sum. The kernel's path is a few 1e-7 of
+    its length longer or shorter than the program's points say: over the last BLEND mm
+    the target moves smoothly onto the distance left to the cut's last point, so the
+    stream lands on it without a jump."""
+    end = piece.points[-1]
+    out = follow(stepper, follow_plan(piece, s), end, float(piece.kappa[-1]), LANDING)
+    if stepper.stop_reason not in (None, END, CLOSED):
+        raise GeometryError(f"{what}: the stepper stopped while streaming "
+                            f"({stepper.stop_reason}: {stepper.stop_detail})")
+    p = np.asarray(stepper.p)
+    to_feed = 60.0 / stepper.period
     for _ in range(3):   # the rest of the cut lies between two periods: land on its end
         if stepper.stop_reason is not None:
             break
@@ -198,8 +188,7 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
             positions[sel] = _hermite(piece, s[sel])
             hermite += 1
             continue
-        positions[sel] = _kernel(stepper, piece, s[sel], machine.period,
-                                 f"cut {piece.cut + 1}")
+        positions[sel] = _kernel(stepper, piece, s[sel], f"cut {piece.cut + 1}")
         kernel += 1
     positions[0] = pieces[0].points[0]
     positions[-1] = pieces[-1].points[-1]

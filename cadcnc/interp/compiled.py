@@ -7,7 +7,8 @@ accurate step, end landing, trial cycle on the compiled evaluators, O(1) trim ch
 commit, record row); Python is entered only for what the kernel leaves to it: an exact
 trim classification where a contact's grid cell is MIXED, the guard, a landing (the same
 ``landing.land`` as the reference) and the messages. ``run`` loops in the kernel
-(``kernel.step.run``) between such events. The plain-Python Stepper stays the reference:
+(``kernel.entry.run``) between such events, ``follow`` likewise with a per-period step
+plan (``kernel.follow``). The plain-Python Stepper stays the reference:
 tests compare the two paths point for point. No OCCT here.
 """
 
@@ -29,6 +30,7 @@ from .cycle import (
     singular_detail, tangent_detail,
 )
 from .kernel import entry as E
+from .kernel import follow as KF
 from .kernel import step as K
 from .kernel.cycle_math import C_OFF, C_SING, C_U, C_W, CS
 from .record import ROW, PathRecord
@@ -195,6 +197,32 @@ class CompiledStepper(Stepper):
                 reported = cycles
                 progress(cycles, self.travelled)
         return self
+
+    def follow(self, plan: np.ndarray, args: np.ndarray) -> np.ndarray:
+        """(rows, 3) the centre after each period of ``plan`` (``kernel.follow``), the loop
+        in the kernel between events; rows after a stop hold the last position."""
+        plan = np.ascontiguousarray(plan, dtype=np.float64)
+        out = np.empty((len(plan), 3))
+        n = 0
+        while n < len(plan):
+            if self.stop_reason is not None:
+                out[n:] = self.S[K.P:K.P + 3]
+                break
+            status, n, rec = KF.follow(self.F, self.I, self.S, self._rows(), self._row(),
+                                       plan, args, out, n, self.max_cycles)
+            if self.record is not None:
+                self.record.set_length(rec)
+            if status == K.DONE:
+                break
+            if status == K.RECORD_FULL:
+                continue
+            if status == K.MAX_CYCLES:
+                self._stop(MAX_CYCLES, f"cycle limit {self.max_cycles} reached")
+            else:
+                self._finish(status, self._row())
+            out[n] = self.S[K.P:K.P + 3]
+            n += 1
+        return out
 
     def _finish(self, status: int, n: int) -> Vec | None:
         """Complete a period the kernel handed back: end, a stop, the exact checks."""
