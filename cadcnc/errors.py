@@ -79,3 +79,11 @@ class ProgramSyntaxError(InputError):
         super().__init__(f"{source}:{line}:{column}: {message}")
         self.line = line
         self.column = column
+
+
+def require(name: str, value, kinds, what: str):
+    """``value`` when it is one of ``kinds``, else InputError naming the parameter: "name
+    must be what, got TYPE" (the API's wrong argument types, never a bare TypeError)."""
+    if not isinstance(value, kinds):
+        raise InputError(f"{name} must be {what}, got {type(value).__name__}")
+    return value

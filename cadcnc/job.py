@@ -130,7 +130,10 @@ class PairPath:
     stretch: int | None = None
 
     def __post_init__(self):
-        faces = tuple(self.faces)
+        try:
+            faces = tuple(self.faces)
+        except TypeError:
+            faces = ()
         if len(faces) != 2:
             raise InputError(f"a path needs two faces, got {_show(self.faces)}")
         for n in faces:
@@ -201,8 +204,8 @@ class Pencil:
     side: str = "climb"
 
     def __post_init__(self):
-        if self.faces is not None:
-            object.__setattr__(self, "faces", check_faces(self.faces))
+        if self.faces is not None:   # a set of faces: the same record whatever its order
+            object.__setattr__(self, "faces", tuple(sorted(check_faces(self.faces))))
         if self.side not in SIDES:
             raise InputError(f"side must be one of {', '.join(SIDES)}, got "
                              f"{_show(self.side)}")

@@ -102,8 +102,31 @@ class Tolerances:
                     and math.isfinite(value) and value > 0):
                 raise InputError(f"tolerance {f.name} must be a finite number > 0, got "
                                  f"{value!r}")
-        if self.coverage > 1:
-            raise InputError(f"tolerance coverage is a fraction <= 1, got {self.coverage!r}")
+            lo, hi = BOUNDS.get(f.name, (0.0, math.inf))
+            if not lo <= value <= hi:
+                raise InputError(f"tolerance {f.name} must lie in [{lo:g}, {hi:g}] (a looser "
+                                 f"value would let the checks pass what they exist to refuse; "
+                                 f"docs/reliability.md), got {value:g}")
+
+
+BOUNDS: dict[str, tuple[float, float]] = {
+    "gouge": (0.0, 0.1),
+    "hit": (0.0, 1e-3),
+    "hausdorff": (0.0, 0.1),
+    "coverage": (0.5, 1.0),
+    "off_face": (0.0, 1e-3),
+    "noise": (0.0, 1e-5),
+    "classify": (0.0, 1e-4),
+    "classify_loose": (0.0, 1e-2),
+    "intersection": (0.0, 1e-4),
+    "sewing": (0.0, 0.1),
+}
+"""The allowed range of every tolerance that loosens a check (mm; ``coverage`` a fraction;
+every tolerance is > 0 besides):
+past these the checks would pass what they exist to refuse. docs/reliability.md has the
+same table and the reasons; a test enforces each row."""
+CHORD_TOLERANCE_MAX = 0.1
+"""mm: the largest G-code chord tolerance (``--tolerance``, also G64 P's ceiling)."""
 
 
 DEFAULT = Tolerances()

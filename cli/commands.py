@@ -18,6 +18,7 @@ from cadcnc.errors import EXIT_PARTIAL
 from cadcnc.io.output_set import OutputSet, check_destination
 from cadcnc.io.outputs import SUFFIXES, render
 from cadcnc.ops.common import single_cut_program
+from cadcnc.ops.run import check_clearance
 from cadcnc.verification.judgement import judge
 
 from . import demo as demo_command, program_commands
@@ -83,6 +84,7 @@ def run(args) -> int:
     gcode = gcode_keywords(args) if wants_gcode(requested) else None
     programs, status = [], 0
     for entry, part in checked:
+        check_clearance(part, entry.job)
         tp = apt.run_job(entry, part, progress(args, f"PATH {entry.name}"), source)
         program = single_cut_program(part, entry.job, tp)
         programs.append((program, part))

@@ -10,15 +10,21 @@ from pathlib import Path
 from cadcnc.errors import InputError
 from cadcnc.io.gcode import blend_for
 from cadcnc.job import Finish, Job, PairPath, Pencil, Tool, check_number
-from cadcnc.tolerances import DEFAULT, Tolerances
+from cadcnc.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT, Tolerances
 from cadcnc.units import parse_duration, parse_feed, parse_length, parse_point
 
 JOB_OPTIONS = ("faces", "radius")  # feed and period have defaults (cli/operation.py)
 
 
 def tolerances(args) -> Tolerances:
-    """The default tolerances with the gouge limit given by ``--gouge-tolerance``."""
+    """The default tolerances with the gouge limit given by ``--gouge-tolerance``, within
+    its bound (docs/reliability.md)."""
     gouge = parse_length(args.gouge_tolerance, "gouge tolerance", allow_zero=False)
+    hi = BOUNDS["gouge"][1]
+    if gouge > hi:
+        raise InputError(f"--gouge-tolerance {gouge:g} mm is over its bound {hi:g} mm: a "
+                         "looser limit would pass gouges the gate exists to refuse "
+                         "(docs/reliability.md)")
     return dataclasses.replace(DEFAULT, gouge=gouge)
 
 
@@ -29,8 +35,11 @@ def job_of(args, operation, source: str) -> Job:
                 parse_length(args.allowance, "allowance"))
     plunge = getattr(args, "plunge_feed", None)
     spindle = getattr(args, "spindle", None)
+    z = clearance(args)
+    if z is not None and getattr(args, "tool_tip", False):
+        z += tool.radius   # the tip's height given: the job holds the ball centre's
     return Job(tool, parse_feed(args.feed), parse_duration(args.period), operation,
-               source=source, clearance=clearance(args), tolerances=tolerances(args),
+               source=source, clearance=z, tolerances=tolerances(args),
                flip_material=getattr(args, "flip_material", False),
                plunge_feed=None if plunge is None else parse_feed(plunge, "plunge feed"),
                spindle=None if spindle is None else check_number("--spindle", spindle, "rpm"))
@@ -92,5 +101,9 @@ def gcode_keywords(args) -> dict:
     """Keyword arguments of :func:`cadcnc.io.program_gcode.program_ngc` besides the job's
     (spindle and plunge feed are in the job): chord tolerance, tool tip, G64 P blending."""
     tol = None if args.tolerance is None else parse_length(args.tolerance, "tolerance", False)
+    if tol is not None and tol > CHORD_TOLERANCE_MAX:
+        raise InputError(f"--tolerance {tol:g} mm is over its bound {CHORD_TOLERANCE_MAX:g} "
+                         "mm (points dropped and G64 P blending that far from the path; "
+                         "docs/reliability.md)")
     return dict(tolerance=tol, tool_tip=args.tool_tip,
                 blend=blend_for(tolerances(args).gouge))

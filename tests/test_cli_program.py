@@ -134,23 +134,42 @@ def test_edge_and_stretch_select(tmp_path):
         assert not (tmp_path / "x.json").exists()
 
 
-def test_the_gate_catches_a_gouging_link(tmp_path):
-    """With the links' height below the boss top, the link between the two stretches
-    runs through the boss: exit 5, the link named, nothing written; --allow-gouge writes
-    the files and keeps exit 5. With the default height the program passes."""
+def test_a_clearance_below_the_top_is_refused_with_the_lowest_allowed(tmp_path):
+    """The links' height must keep the ball above the part's top: a lower --clearance is
+    refused before anything is computed (exit 2, nothing written), naming the lowest
+    allowed height; with --tool-tip the same limit counts for the tip."""
     out = tmp_path / "b.json"
     args = ["path", BOSS, *BOSS_JOB, "-o", out]
+    top = cadcnc.load_step(BOSS).top
     run = cadcnc_cli(*args, "--clearance", "0")
-    assert run.returncode == 5 and not out.exists()
-    assert "cut 2 (faces 1 6, edge 1, stretch 2) or the link moves to it" in run.stderr
-    assert "face 6 by 1.01 mm along 1 move between points" in run.stderr
-    assert "--clearance" not in run.stderr   # no hint at an option that may not help
-    run = cadcnc_cli(*args, "--clearance", "0", "--allow-gouge", "-q")
-    assert run.returncode == 5 and out.exists() and "written anyway" in run.stderr
-    link = read_program(out).segments[2]
-    assert link.kind == "link" and link.points[:, 2].max() == pytest.approx(2.8)
-    run = cadcnc_cli(*args, "-q", check=0)
-    assert run.stderr == ""
+    assert run.returncode == 2 and not out.exists()
+    assert f"lowest allowed is {top + 3:g} mm" in run.stderr
+    run = cadcnc_cli(*args, "--clearance", f"{top + 2.9:g}", "--tool-tip", "-q")
+    assert run.returncode == 0 and out.exists()
+    assert read_program(out).links[0].points[:, 2].max() == pytest.approx(top + 5.9)
+
+
+def test_the_gate_catches_a_gouging_link():
+    """A link forced through the boss (its rapid lowered to Z 2.8, under the boss top) is
+    refused by the library's verdict with the link named, and allowed only on request."""
+    from cadcnc.program.program import LinkSegment, Program
+    from cadcnc.verification.judgement import judge
+
+    part = cadcnc.load_step(BOSS)
+    job = Job(Tool(3.0), 1500.0, 0.004, PairPath(faces=(1, 6), edge=None))
+    program = pair_program.program_for_job(part, job)
+    assert judge(program, part, "path").code == 0
+    segs = list(program.segments)
+    k = next(i for i, seg in enumerate(segs) if seg.kind == "link" and 0 < i < len(segs) - 1)
+    low = segs[k].points.copy()
+    low[1:-1, 2] = 2.8
+    segs[k] = LinkSegment(low, segs[k].rapid)
+    verdict = judge(Program(job, segs), part, "path")
+    assert verdict.code == 5 and not verdict.write
+    assert "cut 2 (faces 1 6, edge 1, stretch 2) or the link moves to it" in verdict.messages[0]
+    assert "--clearance" not in verdict.messages[0]   # no hint at an option that cannot help
+    allowed = judge(Program(job, segs), part, "path", allow_gouge=True)
+    assert allowed.code == 5 and allowed.write and "written anyway" in allowed.messages[0]
 
 
 def test_a_program_stopped_short_exits_6(tmp_path, monkeypatch):
@@ -185,3 +204,25 @@ def test_verify_and_plot_read_a_program(shelf, tmp_path):
     out = tmp_path / "s.png"
     run = cadcnc_cli("plot", d / "s.json", "-o", out, check=0)
     assert out.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_verify_judges_the_links_too(tmp_path):
+    """`verify` of a saved program whose link runs through the boss exits 5 and says the
+    links fail, although every cut passes its own report."""
+    from cadcnc.io.program_json import program_json
+    from cadcnc.program.program import LinkSegment, Program
+
+    part = cadcnc.load_step(BOSS)
+    job = Job(Tool(3.0), 1500.0, 0.004, PairPath(faces=(1, 6), edge=None), source=str(BOSS))
+    program = pair_program.program_for_job(part, job)
+    segs = list(program.segments)
+    k = next(i for i, seg in enumerate(segs) if seg.kind == "link" and 0 < i < len(segs) - 1)
+    low = segs[k].points.copy()
+    low[1:-1, 2] = 2.8
+    segs[k] = LinkSegment(low, segs[k].rapid)
+    bad, good = tmp_path / "bad.json", tmp_path / "good.json"
+    bad.write_text(program_json(Program(job, segs)))
+    good.write_text(program_json(program))
+    run = cadcnc_cli("verify", bad, "-q")
+    assert run.returncode == 5 and "links fail the gouge gate" in run.stderr
+    assert cadcnc_cli("verify", good, "-q").returncode == 0

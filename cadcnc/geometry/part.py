@@ -25,7 +25,7 @@ from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
-from ..errors import FaceNumberError, StepFileError
+from ..errors import FaceNumberError, InputError, StepFileError
 from .face_surface import FaceSurface
 from .material_side import FLIPPED, SOLID, SurfaceModel, material_sides
 from .sewing import file_faces, sew
@@ -67,6 +67,8 @@ def load_step(path: str | os.PathLike, tol: Tolerances = DEFAULT,
     What OCCT's reader printed is kept in ``part.warnings`` (never on standard output).
     A surface model (no solid) is sewn and given a material side (:class:`Part`).
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"path must be a STEP file's path, got {type(path).__name__}")
     path = os.fspath(path)
     shape, warnings = read_step(path)
     part = Part(shape, source=path, tol=tol, flip_material=flip_material)

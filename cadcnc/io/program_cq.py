@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import require
 from ..program.program import Program
 
 MIN_EDGE = 1e-3  # mm: a shorter move is merged into the next
@@ -31,6 +32,7 @@ def to_cq(program: Program, cuts: bool = True, links: bool = True) -> list:
     """CadQuery wires of ``program``'s segments in machining order: one per cut (ball
     centres) when ``cuts``, one per link when ``links``; segments shorter than 1 µm are
     left out."""
+    require("program", program, Program, "a cadcnc Program")
     wires = []
     for seg in program.segments:
         if not (cuts if seg.kind == "cut" else links):

@@ -22,9 +22,11 @@ a rapid (else a feed move at the plunge feed). Written atomically.
 from __future__ import annotations
 
 import json
+import os
 
 import numpy as np
 
+from ..errors import require
 from ..errors import InputError
 from ..job import Job
 from ..jsonable import plain
@@ -116,4 +118,5 @@ def write_program_json(program: Program, out) -> None:
 
 def read_program(file) -> Program:
     """Read a program (version 2) or toolpath (version 1) JSON file; errors name the file."""
+    require("file", file, (str, os.PathLike), "a JSON file's path")
     return v1.read_json_file(file, "program", program_from_dict)

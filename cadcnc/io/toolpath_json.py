@@ -142,10 +142,22 @@ def read_json_file(file, what: str, parse):
         raise InputError(f"{file}: no such file") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise InputError(f"{file}: not a {what} JSON file ({e})") from None
+    except (ValueError, RecursionError) as e:   # a 4300-digit integer; nesting too deep
+        raise InputError(f"{file}: not a {what} JSON file: {_short(e)}") from None
     try:
         return parse(data)
     except InputError as e:
         raise InputError(f"{file}: {e}") from None
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError, OverflowError,
+            RecursionError) as e:
+        raise InputError(f"{file}: a malformed {what} JSON file ({type(e).__name__}: "
+                         f"{_short(e)})") from None
+
+
+def _short(e: BaseException) -> str:
+    """The error's message cut to one readable line."""
+    text = str(e).splitlines()[0] if str(e) else type(e).__name__
+    return text if len(text) <= 200 else text[:200] + "..."
 
 
 def read_json(file) -> Toolpath:

@@ -24,6 +24,7 @@ def run(part, job: Job, *, progress=None, times: dict | None = None) -> Program:
         raise InputError(f"job must be a cadcnc.Job, got {type(job).__name__}")
     if not isinstance(part, Part):
         part = Part.from_cadquery(part, job.tolerances)
+    check_clearance(part, job)
     op = job.operation
     if isinstance(op, PairPath):
         return program_for_job(part, job, progress=progress)
@@ -40,3 +41,16 @@ def cut_back_gap(job: Job) -> float | None:
     the pair the user named and is judged whole."""
     op = job.operation
     return CHAIN_GAP if isinstance(op, Pencil) else JOIN if isinstance(op, Finish) else None
+
+
+def check_clearance(part: Part, job: Job) -> None:
+    """InputError unless the job's clearance keeps the ball above the part's top: the
+    ball centre at least R above it (the links rapid across at that height)."""
+    if job.clearance is None:
+        return
+    lowest = part.top + job.tool.radius
+    if job.clearance < lowest:
+        raise InputError(f"clearance {job.clearance:g} mm (the ball centre's height) is "
+                         f"below the part's top {part.top:g} mm plus the ball radius: the "
+                         f"lowest allowed is {lowest:g} mm (with --tool-tip, "
+                         f"{lowest - job.tool.radius:g} mm)")

@@ -14,6 +14,8 @@ refuses the path. docs/notes/gate.md states what is checked and the bound it use
 from __future__ import annotations
 
 import math
+from ..program.toolpath import Toolpath
+from ..errors import require
 from dataclasses import dataclass, field
 
 from ..tolerances import Tolerances
@@ -60,6 +62,7 @@ def gouge_gate(toolpath, part=None, tol: Tolerances | None = None, *, moves=None
     within ``tol.gouge - blend_mm`` of the part. ``progress(stage, done, total)`` is called
     as the checks advance ("surfaces", "whole part", "moves").
     """
+    require("toolpath", toolpath, Toolpath, "a cadcnc Toolpath")
     limit = math.nan
     blend = blend_mm
     try:

@@ -13,6 +13,8 @@ against the whole part exactly once. The program passes only when every cut pass
 from __future__ import annotations
 
 import math
+from ..program.program import Program
+from ..errors import require
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -119,6 +121,7 @@ def gate_program(program, part=None, tol: Tolerances | None = None, *, moves=Non
     points (cuts and links as computed). ``tol`` default: the program's job's tolerances.
     ``blend_mm`` and ``progress`` as for :func:`gouge_gate`.
     """
+    require("program", program, Program, "a cadcnc Program")
     tol = program.job.tolerances if tol is None else tol
     if moves is None:
         moves = [s.points for s in program.segments]

@@ -13,6 +13,8 @@ import time
 
 import numpy as np
 
+from ..program.toolpath import Toolpath
+from ..errors import require
 from ..tolerances import Tolerances
 from .path_checks import check_feed, check_stop, check_theory, followed_edge, intended_span
 from .probe import offset_surface, shape_distances
@@ -41,6 +43,7 @@ def verify(toolpath, part=None, *, tol: Tolerances | None = None,
     ``progress(stage, done, total)`` is called as stages advance ("surfaces", "reference",
     "whole part").
     """
+    require("toolpath", toolpath, Toolpath, "a cadcnc Toolpath")
     tol = toolpath.job.tolerances if tol is None else tol
     part, probes = prepare(toolpath, part, tol)
     timer = {}
