@@ -9,19 +9,9 @@ import math
 import numba
 import numpy as np
 
-INSIDE = "inside"
-BOUNDARY = "boundary"
-OUTSIDE = "outside"
-TRIM_STATES = (INSIDE, BOUNDARY, OUTSIDE)
-
-# Cell labels of a trim grid (cadcnc.geometry.trim_grid builds it, ``lookup`` below reads
-# it for the compiled kernel and for TrimGrid.cell): small ints, stored as an int8 array.
-CELL_OUTSIDE = 0
-"""The whole cell is outside the trimmed face (the exact classifier says OUT everywhere)."""
-CELL_INSIDE = 1
-"""The whole cell is inside the trimmed face (the exact classifier says IN everywhere)."""
-CELL_MIXED = 2
-"""Near the trim boundary: ask the exact classifier."""
+from .trim_states import (  # noqa: F401 (one spelling for every layer, re-exported)
+    BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE, TRIM_STATES,
+)
 
 
 # -- Reading a trim grid: cadcnc.geometry.trim_grid builds it; the compiled kernel

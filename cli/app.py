@@ -206,15 +206,18 @@ def main(argv: list[str] | None = None) -> int:
         # importing the library (OCCT) takes ~1.5 s: `--help` and usage errors don't pay it;
         # Ctrl-C inside OCCT's C-extension import would surface as an ImportError
         with sigint_deferred():
-            from . import commands
+            if args.command == "faces":   # reads the part only: no interpolation core
+                from .faces import faces as run
+            else:
+                from . import commands
 
-            from .finish import finish_command
-            from .pencil import pencil_command
-            from .stream import stream_command
+                from .finish import finish_command
+                from .pencil import pencil_command
+                from .stream import stream_command
 
-        run = {"pencil": pencil_command, "finish": finish_command,
-               "stream": stream_command}.get(
-            args.command) or commands.COMMANDS[args.command]
+                run = {"pencil": pencil_command, "finish": finish_command,
+                       "stream": stream_command}.get(
+                    args.command) or commands.COMMANDS[args.command]
         return int(run(args) or 0)
     except KeyboardInterrupt:
         print("cadcnc: interrupted", file=sys.stderr)

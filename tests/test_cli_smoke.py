@@ -34,3 +34,15 @@ def test_error_is_one_line_with_exit_code(tmp_path):
     run = cadcnc("faces", "nope.step", cwd=tmp_path)
     assert run.returncode == 2
     assert run.stderr == "cadcnc: error: nope.step: no such file\n"
+
+
+def test_faces_loads_neither_numba_nor_the_interpolation_core():
+    """Listing a part's faces reads the part only (issue 20: it took 2.7 s and 420 MB)."""
+    code = ("import sys; from cadcnc.cli import main; "
+            f"main(['faces', {str(FIXTURES / 'pocket.step')!r}]); "
+            "print('numba' in sys.modules, any(m.startswith('cadcnc.interp') for m in "
+            "sys.modules))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.splitlines()[-1] == "False False"

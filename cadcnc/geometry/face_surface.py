@@ -28,10 +28,9 @@ from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
 
 from . import differential as dg
 from .surface_data import SURFACE_KINDS, SurfaceData, as_topods_face, surface_data
-from .trim_grid import TrimGrid
 from ..errors import GeometryError, InputError, SingularPointError
 from ..tolerances import DEFAULT, Tolerances
-from ..trim import BOUNDARY, INSIDE, OUTSIDE
+from ..trim_states import BOUNDARY, INSIDE, OUTSIDE
 
 @dataclass(frozen=True)
 class Derivatives:
@@ -112,12 +111,16 @@ class FaceSurface:
         return self.classify(u, w) != OUTSIDE
 
     @property
-    def kernel(self) -> tuple[SurfaceData, TrimGrid] | None:
+    def kernel(self) -> tuple[SurfaceData, "TrimGrid"] | None:
         """(surface data, trim grid) for the compiled stepper, built on first use (the
         grid build is planning time, reported by benchmarks/bench_trim_grid.py); None
         where the kernel cannot evaluate this face (OCCT's evaluation is used)."""
         if self._kernel is None:
             data = surface_data(self)
+            # imported here: the grid's build compiles with numba (0.4 s to import), which
+            # listing a part's faces (`cadcnc faces`) does not need
+            from .trim_grid import TrimGrid
+
             self._kernel = (data, TrimGrid.build(self, data=data)) if data is not None else ()
         return self._kernel or None
 
