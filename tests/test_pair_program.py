@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.errors import FacePairError, InputError
+from cadcnc.errors import EXIT_NOTHING, InputError, NothingToCutError
 from cadcnc.job import Job, PairPath, Tool
 from cadcnc.ops.path.pair_program import LIMIT_SLACK, program_for_job, safe_height
 from conftest import FIXTURES
@@ -69,8 +69,9 @@ def test_stretch_selection():
     ("undercut", ["no feasible ball position", "shank touches face 4"]),
 ])
 def test_no_stretch_is_refused_with_the_reason(name, words):
-    with pytest.raises(FacePairError) as err:
+    with pytest.raises(NothingToCutError) as err:   # valid input, nothing to cut: exit 3
         program_for_job(part_of(name), job_for(name))
+    assert err.value.exit_code == EXIT_NOTHING
     for w in words:
         assert w in str(err.value)
 

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.errors import FacePairError
+from cadcnc.errors import EXIT_NOTHING, NothingToCutError
 from cadcnc.guard import guard_for
 from cadcnc.job import Tool
 from cadcnc.ops.path.pair_path import pair_job
@@ -114,8 +114,10 @@ def test_edge_without_stretch_is_refused_with_its_reason(name):
     # the depth named is the closed form's (R' - 1 µm is the threshold)
     too_near = -(want["margin"] + UM)
     assert f"({too_near:.4g} mm too near)" in msg
-    with pytest.raises(FacePairError, match=f"faces {s1.number} and {s2.number}: no feasible"):
+    with pytest.raises(NothingToCutError, match=f"faces {s1.number} and {s2.number}: no "
+                       "feasible") as err:   # a valid pair with nothing to cut: exit 3
         stretch_paths(s1, s2, job, found=found)
+    assert err.value.exit_code == EXIT_NOTHING
 
 
 def test_a_path_per_stretch_runs_between_its_limits():

@@ -1,14 +1,37 @@
-"""What the operations share: the height of link moves, running one stretch's cut, and the
-program of a single path."""
+"""What the operations share: the ball checked up front, the cycles estimated up front, the
+height of link moves, running one stretch's cut, and the program of a single path."""
 
 from __future__ import annotations
 
-from ..errors import GeometryError
+from ..errors import GeometryError, InputError
 from ..job import SAFE_MARGIN, Job
 from ..program.linking import linked
 from ..program.program import CutSegment, Program
 from ..program.toolpath import Toolpath, toolpath_from_record
+from ..work import MAX_CYCLES, refuse_over
 from .path.pair_path import PathPlan, stepper_for
+
+
+def require_ball(job: Job) -> None:
+    """InputError unless the ball has a size: R' = R + C > 0 mm. A ball of R' = 0 runs its
+    centre on the faces, no curvature limits it and no move between its points can be
+    proven clear of the part (the gate refuses every one)."""
+    if not job.tool.offset > 0.0:
+        raise InputError(f"radius: a ball of R' = R + C = {job.tool.offset:g} mm has no size "
+                         "(its centre runs on the faces and no move can be proven clear of "
+                         "the part): give a radius > 0 mm")
+
+
+def refuse_cycles(lengths_mm, job: Job, what: str, max_cycles: int = MAX_CYCLES) -> float:
+    """The cycles ``job``'s step needs for paths of ``lengths_mm`` in all (their sum over
+    the step F Ts, the commanded step; the accuracy rule's shorter steps come on top),
+    refused up front (:class:`~cadcnc.work.WorkLimitError`) over ``max_cycles``."""
+    total = float(sum(lengths_mm))
+    cycles = total / job.step
+    refuse_over(f"{what}: {total:.4g} mm of corners at a step of {job.step:.3g} mm",
+                cycles, max_cycles, "interpolation cycles",
+                "raise --feed or --period (a longer step), or the cycle limit (max_cycles)")
+    return cycles
 
 
 def safe_height(part, job: Job) -> float:

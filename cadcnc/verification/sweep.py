@@ -55,7 +55,10 @@ class Polyline:
             raise ValueError(f"{stage}: position {int(bad[0])} is not finite "
                              f"({self.points[bad[0]].tolist()})")
         self.ball, self.hit, self.allowance = float(ball), hit, allowance
-        self.clearance = None if allowance is None else self.ball - allowance
+        # a ball no larger than the allowance (R' <= limit): still prove R'/2, so that a
+        # move touches no face, stays out of the material and reaches less than R' deep
+        self.clearance = None if allowance is None else max(self.ball - allowance,
+                                                            0.5 * self.ball)
         self.known, self.anchors = known or {}, anchors
         self.progress, self.stage = progress, stage
         n = len(self.points)

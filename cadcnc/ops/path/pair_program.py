@@ -25,7 +25,7 @@ from ...job import Job
 from ...program.linking import linked
 from ...program.program import STOPPED_SHORT, CutSegment, Program, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
-from ..common import run_stretch, safe_height
+from ..common import require_ball, run_stretch, safe_height
 from ...guard import guard_for
 from .pair_path import PathPlan, plan_path, shared_edge_for, stepper_for
 from .stretch_paths import nearest_start, plan_for_stretch, refuse_without_stretch
@@ -58,13 +58,14 @@ def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000, progress=Non
     """The :class:`Program` of a pair job on ``part`` (see the module doc).
 
     ``progress(cycles, mm)`` as for a path; ``found``: the pair's stretches when already
-    computed (``pair_stretches``). Raises FacePairError naming the reason per edge when
-    no edge has a feasible position.
+    computed (``pair_stretches``). Raises NothingToCutError (exit 3) naming the reason per
+    edge when no edge has a feasible position; InputError for a ball of R' = 0.
     """
     op = job.operation
     i, j = op.faces
     if i is None or j is None:
         raise InputError("the job names no faces: give the two face numbers")
+    require_ball(job)
     s1, s2 = part.face(i), part.face(j)
     guard = guard_for(part, (i, j), job)
     if op.start is not None:
@@ -121,7 +122,7 @@ def _reversed(tp: Toolpath, plan: PathPlan) -> PathPlan:
 
 
 def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
-                 progress=None, side: str | None = None
+                 progress=None, side: str | None = None, work: dict | None = None
                  ) -> tuple[list[CutSegment], list[Skipped]]:
     """A cut per stretch of ``found`` (every stretch, or stretch ``job.operation.stretch``
     of each edge), in order along each edge, and what was skipped: edges with no feasible
@@ -129,9 +130,12 @@ def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
 
     ``side``: CLIMB or CONVENTIONAL runs every cut that way (the material on the right of
     the travel for climb; see :func:`climb_measure`), re-running a cut from its other end
-    where the edge's own direction is the other way; None keeps the edge's direction."""
+    where the edge's own direction is the other way; None keeps the edge's direction.
+    ``work["cycles"]`` (when given) counts every stepper cycle run, re-runs included."""
     i, j = s1.number, s2.number
     cuts, skipped = [], []
+    work = {} if work is None else work
+    work.setdefault("cycles", 0)
     for e in found:
         if not e.stretches:
             skipped.append(Skipped((i, j), NO_STRETCH, e.refusal, e.edge + 1))
@@ -139,18 +143,20 @@ def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
         for k, st in enumerate(e.stretches, 1):
             if job.operation.stretch is not None and k != job.operation.stretch:
                 continue
-            cjob = _cut_job(job, st, k)
+            cjob = _short_period(_cut_job(job, st, k), st)
             plan = replace(plan_for_stretch(s1, s2, cjob, st), job=cjob)
             if st.length <= POINT_STRETCH:
                 cuts.append(CutSegment(_point_cut(plan), edge=e.edge + 1, stretch=k,
                                        at_limit=True))
                 continue
             tp = run_stretch(plan, guard, max_cycles, progress)
+            work["cycles"] += len(tp) - 1
             at_limit = _reached_limit(tp, st)
             if side is not None and at_limit and len(tp) > 2:
                 measure = climb_measure(tp)
                 if abs(measure) >= SIDE_MIN and (measure > 0) != (side == CLIMB):
                     back = run_stretch(_reversed(tp, plan), guard, max_cycles, progress)
+                    work["cycles"] += len(back) - 1
                     if back.complete or back.stop_reason in (BOUNDARY, COLLISION):
                         tp = back
             cuts.append(CutSegment(tp, edge=e.edge + 1, stretch=k, at_limit=at_limit))
@@ -166,6 +172,24 @@ POINT_STRETCH = 2e-3
 """mm: a stretch this short is one ball position (the ball fits a hole or a sphere of its
 own radius, R' k = 1: every feasible position of the corner is the same centre), cut as a
 single point reached by the plunge."""
+
+
+SHORT_STEPS = 4
+"""Steps at least, of a cut whose stretch is shorter than that many steps."""
+
+
+def _short_period(job: Job, st: Stretch) -> Job:
+    """The job of a stretch's cut, with a shorter period (the same feed) when the stretch
+    is shorter than SHORT_STEPS steps: the stepper lands on its end only after 2 steps
+    (so that a closed path does not stop at its start), and would otherwise run past the
+    end of a stretch shorter than that (a 0.007 mm edge: 8 mm past it, to a boundary)."""
+    if st.closed or st.length <= POINT_STRETCH:
+        return job
+    chord = float(np.linalg.norm(np.subtract(st.end.p, st.start.p)))
+    length = min(st.length, chord) if chord > 0.0 else st.length
+    if length >= SHORT_STEPS * job.step:
+        return job
+    return replace(job, period=job.period * length / (SHORT_STEPS * job.step))
 
 
 def _point_cut(plan: PathPlan) -> Toolpath:

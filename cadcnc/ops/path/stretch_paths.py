@@ -4,7 +4,7 @@
 (:func:`~cadcnc.ops.path.stretches.pair_stretches`) and runs the stepper once per stretch,
 from its start limit to its end limit (``end=`` given, so the last step lands on it);
 a closed edge feasible all around is followed once around. A pair with no stretch at
-all is refused with the reason per edge. :func:`nearest_start` moves a user's start that
+all is refused with the reason per edge (NothingToCutError, exit 3). :func:`nearest_start` moves a user's start that
 lies outside every stretch to the nearest stretch limit and says so.
 Units: mm.
 """
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import FacePairError
+from ...errors import NothingToCutError
 from ...guard.clearance import ClearanceGuard
 from ...job import Job
 from ...program.toolpath import Toolpath
@@ -29,11 +29,12 @@ def plan_for_stretch(s1, s2, job: Job, stretch: Stretch) -> PathPlan:
 
 
 def refuse_without_stretch(s1, s2, found: list[EdgeStretches]) -> None:
-    """FacePairError naming, per edge, why no position is feasible (if none is)."""
+    """NothingToCutError (exit 3: a valid pair, nothing to cut) naming, per edge, why no
+    position is feasible (if none is)."""
     if any(e.stretches for e in found):
         return
     reasons = "; ".join(e.refusal for e in found)
-    raise FacePairError(f"faces {s1.number} and {s2.number}: no feasible ball position "
+    raise NothingToCutError(f"faces {s1.number} and {s2.number}: no feasible ball position "
                         f"along their shared concave edge(s): {reasons}")
 
 
@@ -63,7 +64,7 @@ def nearest_start(found: list[EdgeStretches], feas: Feasibility, point):
     point = np.asarray(point, dtype=float)
     limits = [lim for e in found for st in e.stretches for lim in (st.start, st.end)]
     if not limits:
-        raise FacePairError("no feasible stretch to start in: "
+        raise NothingToCutError("no feasible stretch to start in: "
                             + "; ".join(e.refusal for e in found))
     nearest = min(limits, key=lambda lim: float(np.linalg.norm(np.subtract(lim.p, point))))
     edge_samples = [x for e in found for x in e.samples if x.tangency is not None]

@@ -119,6 +119,7 @@ class EdgeStretches:
     stretches: list[Stretch] = field(default_factory=list)
     samples: list[Sample] = field(default_factory=list)
     missed: int = 0
+    why: str = ""         # why the edge was not searched (a degenerate edge)
 
     @property
     def refusal(self) -> str | None:
@@ -126,6 +127,8 @@ class EdgeStretches:
         the edge itself, with an example), or None when it has a stretch."""
         if self.stretches:
             return None
+        if self.why or not self.samples:
+            return f"edge {self.edge + 1}: {self.why or 'not searched'}"
         on_edge = [x for x in self.samples if 0.0 <= x.s <= self.length] or self.samples
         counts: dict[str, int] = {}
         for x in on_edge:
@@ -147,11 +150,15 @@ class Feasibility:
         self.tol = job.tolerances
         self.guard = guard
         self.max_reach = 10.0 * max(max(self.offsets), 1e-3)   # mm from the anchor
+        self.samples, self.beat = 0, None   # positions judged; called after each (progress)
 
     def sample(self, s: float, anchor, tangent, seed: Tangency | None = None) -> Sample:
         """Solve the tangency in the plane through ``anchor`` normal to ``tangent`` (seeded
         from ``seed`` or the projections of the anchor) and judge it."""
         tangent = tuple(map(float, tangent))
+        self.samples += 1
+        if self.beat is not None:
+            self.beat()
         try:
             seeds = ([seed.uv1, seed.uv2] if seed is not None else
                      [_project(s, anchor) for s in (self.s1, self.s2)])
@@ -193,7 +200,10 @@ def too_tight(rk: float, offset: float, tol: Tolerances) -> bool:
     """Whether a concave curvature k with R' k = ``rk`` is tighter than a ball of offset
     R' (mm) can follow. R' k = 1 is a tie: the ball fits the face exactly (a hole of its
     own radius) and does not cut it; past 1 + gouge / 2 R' it cuts the face deeper than
-    the spec's 1 um (a cylinder of radius R'/(R' k) is cut by ~2 R' (R' k - 1))."""
+    the spec's 1 um (a cylinder of radius R'/(R' k) is cut by ~2 R' (R' k - 1)). A ball
+    of R' <= 0 is a point: no curvature is too tight for it."""
+    if not offset > 0.0:
+        return False
     return rk > 1.0 + tol.gouge / (2.0 * offset)
 
 
@@ -215,6 +225,10 @@ def edge_stretches(feas: Feasibility, shared_edge, edge: int,
     concave edge of the same pair continues it (that edge's own search covers it, and two
     cuts would overlap)."""
     curve = EdgeCurve(shared_edge)
+    if not curve.closed and not curve.length >= feas.tol.gouge:
+        return EdgeStretches(edge, curve.length, why=(
+            f"degenerate edge of {curve.length:.3g} mm, shorter than the gouge limit "
+            f"{feas.tol.gouge:g} mm: not a corner"))
     ext = 0.0 if curve.closed else max(feas.offsets) + 1.0
     n = max(MIN_SAMPLES, int(math.ceil(curve.length / spacing)) + 1)
     grid = np.linspace(0.0, curve.length, n)
@@ -345,16 +359,19 @@ def _polyline(tangencies: list[Tangency]) -> float:
 
 
 def pair_stretches(s1, s2, job: Job, guard: ClearanceGuard | None = None,
-                   spacing: float = SPACING) -> list[EdgeStretches]:
+                   spacing: float = SPACING, feas: Feasibility | None = None
+                   ) -> list[EdgeStretches]:
     """Every stretch of every shared concave edge of two faces of one part.
 
-    ``guard`` defaults to the job's tool (R', shank length, tolerance ``hit``).
+    ``guard`` defaults to the job's tool (R', shank length, tolerance ``hit``); ``feas``:
+    the judge of positions to use (one whose ``beat`` reports progress), else built here.
     """
     part = s1.part
     edges = [e for e in part.shared_edges(s1.number, s2.number) if e.edge_class == CONCAVE]
-    if guard is None:
-        guard = guard_for(part, (s1.number, s2.number), job)
-    feas = Feasibility(s1, s2, job, guard)
+    if feas is None:
+        if guard is None:
+            guard = guard_for(part, (s1.number, s2.number), job)
+        feas = Feasibility(s1, s2, job, guard)
     return [edge_stretches(feas, e, k, spacing, (not _continued(e.start, e, edges),
                                                  not _continued(e.end, e, edges)))
             for k, e in enumerate(edges)]

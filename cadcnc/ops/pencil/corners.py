@@ -13,7 +13,8 @@ Corners found and not to be cut carry ``skip`` (a reason key) and ``detail`` (a 
 ``tangent`` faces, a ``mixed`` edge, a blend the ball rolls on (``blend_rolls``), a face
 tighter than the ball or facing its partner (``no_fit``), a ``vertex_blend``, a blend
 whose rails reach other than two faces (``blend_rails``), faces left out by ``faces=``
-(``not_selected``). Lengths mm.
+(``not_selected``), a concave edge shorter than the gouge limit (``degenerate``: a
+sliver of the model, not a corner). Lengths mm.
 """
 
 from __future__ import annotations
@@ -27,13 +28,14 @@ from ...geometry.blends import Blend, find_blends
 from ...geometry.part import CONCAVE, MIXED, TANGENT, Part
 from ...job import Tool
 from ...program.program import Skipped
-from ...tolerances import DEFAULT
+from ...tolerances import DEFAULT, Tolerances
 from ..path.stretches import too_tight
 
 EDGE, BLEND = "edge", "blend"
 TANGENT_FACES, MIXED_EDGE, BLEND_ROLLS = "tangent", "mixed", "blend_rolls"
 NO_FIT, VERTEX_BLEND, BLEND_RAILS, NOT_SELECTED = ("no_fit", "vertex_blend", "blend_rails",
                                                    "not_selected")
+DEGENERATE = "degenerate"  # a concave edge shorter than the gouge limit: nothing to cut
 SAME_POINT = 1e-4  # mm: rail end points closer than this are one vertex
 SEED_ITERATIONS = 4  # tangent-plane solves of a blend seed (curved faces a, b)
 ROLLS = 1e-9      # relative: a blend of radius >= R' (1 - ROLLS) is one the ball rolls on
@@ -80,18 +82,19 @@ def _pair(i: int, j: int) -> tuple[int, int]:
 
 
 def find_corners(part: Part, radius: float, allowance: float = 0.0,
-                 faces=None) -> list[Corner]:
+                 faces=None, tol: Tolerances = DEFAULT) -> list[Corner]:
     """Every corner of ``part`` for a ball of radius R (mm) and allowance C (mm), in order.
 
     ``faces``: None for all faces, else an iterable of face numbers: corners whose two faces
-    are not both in it are returned skipped (``not_selected``).
+    are not both in it are returned skipped (``not_selected``). ``tol.gouge``: concave
+    edges shorter than it are skipped (``degenerate``).
     """
     rp = Tool(radius, allowance).offset
     blends, kranges = find_blends(part)
     # faces concave tighter than the ball at every sample: {face: least k_max, 1/mm}
     tight = {n: klo for n, (klo, _) in kranges.items() if too_tight(klo * rp, rp, DEFAULT)}
     corners = _blend_corners(part, blends, tight, rp)
-    corners += _edge_corners(part, blends, tight, rp)
+    corners += _edge_corners(part, blends, tight, rp, tol.gouge)
     if faces is not None:
         keep = {int(n) for n in faces}
         for n in keep:
@@ -103,9 +106,9 @@ def find_corners(part: Part, radius: float, allowance: float = 0.0,
 
 
 def _edge_corners(part: Part, blends: dict[int, Blend], tight: dict[int, float],
-                  rp: float) -> list[Corner]:
-    """Concave edges (cut unless a face is tighter than the ball), mixed and tangent edges
-    not belonging to a blend (skipped)."""
+                  rp: float, shortest: float) -> list[Corner]:
+    """Concave edges (cut unless a face is tighter than the ball or the edge is shorter
+    than ``shortest`` mm), mixed and tangent edges not belonging to a blend (skipped)."""
     owned = {id(e) for b in blends.values() for _, e in b.rails + b.ends}
     out = []
     for (i, j), edges in part.adjacency.items():
@@ -113,7 +116,11 @@ def _edge_corners(part: Part, blends: dict[int, Blend], tight: dict[int, float],
         for k, e in enumerate(concave):
             c = Corner(EDGE, (i, j), edge=k, length=float(e.length), closed=e.closed)
             small = [n for n in (i, j) if n in tight]
-            if small:
+            if not e.closed and not e.length >= shortest:
+                c = replace(c, skip=DEGENERATE, detail=(
+                    f"degenerate edge of {e.length:.3g} mm, shorter than the gouge limit "
+                    f"{shortest:g} mm: a sliver of the model, not a corner"))
+            elif small:
                 r = 1.0 / tight[small[0]]
                 c = replace(c, skip=NO_FIT, detail=(
                     f"face {small[0]} is concave tighter than the ball everywhere (radius "

@@ -19,6 +19,7 @@ and so do blend corners (from the blend's first seed to its second) in this vers
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import replace
 
@@ -30,12 +31,14 @@ from ...job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
 from ...program.linking import linked, order_cuts
 from ...program.program import CutSegment, Program, Skipped
 from ...tolerances import DEFAULT, Tolerances
-from .corners import BLEND, EDGE, find_corners
+from ...work import MAX_CYCLES, Heartbeat, refuse_over
+from .corners import BLEND, EDGE, Corner, find_corners
 from ...guard import guard_for
-from ..common import run_stretch, safe_height
+from ..common import refuse_cycles, require_ball, run_stretch, safe_height
 from ..path.pair_program import CLIMB, stretch_cuts
 from ..path.pair_path import plan_path
-from ..path.stretches import Feasibility, edge_stretches, pair_stretches
+from ..path.stretches import (LIMIT_TOL, MIN_SAMPLES, SPACING, Feasibility,
+                              edge_stretches, pair_stretches)
 
 CHAIN_GAP = 1e-3
 """mm: a cut starting this near another's end continues it (no lift)."""
@@ -59,66 +62,87 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
     if not isinstance(part, Part):
         part = Part.from_cadquery(part, tol)
     job = Job(Tool(radius, allowance, shank_length), feed, period,
-              Pencil(None if faces is None else tuple(sorted(faces)), side),
+              Pencil(faces, side),
               source=part.source, clearance=clearance, tolerances=tol)
     return pencil_program(part, job, progress=progress, times=times)
 
 
-def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = None
-                   ) -> Program:
+def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = None,
+                   max_cycles: int = MAX_CYCLES, clock=time.monotonic,
+                   work: dict | None = None) -> Program:
     """The pencil program of a :class:`~cadcnc.job.Pencil` ``job`` on ``part``.
 
-    ``progress(done, total, what)`` after each corner. ``times``: a dict to which the
-    seconds spent per stage are added (``edges``: the part's edge classification;
+    ``progress(done, total, what)`` after each corner, and within a corner at least every
+    HEARTBEAT_S seconds of ``clock`` (the stretch search, sample by sample; the stepper;
+    the linking), ``done`` then counting the corners finished. ``times``: a dict to which
+    the seconds spent per stage are added (``edges``: the part's edge classification;
     ``corners``; ``guards``: building the third-face guards; ``stretches``: the stretch
     search; ``interpolation``: the stepper along every stretch; ``linking``: reachability
-    from +Z, ordering and links).
+    from +Z, ordering and links). Before any corner is cut, the work is estimated
+    (:func:`estimate_work`) and refused over ``max_cycles`` interpolation cycles or
+    MAX_SAMPLES search samples (:class:`~cadcnc.work.WorkLimitError`, exit 2); ``work``:
+    a dict given the estimates and the counts (``cycles_estimate``, ``samples_estimate``,
+    ``cycles``: every stepper cycle run, re-runs included; ``samples``).
     """
-    clock = _Clock(times)
+    require_ball(job)
+    stage = _Clock(times)
     op, tool = job.operation, job.tool
     side = op.side
     faces = None if op.faces is None else set(op.faces)
     radius, allowance = tool.radius, tool.allowance
-    with clock("edges"):
+    with stage("edges"):
         part.adjacency
-    with clock("corners"):
-        corners = find_corners(part, radius, allowance, faces)
+    with stage("corners"):
+        corners = find_corners(part, radius, allowance, faces, job.tolerances)
     cuts: list[CutSegment] = []
     skipped: list[Skipped] = [c.skipped() for c in corners if not c.cut]
     todo = [c for c in corners if c.cut]
+    work = {} if work is None else work
+    work.update(estimate_work(todo, job, max_cycles), cycles=0, samples=0)
     stretches: dict = {}
     guards: dict = {}
+    beat = Heartbeat(progress and (lambda text: progress(done, len(todo), text)), clock=clock)
+    done = 0
     for k, corner in enumerate(todo, 1):
         i, j = corner.faces
         cjob = replace(job, operation=PairPath(faces=(i, j), edge=corner.edge))
+        at = f"faces {i} {j}"
+        feas = None
+        steps = (lambda cycles, mm: beat.beat(f"{at}: interpolating, {cycles} cycles"))
         try:
             s1, s2 = part.face(i), part.face(j)
-            with clock("guards"):   # one per pair (its cache serves all its corners)
+            with stage("guards"):   # one per pair (its cache serves all its corners)
                 guard = guards.get((i, j)) or guards.setdefault(
                     (i, j), guard_for(part, (i, j), cjob))
+            beat.beat(f"{at}: guard built")
+            feas = Feasibility(s1, s2, cjob, guard)
+            feas.beat = lambda: beat.beat(lambda: f"{at}: stretch search, {feas.samples} "
+                                          "ball positions")
             if corner.kind == EDGE:
-                with clock("stretches"):
+                with stage("stretches"):
                     if (i, j) not in stretches:
-                        stretches[(i, j)] = pair_stretches(s1, s2, cjob, guard)
+                        stretches[(i, j)] = pair_stretches(s1, s2, cjob, guard, feas=feas)
                 found = [stretches[(i, j)][corner.edge]]
-                with clock("interpolation"):
-                    new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
+                with stage("interpolation"):
+                    new, why = stretch_cuts(s1, s2, cjob, found, guard, max_cycles, steps,
+                                            side=side, work=work)
                 cuts += new
                 skipped += why
             elif corner.kind == BLEND and len(corner.rails) == 1:
                 # the ball's stretches anchored on planes normal to the blend's rail on a
-                with clock("stretches"):
-                    found = [edge_stretches(Feasibility(s1, s2, cjob, guard),
-                                            corner.rails[0], 0)]
-                with clock("interpolation"):
-                    new, why = stretch_cuts(s1, s2, cjob, found, guard, side=side)
+                with stage("stretches"):
+                    found = [edge_stretches(feas, corner.rails[0], 0)]
+                with stage("interpolation"):
+                    new, why = stretch_cuts(s1, s2, cjob, found, guard, max_cycles, steps,
+                                            side=side, work=work)
                 cuts += new
                 skipped += [replace(w, detail=f"blend corner over face(s) "
                                     f"{', '.join(map(str, corner.blend_faces))}: {w.detail}")
                             for w in why]
             elif corner.kind == BLEND:
-                with clock("interpolation"):
-                    cut = _blend_cut(s1, s2, cjob, corner, guard)
+                with stage("interpolation"):
+                    cut = _blend_cut(s1, s2, cjob, corner, guard, max_cycles, steps)
+                work["cycles"] += len(cut.points) - 1
                 if len(cut.points) < 2:
                     skipped.append(Skipped((i, j), cut.path.stop_reason, (
                         f"blend corner over face(s) {', '.join(map(str, corner.blend_faces))}"
@@ -128,17 +152,56 @@ def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = 
         except CadcncError as e:
             skipped.append(Skipped((i, j), "failed", f"{corner.kind} corner: {e}",
                                    None if corner.edge is None else corner.edge + 1))
+        work["samples"] += 0 if feas is None else feas.samples
+        done = k
         if progress is not None:
-            progress(k, len(todo), f"faces {i} {j}")
-    with clock("linking"):
+            progress(k, len(todo), at)
+            beat.last = beat.clock()
+    with stage("linking"):
         z_safe = safe_height(part, job)
-        ordered, unreachable = reachable_order(part, job, cuts, z_safe)
+        ordered, unreachable = reachable_order(part, job, cuts, z_safe, beat)
         segments = linked(ordered, z_safe, join=CHAIN_GAP)
     return Program(job, segments, skipped + unreachable)
 
 
+MAX_SAMPLES = 400_000
+"""Ball positions one stretch search may solve in all (about a minute or two): over it,
+the search is refused up front (:func:`search_samples`)."""
+
+
+def search_samples(length: float, offset: float, closed: bool = False) -> int:
+    """About how many ball positions the search of an edge of ``length`` mm solves for a
+    ball of offset R' = ``offset`` mm: the grid every SPACING mm (at least MIN_SAMPLES),
+    R' + 1 mm past each end of an open edge, and the bisection of two limits (SPACING to
+    LIMIT_TOL); more stretches and the refinement add on top."""
+    n = max(MIN_SAMPLES, int(math.ceil(length / SPACING)) + 1)
+    ext = 0.0 if closed else max(offset, 0.0) + 1.0
+    bisect = 2 * int(math.ceil(math.log2(SPACING / LIMIT_TOL)))
+    return n + 2 * int(math.ceil(ext / max(SPACING, length / max(n - 1, 1)))) + bisect
+
+
+def estimate_work(todo: list[Corner], job: Job, max_cycles: int = MAX_CYCLES) -> dict:
+    """The work of cutting the corners ``todo``, estimated before any is searched or cut,
+    and refused (:class:`~cadcnc.work.WorkLimitError`) over its limit:
+    ``cycles_estimate``: their lengths over the step F Ts, twice (a cut whose corner runs
+    against ``side`` is run again from its other end), over ``max_cycles``; ``samples_estimate``: the ball positions their stretch search solves
+    (:func:`search_samples`), over MAX_SAMPLES."""
+    rp = job.tool.offset
+    length = sum(c.length for c in todo)
+    samples = sum(search_samples(c.length, rp, c.closed) for c in todo
+                  if c.kind == EDGE or len(c.rails) == 1)
+    runs = 1 if job.operation.side is None else 2   # a cut may be run again the other way
+    cycles = refuse_cycles([runs * length], job, f"pencil of {len(todo)} corner(s)",
+                           max_cycles)
+    refuse_over(f"the stretch search of {len(todo)} corner(s) ({length:.4g} mm of corners, "
+                f"searched R' + 1 = {rp + 1:.4g} mm past each end)", samples, MAX_SAMPLES,
+                "ball positions", "a smaller --radius or --allowance, or fewer corners "
+                "(--faces)")
+    return dict(cycles_estimate=cycles, samples_estimate=samples)
+
+
 class _Clock:
-    """``with clock(stage):`` adds the block's wall seconds to ``times[stage]`` (no-op
+    """``with stage(name):`` adds the block's wall seconds to ``times[stage]`` (no-op
     without a dict)."""
 
     def __init__(self, times: dict | None):
@@ -162,7 +225,8 @@ class _Clock:
 NOT_REACHABLE = "not reachable from +Z"
 
 
-def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float
+def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float,
+                    beat: Heartbeat | None = None
                     ) -> tuple[list[CutSegment], list[Skipped]]:
     """The cuts the tool can reach from above, in linking order (:func:`order_cuts`), and
     the others skipped as "not reachable from +Z". A chain is entered by a plunge straight
@@ -172,7 +236,8 @@ def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float
     less the gate's tolerance (:func:`.guard.guard_for`, the stepper's guard with a longer
     shank): not so in a sealed
     void, or under an overhang higher than the shank. A cut whose entry or exit is
-    blocked is dropped and the rest ordered again (its neighbours may then need one)."""
+    blocked is dropped and the rest ordered again (its neighbours may then need one).
+    ``beat``: a :class:`~cadcnc.work.Heartbeat` told of every cut checked."""
     lo, _ = part.bounding_box()
     shank = max(z_safe - float(lo[2]), job.tool.shank)
     guards: dict = {}
@@ -193,6 +258,8 @@ def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float
         ordered = order_cuts(cuts, CHAIN_GAP)
         bad = {}
         for k, cut in enumerate(ordered):
+            if beat is not None:
+                beat.beat(f"linking: {k} of {len(ordered)} cuts checked for reach from +Z")
             why = []
             if k == 0 or np.linalg.norm(cut.points[0] - ordered[k - 1].points[-1]) > CHAIN_GAP:
                 why.append(blocked(cut, "start", cut.points[0]))
@@ -212,12 +279,12 @@ def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float
         cuts = [c for c in ordered if id(c) not in bad]
 
 
-def _blend_cut(s1, s2, job: Job, corner, guard) -> CutSegment:
+def _blend_cut(s1, s2, job: Job, corner, guard, max_cycles: int, progress) -> CutSegment:
     """The cut bridging a blend: from its first seed to its second (once around when the
     blend is closed), stopped by the guard or a boundary where the ball cannot go on."""
     seeds = corner.seeds
     op = replace(job.operation, start=tuple(seeds[0]),
                  end=tuple(seeds[1]) if len(seeds) > 1 else None, edge=None)
     plan = plan_path(s1, s2, replace(job, operation=op))
-    tp = run_stretch(plan, guard, 1_000_000, None, allow_empty=True)
+    tp = run_stretch(plan, guard, max_cycles, progress, allow_empty=True)
     return CutSegment(tp, edge=None, at_limit=tp.stop_reason in ("boundary", "collision"))
