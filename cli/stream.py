@@ -4,8 +4,16 @@ Reads the machine (``--machine FILE.ini``, LinuxCNC's INI; default a Tormach PCN
 plans the feed to its axis limits, re-runs every cut on the part with the planned feed
 as the per-cycle override, gates every streamed position and chord against the whole
 part, and only then writes ``.npy`` (N, 3) or ``.txt`` (halstreamer ``cfg=fff``)
-atomically. Exit 0 written, 2 bad input (INI, limits, feed), 3 the kernel could not
-re-run a cut, 5 the gate refused the stream.
+atomically. With ``--hal`` the gated stream is then executed by LinuxCNC's HAL
+(``streamer`` into one ``limit3`` per axis at the machine's limits, read back by
+``halsampler``: :func:`cadcnc.controller.hal.run_hal_loop`). Exit 0 written (and, with
+``--hal``, executed as streamed), 1 HAL could not start or run (its own text), 2 bad input
+(INI, limits, feed), 3 the kernel could not re-run a cut, 5 the gate refused the stream,
+6 the executed program fell short of the stream (a sample clipped by ``limit3`` or an
+underrun within the program), 130 Ctrl-C (HAL unloaded).
+
+:func:`stream_outputs` is the whole command after its arguments are read, for the other
+commands' ``--stream OUT`` option.
 """
 
 from __future__ import annotations
@@ -17,7 +25,6 @@ from cadcnc.units import parse_feed, parse_length
 from .feedback import say_error
 
 SUFFIXES = (".npy", ".txt")
-GOUGE_REFUSED = 5
 
 
 def add_parser(add, flip, gouge) -> None:
@@ -30,8 +37,8 @@ def add_parser(add, flip, gouge) -> None:
             "the exact path, gate them against the part, and write them: .npy (N x 3 "
             "float64, mm) or .txt (one 'X Y Z' line per period, halstreamer cfg=fff).")
     p.add_argument("program", metavar="PROGRAM.json")
-    p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
-                   help=".npy or .txt; repeat for both")
+    p.add_argument("-o", "--output", action="append", metavar="OUT",
+                   help=".npy or .txt; repeat for both (optional with --hal)")
     p.add_argument("--machine", metavar="FILE.ini",
                    help="LinuxCNC INI: [EMCMOT] SERVO_PERIOD, [TRAJ] LINEAR_UNITS, [AXIS_X/Y/Z] "
                         "MAX_VELOCITY, MAX_ACCELERATION, MAX_JERK (default: a Tormach "
@@ -44,6 +51,11 @@ def add_parser(add, flip, gouge) -> None:
                    help="stream at the programmed feed ignoring the limits (a comparison)")
     p.add_argument("--part", metavar="PART.step",
                    help="the part (default: the STEP file recorded in the program)")
+    p.add_argument("--hal", action="store_true",
+                   help="then execute the stream in LinuxCNC's HAL (streamer -> limit3 at "
+                        "the machine's limits -> sampler; needs linuxcnc-uspace) and report "
+                        "samples, underruns, executed - commanded, clipped samples (exit 6 "
+                        "if any sample was clipped or underran)")
     flip(p)
     gouge(p)
 
@@ -63,19 +75,14 @@ def machine_of(args):
 
 
 def stream_command(args) -> int:
-    import numpy as np
-
     import cadcnc
-    from cadcnc.controller.stream import stream_program, stream_text
     from cadcnc.errors import InputError
-    from cadcnc.io.output_set import OutputSet
     from cadcnc.io.program_json import read_program
-    from cadcnc.ops.stream_steppers import stepper_factory
-    from cadcnc.verification import gate_program
 
     from .options import tolerances
 
-    outputs = OutputSet(args.output, SUFFIXES, inputs=[args.program])
+    if not args.output and not args.hal:
+        raise InputError("stream: give -o OUT (.npy or .txt), --hal, or both")
     machine = machine_of(args)
     feed = None if args.feed is None else parse_feed(args.feed)
     tol = tolerances(args)
@@ -84,25 +91,74 @@ def stream_command(args) -> int:
     if not source:
         raise InputError(f"{args.program}: the program names no part: give --part PART.step")
     part = cadcnc.load_step(source, flip_material=args.flip_material)
+    return stream_outputs(program, part, machine, args.output or [], feed=feed,
+                          planned=not args.constant_feed, tolerances=tol,
+                          allow_gouge=args.allow_gouge, hal=args.hal, quiet=args.quiet,
+                          name=str(args.program), inputs=[args.program])
+
+
+def stream_outputs(program, part, machine, out, *, feed=None, planned=True, tolerances=None,
+                   allow_gouge=False, hal=False, quiet=False, name="program",
+                   inputs=()) -> int:
+    """Stream ``program`` on ``part`` to ``machine`` and write it to ``out`` (a path or a
+    list of paths, ``.npy`` / ``.txt``); optionally execute it in HAL. The exit code (see
+    the module doc); raises the library's errors (InputError, GeometryError, HalError...).
+
+    For ``path``, ``pencil`` and ``finish --stream OUT``: call it with the program they
+    computed, the part, :func:`machine_of` of the arguments and OUT, after their own
+    outputs are written."""
+    import numpy as np
+
+    from cadcnc.controller.stream import stream_program, stream_text
+    from cadcnc.errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL
+    from cadcnc.io.output_set import OutputSet
+    from cadcnc.ops.stream_steppers import stepper_factory
+    from cadcnc.tolerances import DEFAULT
+    from cadcnc.verification import gate_program
+
+    if hal:
+        from cadcnc.controller.hal import HalError, hal_available
+
+        missing = hal_available()
+        if missing:
+            raise HalError(f"--hal: HAL tools {missing} (install linuxcnc-uspace)")
+    outs = [out] if isinstance(out, (str, bytes)) or hasattr(out, "__fspath__") else list(out)
+    outputs = OutputSet(outs, SUFFIXES, inputs=list(inputs)) if outs else None
     stream = stream_program(program, machine, stepper_factory(part), feed=feed,
-                            planned=not args.constant_feed)
-    gate = gate_program(program, part, tol, moves=stream.segment_moves(program))
-    if not gate.ok and not args.allow_gouge:
+                            planned=planned)
+    gate = gate_program(program, part, tolerances or DEFAULT,
+                        moves=stream.segment_moves(program))
+    if not gate.ok and not allow_gouge:
         say_error(f"cadcnc: stream: {gate.message}; nothing written (--allow-gouge writes it)")
-        return GOUGE_REFUSED
-    contents = {}
-    for out in outputs.destinations:
-        if out.suffix.lower() == ".npy":
-            buf = io.BytesIO()
-            np.save(buf, stream.positions)
-            contents[out] = buf.getvalue()
-        else:
-            contents[out] = stream_text(stream.positions)
-    outputs.write(contents)
-    if not args.quiet:
-        print(summary_text(stream, args.program))
-        print(f"  wrote      {', '.join(map(str, outputs.destinations))}")
-    return 0 if gate.ok else GOUGE_REFUSED
+        return EXIT_GOUGE
+    if outputs is not None:
+        contents = {}
+        for dest in outputs.destinations:
+            if dest.suffix.lower() == ".npy":
+                buf = io.BytesIO()
+                np.save(buf, stream.positions)
+                contents[dest] = buf.getvalue()
+            else:
+                contents[dest] = stream_text(stream.positions)
+        outputs.write(contents)
+    if not quiet:
+        print(summary_text(stream, name))
+        if outputs is not None:
+            print(f"  wrote      {', '.join(map(str, outputs.destinations))}")
+    code = EXIT_OK if gate.ok else EXIT_GOUGE
+    if hal:
+        from cadcnc.controller.hal import run_hal_loop, summary as hal_report
+
+        result = run_hal_loop(stream.positions, machine, limits="machine")
+        fell_short = result.clipped or result.underruns or result.overruns
+        if not quiet or fell_short:
+            print(hal_report(result))
+        if fell_short:
+            say_error(f"cadcnc: stream: HAL executed less than the stream: {result.clipped} "
+                      f"samples clipped by limit3, {result.underruns} underruns, "
+                      f"{result.overruns} samples lost")
+            code = max(code, EXIT_PARTIAL)
+    return code
 
 
 def summary_text(stream, name: str) -> str:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 
 import numpy as np
 import pytest
@@ -64,3 +65,43 @@ def test_ctrl_c_leaves_no_file(program, tmp_path, monkeypatch, where):
     run = cadcnc_cli("stream", program, "-o", tmp_path / "s.npy", "-o", tmp_path / "s.txt")
     assert run.returncode == 130 and "interrupted" in run.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+needs_hal = pytest.mark.skipif(shutil.which("halrun") is None,
+                               reason="halrun not installed (apt install linuxcnc-uspace)")
+
+
+@needs_hal
+def test_hal_executes_the_planned_stream_unclipped(program, tmp_path):
+    """--hal: the gated stream through streamer -> limit3 at the machine's limits ->
+    sampler; every sample read back, no underrun, nothing clipped, executed = commanded."""
+    out = tmp_path / "s.npy"
+    run = cadcnc_cli("stream", program, "-o", out, "--feed", "10000", "--hal", check=0)
+    n = len(np.load(out))
+    assert f"HAL loop: {n} periods" in run.stdout, run.stdout
+    assert "underruns within the program: 0;" in run.stdout
+    assert f"samples clipped by limit3: 0 of {n} in the program" in run.stdout
+    got = float(run.stdout.split("executed - commanded: max ")[1].split()[0])
+    assert got <= 1e-6
+
+
+@needs_hal
+def test_hal_reports_clipping_of_a_constant_feed_stream_as_exit_6(program):
+    """At constant 10 000 mm/min the stream asks 167 mm/s of axes limited to 57 mm/s:
+    limit3 clips it, and the run is a failure (exit 6) saying so; no file is needed."""
+    run = cadcnc_cli("stream", program, "--hal", "--constant-feed", "--feed", "10000")
+    assert run.returncode == 6, (run.returncode, run.stdout, run.stderr)
+    assert "HAL executed less than the stream" in run.stderr
+    clipped = int(run.stderr.split("HAL executed less than the stream: ")[1].split()[0])
+    assert clipped > 10
+
+
+def test_hal_that_cannot_start_is_exit_1_with_the_reason(program, monkeypatch, tmp_path):
+    monkeypatch.setenv("PATH", str(tmp_path))   # no halrun on it
+    run = cadcnc_cli("stream", program, "--hal")
+    assert run.returncode == 1 and "not on PATH: halrun" in run.stderr, run.stderr
+
+
+def test_stream_needs_an_output_or_hal(program):
+    run = cadcnc_cli("stream", program)
+    assert run.returncode == 2 and "--hal" in run.stderr

@@ -39,7 +39,7 @@ QUANTUM = 1e-9  # mm: resolution of the sampled positions (µm printed with 6 de
 
 @dataclass(frozen=True)
 class Limits:
-    """The machine used when cadcnc.controller.machine is absent (s, mm/s, mm/s², mm/s³)."""
+    """A faster machine than the default (s, mm/s, mm/s², mm/s³): the synthetic table's."""
 
     period: float = 0.001
     max_velocity: tuple = (10000 / 60, 10000 / 60, 5000 / 60)
@@ -185,13 +185,12 @@ def _line(r: dict) -> str:
 
 
 def machine_under_test(args):
-    """cadcnc's Machine defaults where that module exists, else :class:`Limits`."""
-    try:
-        from cadcnc.controller.machine import Machine  # issue 21; absent on older trees
-        m = Machine()
-    except ImportError:
-        m = Limits()
-    return m
+    """``--machine fast`` (default): :class:`Limits`, the machine of the synthetic-curve
+    table in docs/notes/controller.md; ``default``: cadcnc's ``Machine.default()``."""
+    if args.machine == "default":
+        from cadcnc.controller.machine import Machine
+        return Machine.default()
+    return Limits()
 
 
 def main() -> None:
@@ -202,6 +201,9 @@ def main() -> None:
     ap.add_argument("--polyline", choices=["dp", "step"], default="dp",
                     help="G1 points: simplified to 1 µm (dp) or one per period (step)")
     ap.add_argument("--no-constant", action="store_true", help="skip the limit3 column")
+    ap.add_argument("--machine", choices=["fast", "default"], default="fast",
+                    help="fast: v 166.7/166.7/83.3 mm/s, a 1000/1000/500 mm/s² (the notes' "
+                         "table); default: Machine.default() (the Tormach PCNC 770)")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     m = machine_under_test(args)

@@ -1,9 +1,9 @@
 """``python -m cadcnc.controller.hal STREAM --period S --max-velocity X Y Z ...``: HAL in the loop.
 
-A stand-alone front end until ``cadcnc stream --hal`` calls :func:`run_hal_loop`. Exit 0
-when the run completed with no underrun within the program and, at the machine's limits,
-no clipped sample; 1 when it completed but some did; 2 for an unreadable stream, 1 when HAL could not run; 130 on
-Ctrl-C (HAL unloaded first).
+A stream file's front end (``cadcnc stream --hal`` runs a program's planned stream). Exit
+0 when the run completed with no underrun within the program and no clipped sample; 6 when
+it completed but some were (as ``cadcnc stream --hal``); 2 for an unreadable stream; 1 when
+HAL could not start or run; 130 on Ctrl-C (HAL unloaded first).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import CadcncError
+from ...errors import EXIT_PARTIAL, CadcncError
 from .loop import run_hal_loop, summary
 from .session import HalError, hal_available
 
@@ -56,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     print(summary(result))
     if args.executed:
         np.save(args.executed, result.executed)
-    return 0 if result.underruns == 0 and result.clipped == 0 else 1
+    return 0 if result.underruns == 0 and result.clipped == 0 else EXIT_PARTIAL
 
 
 if __name__ == "__main__":
