@@ -23,13 +23,6 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from OCP.BRep import BRep_Builder
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
-from OCP.BRepClass3d import BRepClass3d_SolidClassifier
-from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-from OCP.gp import gp_Pnt
-from OCP.TopAbs import TopAbs_IN
-from OCP.TopoDS import TopoDS_Compound
 
 import cadcnc
 from cadcnc.errors import CadcncError
@@ -37,6 +30,7 @@ from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_gcode import to_ngc
 from cadcnc.verification import gouge_gate
 
+from benchmarks.reliability.judge import polyline_depths
 from conftest import FIXTURES, load_fixture
 from test_gcode import rs274
 
@@ -58,43 +52,6 @@ def part_of(name: str):
         _parts[name] = (cadcnc.load_step(FIXTURES / name) if name.endswith(".step")
                         else load_fixture(name))
     return _parts[name]
-
-
-def boundary_distances(part, points: np.ndarray) -> np.ndarray:
-    """(N,) distance (mm) from each point to the part's boundary: OCCT's vertex-to-shape
-    distance to the compound of all its faces, i.e. the least vertex-to-face distance over
-    its faces (one call per point: OCCT skips the faces whose boxes are farther)."""
-    faces = TopoDS_Compound()
-    builder = BRep_Builder()
-    builder.MakeCompound(faces)
-    for n in range(1, len(part) + 1):
-        builder.Add(faces, part.face(n).topods)
-    dss = BRepExtrema_DistShapeShape()
-    dss.LoadS2(faces)
-    out = np.empty(len(points))
-    for k, p in enumerate(points):
-        dss.LoadS1(BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex())
-        dss.Perform()
-        assert dss.IsDone()
-        out[k] = dss.Value()
-    return out
-
-
-def polyline_depths(part, points: np.ndarray, ball: float) -> np.ndarray:
-    """(N,) depth R' -/+ d (mm) of the ball at each point of a polyline: R' - d outside
-    the solid, R' + d inside. Membership comes from OCCT's solid classifier, asked again
-    only where two consecutive points' boundary-free balls (radius d) do not cover the
-    segment between them (then the segment might cross the boundary)."""
-    d = boundary_distances(part, points)
-    classifier = BRepClass3d_SolidClassifier(part.shape)
-    inside = np.empty(len(points), bool)
-    for k, p in enumerate(points):
-        if k and d[k - 1] + d[k] >= np.linalg.norm(p - points[k - 1]):
-            inside[k] = inside[k - 1]
-            continue
-        classifier.Perform(gp_Pnt(*map(float, p)), 1e-9)
-        inside[k] = classifier.State() == TopAbs_IN
-    return np.where(inside, ball + d, ball - d)
 
 
 def edge_start(part, i, j, t: float, offset) -> np.ndarray:

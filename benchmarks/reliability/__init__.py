@@ -1,0 +1,1 @@
+"""Reliability benchmarks: long fuzz runs judged independently against OCCT."""
