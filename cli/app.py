@@ -17,7 +17,7 @@ from importlib.metadata import version
 from cadcnc.errors import CadcncError  # light: the package loads OCCT lazily
 from cadcnc.interrupts import sigint_deferred
 
-from .operation import DEFAULT_FEED, DEFAULT_PERIOD
+from .operation import DEFAULT_FEED, DEFAULT_PERIOD, add_max_cycles
 
 UNITS = "Units: lengths mm, feed mm/min, period with a unit (4ms, 0.004s, 250us)."
 
@@ -127,6 +127,7 @@ def build_parser() -> argparse.ArgumentParser:
     _gcode_options(p)
     p.add_argument("--plunge-feed", metavar="F",
                    help="feed of the links' plunge moves, mm/min (default: the feed)")
+    add_max_cycles(p)
 
     from . import finish, pencil, stream  # light: their commands import the library when run
     pencil.add_parser(add, _flip_option, _gouge_options, _gcode_options)

@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 from cadcnc.job import DEFAULT_FEED as FEED, DEFAULT_PERIOD as PERIOD
+from cadcnc.work import MAX_CYCLES
 
 DEFAULT_FEED = f"{FEED:g}"  # the job's defaults as the options' text
 DEFAULT_PERIOD = f"{PERIOD * 1000:g}ms"
@@ -29,6 +30,14 @@ def add_operation_options(p, allowance_help: str) -> None:
                    help="feed of the plunges in the links, mm/min (default: --feed)")
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
                    help=OUTPUT_HELP)
+    add_max_cycles(p)
+
+
+def add_max_cycles(p) -> None:
+    """--max-cycles: the work limit of path and pencil (docs/reliability.md)."""
+    p.add_argument("--max-cycles", type=int, default=MAX_CYCLES, metavar="N",
+                   help=f"interpolation cycles the program may need, estimated before "
+                        f"computing and refused over it (default {MAX_CYCLES})")
 
 
 def operation_command(args, what: str, job_of, *, progress=None,
@@ -37,7 +46,7 @@ def operation_command(args, what: str, job_of, *, progress=None,
     builds its Job; ``progress``: the operation's progress callback; ``times``: per-stage
     seconds (pencil)."""
     import cadcnc
-    from cadcnc.errors import NothingToCutError
+    from cadcnc.errors import InputError, NothingToCutError
     from cadcnc.io.output_set import OutputSet
     from cadcnc.io.outputs import SUFFIXES, render
     from cadcnc.ops.common import safe_height
@@ -54,7 +63,10 @@ def operation_command(args, what: str, job_of, *, progress=None,
     for n in getattr(job.operation, "faces", None) or ():
         if n is not None:
             part.face(n)   # face numbers checked before anything is computed
-    program = cadcnc.run(part, job, progress=progress, times=times)
+    if args.max_cycles < 1:
+        raise InputError(f"--max-cycles must be at least 1, got {args.max_cycles}")
+    program = cadcnc.run(part, job, progress=progress, times=times,
+                         max_cycles=args.max_cycles)
     t_cut = time.monotonic() - t0
     name = Path(args.step).name
     join = cut_back_gap(job)

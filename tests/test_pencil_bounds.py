@@ -178,7 +178,7 @@ def test_a_huge_part_is_refused_up_front_with_the_estimate():
         pencil_program(part, pencil_job(1.0))
     msg = str(err.value)
     assert "needs about 8e+06 interpolation cycles" in msg
-    assert "--feed or --period" in msg and "max_cycles" in msg
+    assert "--feed or --period" in msg and "--max-cycles" in msg
     with pytest.raises(WorkLimitError, match="needs about 1e\\+06 ball positions"):
         pencil_program(part, pencil_job(1.0), max_cycles=10**8)
 

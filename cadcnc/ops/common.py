@@ -30,7 +30,7 @@ def refuse_cycles(lengths_mm, job: Job, what: str, max_cycles: int = MAX_CYCLES)
     cycles = total / job.step
     refuse_over(f"{what}: {total:.4g} mm of corners at a step of {job.step:.3g} mm",
                 cycles, max_cycles, "interpolation cycles",
-                "raise --feed or --period (a longer step), or the cycle limit (max_cycles)")
+                "raise --feed or --period (a longer step), or the cycle limit (--max-cycles)")
     return cycles
 
 

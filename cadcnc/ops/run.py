@@ -6,12 +6,14 @@ from ..errors import InputError
 from ..geometry.part import Part
 from ..job import Finish, Job, PairPath, Pencil
 from ..program.program import Program
+from ..work import MAX_CYCLES
 from .finish.finish import JOIN, finish_program
 from .path.pair_program import program_for_job
 from .pencil.pencil import CHAIN_GAP, pencil_program
 
 
-def run(part, job: Job, *, progress=None, times: dict | None = None) -> Program:
+def run(part, job: Job, *, progress=None, times: dict | None = None,
+        max_cycles: int = MAX_CYCLES) -> Program:
     """The :class:`~cadcnc.program.program.Program` of ``job`` on ``part`` (a
     :class:`~cadcnc.geometry.part.Part`, or a CadQuery Workplane or Shape): the pair's
     corner for :class:`~cadcnc.job.PairPath` (every feasible stretch, cut and linked),
@@ -19,7 +21,8 @@ def run(part, job: Job, *, progress=None, times: dict | None = None) -> Program:
     :class:`~cadcnc.job.Finish`. ``progress``: the operation's progress callback
     (:func:`program_for_job`: ``(cycles, mm)``; pencil and finish: ``(done, total,
     what)``); ``times``: pencil's seconds per stage
-    (:func:`pencil_program`). The program is not gated: see :func:`cadcnc.verification.gate_program`."""
+    (:func:`pencil_program`); ``max_cycles``: the interpolation cycles the path or pencil
+    program may need, estimated and refused up front over it. The program is not gated: see :func:`cadcnc.verification.gate_program`."""
     if not isinstance(job, Job):
         raise InputError(f"job must be a cadcnc.Job, got {type(job).__name__}")
     if not isinstance(part, Part):
@@ -27,9 +30,10 @@ def run(part, job: Job, *, progress=None, times: dict | None = None) -> Program:
     check_clearance(part, job)
     op = job.operation
     if isinstance(op, PairPath):
-        return program_for_job(part, job, progress=progress)
+        return program_for_job(part, job, progress=progress, max_cycles=max_cycles)
     if isinstance(op, Pencil):
-        return pencil_program(part, job, progress=progress, times=times)
+        return pencil_program(part, job, progress=progress, times=times,
+                              max_cycles=max_cycles)
     if isinstance(op, Finish):
         return finish_program(part, job, progress=progress)
     raise InputError(f"unknown operation {type(op).__name__}")

@@ -182,7 +182,7 @@ def check_cycle_count(plan: PathPlan, max_cycles: int) -> None:
             f"the path is about {length:.4g} mm long: at feed {job.feed:g} mm/min and "
             f"period {job.period:g} s (a step of {job.step:.3g} mm) it needs about "
             f"{cycles:.3g} cycles, over the limit of {max_cycles}: raise the feed or the "
-            "period, or the cycle limit")
+            "period, or the cycle limit (--max-cycles)")
 
 
 def stepper_for(plan: PathPlan, max_cycles: int = 1_000_000, record: bool = True, *,
