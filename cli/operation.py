@@ -83,6 +83,8 @@ def operation_command(args, what: str, job_of, *, progress=None,
         say_error(line)
     if not args.quiet:
         print(program.summary(name))
+        print("  verdict    " + ("written" if verdict.write else "nothing written") + (
+            "" if verdict.code == 0 else f" (exit {verdict.code}: see the message above)"))
         staged = "" if not times else "; " + ", ".join(f"{k} {v:.1f} s"
                                                        for k, v in times.items())
         print(f"  time       computed in {t_cut:.1f} s, gated in "

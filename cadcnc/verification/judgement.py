@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from ..errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL, NothingToCutError
 from ..io.program_gcode import program_written_moves
-from ..program.program import STOPPED_SHORT, Program
+from ..program.program import FAILED, STOPPED_SHORT, Program
 from ..program.summary import skipped_counts
 from .cut_back import cut_back
 from .program_gate import ProgramGate, gate_program
@@ -53,7 +53,8 @@ def judge(program: Program, part, what: str, *, gcode: dict | None = None,
     if not program.complete:
         verdict.write, verdict.code = allow_partial, EXIT_PARTIAL
         why = "; ".join(program.partial_reasons + [
-            s.detail for s in program.skipped if s.reason == STOPPED_SHORT
+            f"faces {' '.join(map(str, s.faces))}: {s.reason}: {s.detail}"
+            for s in program.skipped if s.reason in (STOPPED_SHORT, FAILED)
         ]) or "a cut stopped short of its end"
         verdict.messages.append(f"{what}: partial: {why}" + (
             "" if allow_partial else "; nothing written (--allow-partial writes it)"))

@@ -144,6 +144,8 @@ class FaceEdges:
                     entry = self._enters(k, t, uv, n, nrm, travel)
                 except ValueError:
                     continue   # parallel to the plane there: no pass crosses it
+                if any(o.entry == entry and np.linalg.norm(o.point - c) <= 1e-9 for o in out):
+                    continue   # one point found twice (a closed edge's vertex)
                 out.append(Crossing(self.face.number, k, t, uv, c, n, float(c @ travel),
                                     entry, self.neighbours[k]))
         return out
@@ -158,8 +160,15 @@ class FaceEdges:
             return float(self.velocity(curve, x) @ nrm)
 
         def solve(a: float, b: float) -> float:
+            ha, hb = h(a), h(b)
+            if np.signbit(ha) == np.signbit(hb):   # a closed edge's vertex, by rounding
+                return a if abs(ha) <= abs(hb) else b
             return brentq(h, a, b, xtol=ROOT_XTOL, rtol=4 * np.finfo(float).eps)
 
+        g = np.array(g, float)
+        if float(np.linalg.norm(self.centre(curve, ts[0])[0] - self.centre(curve, ts[-1])[0])
+                 ) <= ROOT_XTOL * max(1.0, abs(curve.t1 - curve.t0)):
+            g[-1] = g[0]   # a closed edge: its vertex is one point, with one sign
         neg = np.signbit(g)   # an exact zero counts as positive (the plane a hair lower)
         roots = []
         for i in range(len(ts) - 1):

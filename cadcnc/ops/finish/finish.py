@@ -17,6 +17,7 @@ mm, feed mm/min, period s, angles degrees.
 from __future__ import annotations
 
 import numbers
+import time
 
 import numpy as np
 
@@ -27,9 +28,10 @@ from ...program.linking import linked
 from ...program.program import CutSegment, Program, Skipped
 from ...tolerances import DEFAULT, Tolerances
 from ...guard.stay_down import StayDown
+from ...work import MAX_PLANES, Heartbeat
 from .passes import GuidePlane, pass_cuts
 from .setup import pass_setup
-from .plan import centre_chord, plan_planes, sample_faces
+from .plan import MAX_SAMPLES, centre_chord, plan_planes, sample_faces
 from .uncut import uncut_report
 from ..common import safe_height
 from ...job import DEFAULT_FEED, DEFAULT_PERIOD
@@ -46,7 +48,7 @@ def finish(part, faces, *, radius: float, allowance: float = 0.0,
            angle: float = 0.0, pattern: str = "zigzag", feed: float = DEFAULT_FEED,
            period: float = DEFAULT_PERIOD, clearance: float | None = None,
            shank_length: float | None = None, tol: Tolerances = DEFAULT,
-           progress=None) -> Program:
+           progress=None, max_planes: int = MAX_PLANES) -> Program:
     """The finishing program of ``faces`` of ``part`` (see the module doc).
 
     ``part``: a :class:`~cadcnc.geometry.part.Part`, or a CadQuery Workplane or Shape;
@@ -63,25 +65,38 @@ def finish(part, faces, *, radius: float, allowance: float = 0.0,
     op = Finish(face_numbers(part, faces), stepover, scallop, angle, pattern)
     job = Job(Tool(radius, allowance, shank_length), feed, period, op, source=part.source,
               clearance=clearance, tolerances=tol)
-    return finish_program(part, job, progress=progress)
+    return finish_program(part, job, progress=progress, max_planes=max_planes)
 
 
-def finish_program(part: Part, job: Job, *, progress=None) -> Program:
+def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX_PLANES,
+                   clock=time.monotonic, work: dict | None = None) -> Program:
     """The finishing program of a :class:`~cadcnc.job.Finish` ``job`` on ``part``:
-    ``progress(done, total, what)`` after each plane."""
+    ``progress(done, total, what)`` after each plane, and inside a plane at least every
+    HEARTBEAT_S seconds of ``clock`` (``done`` then counting the planes finished). The
+    planes are estimated before any is placed and refused over ``max_planes``
+    (:class:`~cadcnc.work.WorkLimitError`, exit 2); the face samples are at most
+    MAX_SAMPLES. ``work``: a dict given ``planes_estimate``, ``planes``,
+    ``samples_estimate``, ``samples`` and ``cycles`` (every stepper cycle run)."""
     op, tol, pattern = job.operation, job.tolerances, job.operation.pattern
     for n in op.faces:
         part.face(n)  # FaceNumberError names the range
-    plan, samples = plan_for_job(part, job)
+    work = {} if work is None else work
+    plan, samples = plan_for_job(part, job, max_planes=max_planes, work=work)
+    total, done = len(plan.offsets), 0
+    beat = Heartbeat(progress and (lambda text: progress(done, total, text)), clock=clock)
+    work.update(planes=total, samples=len(samples), cycles=0)
     cuts: list[CutSegment] = []
     skipped: list[Skipped] = []
     for k, offset in enumerate(plan.offsets):
         res = pass_cuts(part, op.faces, GuidePlane(op.angle, float(offset)), job,
-                        reverse=pattern == "zigzag" and k % 2 == 1)
+                        reverse=pattern == "zigzag" and k % 2 == 1,
+                        beat=lambda text, k=k: beat.beat(
+                            lambda: f"plane {k + 1}: " + (text() if callable(text) else text)))
         cuts += res.cuts
         skipped += res.skipped
-        if progress is not None:
-            progress(k + 1, len(plan.offsets), f"plane {k + 1} at {offset:.3f} mm")
+        work["cycles"] += res.cycles
+        done = k + 1   # reported now, which restarts the heartbeat's interval
+        beat.beat(f"plane {done} at {offset:.3f} mm", force=True)
     stay_down = None
     if pattern == "zigzag":
         setup = pass_setup(part, op.faces, job)
@@ -96,12 +111,20 @@ def finish_program(part: Part, job: Job, *, progress=None) -> Program:
     return program
 
 
-def plan_for_job(part: Part, job: Job):
+def plan_for_job(part: Part, job: Job, *, max_planes: int = MAX_PLANES,
+                 work: dict | None = None):
     """(plan, samples): the guide planes of a finishing ``job`` and the samples of its
-    faces they were placed from; InputError for a face the ball cannot reach at all."""
+    faces they were placed from; InputError for a face the ball cannot reach at all,
+    WorkLimitError for more than ``max_planes`` planes (estimated before any is placed).
+    ``work``: given ``samples_estimate`` and ``planes_estimate``."""
     op, tool = job.operation, job.tool
     spacing = op.stepover if op.stepover is not None else float(
         centre_chord(op.scallop, 0.0, tool.radius, tool.allowance))
+    if not spacing > 0.0:   # a scallop below what floats resolve
+        raise InputError(f"scallop {op.scallop:g} mm is too small to space planes for "
+                         "(the spacing is 0): give a larger --scallop")
+    work = {} if work is None else work
+    work["samples_estimate"] = MAX_SAMPLES   # sample_faces coarsens its grid to stay within
     samples = sample_faces(part, op.faces, spacing / SAMPLES_PER_SPACING)
     for n in op.faces:
         mine = samples.faces == n
@@ -109,7 +132,8 @@ def plan_for_job(part: Part, job: Job):
             raise InputError(f"face {n} points down (its normals have -Z components "
                              "everywhere): a ball cannot reach it from +Z")
     plan = plan_planes(samples, tool.radius, tool.allowance, op.angle,
-                       stepover=op.stepover, scallop=op.scallop)
+                       stepover=op.stepover, scallop=op.scallop, max_planes=max_planes,
+                       work=work)
     return plan, samples
 
 

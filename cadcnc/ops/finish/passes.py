@@ -43,15 +43,21 @@ from .check import pass_problems
 from .crossings import Crossing, pass_tangent
 from .setup import PassSetup, guide_face, pass_setup
 from .polish import polish
+from .resume import PASS_CYCLES, clear_again, free_run, land_exact, last_state, xyz
 from .transitions import CONCAVE, CONVEX, TANGENT, transition
 
 REACHED = 1e-3
 """mm: a cut stopping on its face's boundary this near the planned exit has reached it."""
-RESUME_STEPS = 4     # cycles allowed to the run landing back on a clearance's zero
 SHORTEST = 2e-6      # mm: the step of a piece shorter than two steps is a third of it
+JOIN_MM = 1e-6
+"""mm: a cut starting this near another's end continues it (as the program's links)."""
 NO_PIECE = 1e-4
 """mm: a piece of a face this short between its entry and exit (a plane grazing a corner)
 is not cut: the chain goes on from its exit (the chord's sag would be below 1e-9 mm)."""
+MAX_RESUMES = 1000
+"""Collisions one piece of a face may resume past; more stop the piece with a reason."""
+BEAT_CYCLES = 256
+"""The stepper tells the pass's heartbeat every this many cycles."""
 
 
 @dataclass(frozen=True)
@@ -82,10 +88,12 @@ class PassResult:
 
     cuts: list[CutSegment] = field(default_factory=list)
     skipped: list[Skipped] = field(default_factory=list)
+    cycles: int = 0
+    """Stepper cycles the pass ran (re-runs past collisions included)."""
 
 
 def pass_cuts(part: Part, faces: Sequence[int], plane: GuidePlane, job: Job, *,
-              reverse: bool = False, guard=None) -> PassResult:
+              reverse: bool = False, guard=None, beat=None) -> PassResult:
     """Every cut of one guide plane over the selected ``faces`` (1-based numbers of
     ``part``): the ball (radius job.tool.offset = R') touches the selected faces and its
     centre stays on ``plane`` (the paper's guide-surface interpolation, offsets (R', 0)).
@@ -98,21 +106,26 @@ def pass_cuts(part: Part, faces: Sequence[int], plane: GuidePlane, job: Job, *,
 
     ``guard``: None for the default (:func:`pass_setup`'s, built once per part, faces
     and tool), a :class:`PassSetup` (its per-face guards), False for none, or any object
-    with ``margin(p)`` used for every cut.
+    with ``margin(p)`` used for every cut. ``beat(text)``: told while the pass runs (every
+    BEAT_CYCLES stepper cycles and at every piece), e.g. a
+    :class:`~cadcnc.work.Heartbeat`'s ``beat``, which reports when due.
     """
     if isinstance(guard, PassSetup):
         setup, fixed = guard, None
     else:
         setup = pass_setup(part, faces, job)
         fixed = guard
-    return _Pass(setup, plane, job, reverse, fixed).run()
+    return _Pass(setup, plane, job, reverse, fixed, beat).run()
 
 
 class _Pass:
     """The planning and cutting of one plane (see the module doc)."""
 
-    def __init__(self, setup: PassSetup, plane: GuidePlane, job: Job, reverse: bool, guard):
+    def __init__(self, setup: PassSetup, plane: GuidePlane, job: Job, reverse: bool, guard,
+                 beat=None):
         self.setup, self.plane, self.job = setup, plane, job
+        self.beat = beat or (lambda text: False)
+        self.cycles = 0      # stepper cycles run by this pass, re-runs included
         self.sense = -1.0 if reverse else 1.0
         self.travel = self.sense * plane.direction
         self.nrm = plane.normal
@@ -159,7 +172,8 @@ class _Pass:
             try:
                 self.chain(c.face, self.tangency(c.point, c.uv))
             except CadcncError as e:
-                self.skip(c.face, FAILED, f"from {_xyz(c.point)}: {e}")
+                self.skip(c.face, FAILED, f"from {xyz(c.point)}: {e}")
+        self.result.cuts = chained_order(self.result.cuts)
         problems = pass_problems(self.result.cuts, self.crossings, self.accounted,
                                  self.travel)
         if problems:   # never a wrong path: the plane's cuts are dropped, the plane listed
@@ -179,22 +193,51 @@ class _Pass:
         return min(ahead, key=lambda c: (round(c.s, 9), float(np.linalg.norm(c.point - p))),
                    default=None)
 
+    def exit_at(self, face: int, p) -> Crossing | None:
+        """An unused exit of ``face`` within REACHED of the centre ``p`` (mm), or None."""
+        near = [c for c in self.crossings[face] if not c.entry and not c.used
+                and np.linalg.norm(c.point - np.asarray(p)) <= REACHED]
+        return min(near, key=lambda c: float(np.linalg.norm(c.point - np.asarray(p))),
+                   default=None)
+
+    def cut_near(self, face: int, p) -> bool:
+        """Whether a cut of this pass on ``face`` already passes within a step of ``p``."""
+        step = max(self.job.step, REACHED)
+        return any(cut.path.faces[0] == face and float(np.linalg.norm(
+            cut.points - np.asarray(p), axis=1).min()) <= step for cut in self.result.cuts)
+
     def chain(self, face: int, start: Tangency) -> None:
-        """Cuts from ``start`` on ``face`` across selected faces until the chain ends."""
-        while True:
+        """Cuts from ``start`` on ``face`` across selected faces until the chain ends.
+        Bounded: every turn consumes an exit crossing. The exit a cut reached is the one
+        it landed on (the crossings' order along the pass), not always the first in s."""
+        for _ in range(sum(len(cs) for cs in self.crossings.values()) + 1):
             exit_ = self.next_exit(face, np.asarray(start.p))
             step = transition(self, face, exit_) if exit_ is not None else None
             end = step.end if step is not None else None
+            self.landed = None
             last = self.piece(face, start, end)
             if last is None:
                 return
+            if self.landed is not None and self.landed is not exit_:
+                exit_ = self.landed   # landed on another exit of the face: go on from it
+                step = transition(self, face, exit_)
+                if step.kind == CONCAVE:   # its tri-tangent point was not where we stopped
+                    exit_.used = True
+                    return
             if step is None or step.kind is None:
+                if exit_ is not None and self.landed is exit_:
+                    exit_.used = True
                 return
             if step.end is None or np.linalg.norm(np.subtract(last.p, step.end.p)) > REACHED:
                 return
             exit_.used = True
             if step.entry is not None:
                 step.entry.used = True
+            if step.kind == CONCAVE:   # F's curve past the tri-tangent point is in G's shadow
+                self.accounted.append(tuple(float(np.dot(q, self.travel))
+                                            for q in (last.p, exit_.point)))
+                if self.cut_near(step.next_face, last.p):
+                    return   # G's curve from there was cut already (by an earlier chain)
             if step.kind == CONVEX:
                 arc = step.arc(last.p)
                 self.result.cuts.append(CutSegment(arc, at_limit=True))
@@ -210,31 +253,44 @@ class _Pass:
         pos, exact = start, True
         if end is not None and np.linalg.norm(np.subtract(end.p, start.p)) <= NO_PIECE:
             return end
-        while True:
+        for _ in range(MAX_RESUMES):
+            self.beat(lambda: f"{self.where(face)}: cutting from {xyz(pos.p)}")
             tp = self.run_stepper(face, pos, end, guard)
             self.exact(face, tp, guard, exact)
             if len(tp) > 1:
                 self.result.cuts.append(CutSegment(
                     tp, at_limit=tp.stop_reason in (END, BOUNDARY, COLLISION)))
-            last = _last_state(tp)
+            last = last_state(tp)
             if tp.stop_reason == END:
                 return last
             if tp.stop_reason == BOUNDARY:
                 near = end is not None and np.linalg.norm(
                     np.subtract(last.p, end.p)) <= REACHED
+                if not near:   # another exit of the face, reached first along the pass
+                    self.landed = self.exit_at(face, last.p)
+                    near = self.landed is not None
                 if near or end is None:
                     return last if near else None
-                self.skip(face, STOPPED_SHORT, f"the cut from {_xyz(pos.p)} stopped on the "
-                          f"face's boundary at {_xyz(last.p)}, short of its planned exit "
-                          f"{_xyz(end.p)}", (last.p, end.p))
+                self.skip(face, STOPPED_SHORT, f"the cut from {xyz(pos.p)} stopped on the "
+                          f"face's boundary at {xyz(last.p)}, short of its planned exit "
+                          f"{xyz(end.p)}", (last.p, end.p))
                 return None
             if tp.stop_reason != COLLISION:
-                self.skip(face, STOPPED_SHORT, f"the cut from {_xyz(pos.p)} {tp.partial_reason}",
+                self.skip(face, STOPPED_SHORT, f"the cut from {xyz(pos.p)} {tp.partial_reason}",
                           (last.p, end.p) if end is not None else None)
                 return None
+            before = pos
             pos, exact = self.clear_again(face, last, end, guard, tp.stop_detail), False
             if pos is None:
                 return None
+            if len(tp) <= 1 and np.linalg.norm(np.subtract(pos.p, before.p)) <= SHORTEST:
+                self.skip(face, STOPPED_SHORT, f"the pass made no progress at "
+                          f"{xyz(pos.p)}: it resumed where it had stopped on collision")
+                return None
+        self.skip(face, STOPPED_SHORT, f"the cut stopped on collision {MAX_RESUMES} times "
+                  f"and resumed past each; stopped at {xyz(pos.p)}",
+                  (pos.p, end.p) if end is not None else None)
+        return None
 
     def exact(self, face: int, tp: Toolpath, guard, keep_first: bool) -> None:
         """Move the cut's points onto the exact offset curve (:mod:`.finish_polish`), in
@@ -263,62 +319,27 @@ class _Pass:
         tp.uv[:, 1] = np.stack([d @ self.plane.direction, d @ self.y_axis], axis=1)
         tp.steps[1:] = np.linalg.norm(np.diff(c, axis=0), axis=1)
 
-    def land_exact(self, surface, clear: np.ndarray, beyond: np.ndarray, uv, guard):
-        """The point of the exact offset curve between ``clear`` and ``beyond`` (mm;
-        ``beyond`` one step past a landed point) where the guard's clearance reaches 0, on
-        its clear side (bisection to 1e-10 of the chord): (centre, uv, contact, normal),
-        or None when the curve is clear up to ``beyond``."""
-        def on_curve(x: float):
-            return polish(surface, self.job.tool.offset, self.nrm, self.plane.offset,
-                          (clear + x * (beyond - clear))[None], np.asarray(uv)[None])
-
-        best = on_curve(1.0)
-        if guard.margin(tuple(best[0][0]))[0] >= 0.0:
-            return None
-        lo, hi, best = 0.0, 1.0, on_curve(0.0)
-        for _ in range(34):
-            mid = 0.5 * (lo + hi)
-            found = on_curve(mid)
-            if guard.margin(tuple(found[0][0]))[0] >= 0.0:
-                lo, best = mid, found
-            else:
-                hi = mid
-        return tuple(a[0] for a in best)
+    def land_exact(self, surface, clear, beyond, uv, guard):
+        """See :func:`.resume.land_exact`."""
+        return land_exact(self, surface, clear, beyond, uv, guard)
 
     def clear_again(self, face: int, at: Tangency, end, guard, why: str) -> Tangency | None:
-        """Where the plane's curve on ``face`` past a collision at ``at`` is clear again:
-        run on without the guard, take the first clear point after a hit, and land back
-        from it on the clearance's zero. Skips the stretch in between (``collision``)."""
-        free = self.run_stepper(face, at, end, None)
-        margins = [guard.margin(tuple(p))[0] for p in free.points[1:]]
-        hit = False
-        for k, m in enumerate(margins, 1):
-            hit = hit or m < 0.0
-            if m >= 0.0 and (hit or k == len(margins)):
-                break
-        else:
-            k = None
-        if k is None or not hit:
-            self.skip(face, COLLISION, f"from {_xyz(at.p)} to {_xyz(free.points[-1])} "
-                      f"({why})", (at.p, end.p if end is not None else free.points[-1]))
-            return None
-        clear = _state(free, k)
-        back = self.run_stepper(face, clear, None, guard, backwards=True,
-                                max_cycles=RESUME_STEPS)
-        resume = _last_state(back) if back.stop_reason == COLLISION else clear
-        self.skip(face, COLLISION, f"from {_xyz(at.p)} to {_xyz(resume.p)} ({why})",
-                  (at.p, resume.p))
-        return resume
+        """See :func:`.resume.clear_again`."""
+        return clear_again(self, face, at, end, guard, why)
+
+    def free_run(self, face: int, at: Tangency, end, guard):
+        """See :func:`.resume.free_run`."""
+        return free_run(self, face, at, end, guard)
 
     def run_stepper(self, face: int, start: Tangency, end: Tangency | None, guard, *,
-                    backwards: bool = False, max_cycles: int = 1_000_000) -> Toolpath:
+                    backwards: bool = False, max_cycles: int = PASS_CYCLES) -> Toolpath:
         """The stepper on ``face`` and the guide plane from ``start`` (to ``end``)."""
         job = self.job
         surface = self.setup.surfaces[face]
         try:
             tau = pass_tangent(surface.normal(*start.uv1), self.travel)
         except ValueError as e:
-            raise GeometryError(f"at {_xyz(start.p)} on face {face}: {e}") from None
+            raise GeometryError(f"at {xyz(start.p)} on face {face}: {e}") from None
         if backwards:
             tau = -tau
         feed = job.feed
@@ -328,20 +349,30 @@ class _Pass:
         stepper = Stepper(surface, self.guide, (job.tool.offset, 0.0), start, feed=feed,
                           period=job.period, direction=tuple(tau), end=end,
                           tol=job.tolerances, max_cycles=max_cycles, guard=guard)
-        stepper.run()
+        where = self.where(face)
+        stepper.run(progress=lambda cycles, mm: self.beat(
+            lambda: f"{where}: {self.cycles + cycles} cycles, {mm:.3f} mm"), every=BEAT_CYCLES)
+        self.cycles += stepper.cycles
+        self.result.cycles = self.cycles
         op = PairPath(faces=(face, None), offsets=(None, 0.0), start=start.p, edge=None)
         return toolpath_from_record(stepper.record, replace(job, operation=op),
                                     stepper.stop_reason, stepper.stop_detail)
 
 
-def _state(tp: Toolpath, k: int) -> Tangency:
-    return Tangency(tuple(map(float, tp.points[k])), tuple(map(float, tp.uv[k, 0])),
-                    tuple(map(float, tp.uv[k, 1])))
-
-
-def _last_state(tp: Toolpath) -> Tangency:
-    return _state(tp, len(tp) - 1)
-
-
-def _xyz(p) -> str:
-    return "(" + ", ".join(f"{float(v):.3f}" for v in p) + ")"
+def chained_order(cuts: list[CutSegment]) -> list[CutSegment]:
+    """``cuts`` in the order they were made, except that a cut ending exactly (within
+    ``JOIN_MM``) where an earlier one starts is moved before it (a wall descended onto
+    a stretch an earlier chain reached first): the pass runs on without a link."""
+    out = list(cuts)
+    for _ in range(len(out)):   # at most one move per cut
+        moved = False
+        for i in range(len(out)):
+            j = next((j for j in range(i + 1, len(out)) if np.linalg.norm(
+                out[j].points[-1] - out[i].points[0]) <= JOIN_MM), None)
+            if j is not None:
+                out.insert(i, out.pop(j))
+                moved = True
+                break
+        if not moved:
+            break
+    return out

@@ -29,6 +29,7 @@ import numpy as np
 
 from ...errors import InputError
 from ...trim import OUTSIDE
+from ...work import MAX_PLANES, refuse_over
 from .polish import face_derivatives
 
 PARALLEL_DEG = 5.0
@@ -38,6 +39,8 @@ DOWN_NZ = -1e-9
 MAX_SAMPLES = 60_000
 """Samples over all the selected faces at most (the grid is made coarser above)."""
 MIN_PER_SIDE = 4
+ESTIMATE_BINS = 2048
+"""Bins of the plane coordinate over which the adaptive spacing's plane count is estimated."""
 
 
 @dataclass
@@ -143,8 +146,10 @@ def centre_chord(h, k, radius: float, allowance: float = 0.0):
     """The distance (mm) between neighbouring ball centres across the passes that leaves a
     cusp ``h`` mm high on a surface of normal curvature ``k`` (1/mm, < 0 convex) across
     them, ball ``radius`` R with ``allowance`` C (the module doc's c; exact for a circular
-    cross-section). 0 where the ball does not fit (R' k >= 1). Arrays broadcast."""
-    h, k = np.asarray(h, float), np.asarray(k, float)
+    cross-section). 0 where the ball does not fit (R' k >= 1). A cusp can be no higher
+    than the ball: h is taken at most R (the chord of h >= R is that of R, at most 2 R
+    on a flat floor). Arrays broadcast."""
+    h, k = np.minimum(np.asarray(h, float), radius), np.asarray(k, float)
     r1 = radius + allowance
     w = 2.0 * radius * h - h * h
     A = np.abs(1.0 - (allowance + h) * k)
@@ -186,8 +191,13 @@ def sample_reasons(samples: FaceSamples, k, g, offset: float) -> np.ndarray:
 
 
 def plan_planes(samples: FaceSamples, radius: float, allowance: float, angle: float, *,
-                stepover: float | None = None, scallop: float | None = None) -> PlanePlan:
-    """The guide planes over ``samples`` (see the module doc)."""
+                stepover: float | None = None, scallop: float | None = None,
+                max_planes: int = MAX_PLANES, work: dict | None = None) -> PlanePlan:
+    """The guide planes over ``samples`` (see the module doc). Their number is estimated
+    before any is placed (:func:`planes_estimate`) and refused over ``max_planes``
+    (:class:`~cadcnc.work.WorkLimitError`, naming the option that brings it down);
+    ``work``: a dict given ``planes_estimate``."""
+    work = {} if work is None else work
     r1 = radius + allowance
     n = plane_normal(angle)
     k, g = across(samples, n)
@@ -198,18 +208,55 @@ def plan_planes(samples: FaceSamples, radius: float, allowance: float, angle: fl
         return PlanePlan(angle, n, np.zeros(0), f, reason)
     lo, hi = float(f[reach].min()), float(f[reach].max())
     if stepover is not None:
-        count = max(1, math.ceil((hi - lo) / stepover - 1e-9))
+        count = work["planes_estimate"] = planes_estimate(lo, hi, stepover=stepover)
+        refuse_over(f"finishing {hi - lo:.4g} mm across the planes (R' {r1:g} mm) at a "
+                    f"stepover of {stepover:g} mm", count, max_planes, "guide planes",
+                    "give a larger --stepover, or a smaller --radius")
+        count = int(count)
         first = 0.5 * (lo + hi) - 0.5 * (count - 1) * stepover
         return PlanePlan(angle, n, first + stepover * np.arange(count), f, reason)
     spacing = np.where(reason == "", centre_chord(scallop, k, radius, allowance) * g, np.inf)
-    return PlanePlan(angle, n, adaptive_offsets(f, spacing, lo, hi), f, reason, spacing)
+    estimate = work["planes_estimate"] = planes_estimate(lo, hi, f=f, spacing=spacing)
+    refuse_over(f"finishing {hi - lo:.4g} mm across the planes (R' {r1:g} mm) for a "
+                f"scallop of {scallop:g} mm", estimate, max_planes, "guide planes",
+                "give a larger --scallop, or a smaller --radius")
+    offsets = adaptive_offsets(f, spacing, lo, hi, limit=int(1.5 * estimate) + 2)
+    return PlanePlan(angle, n, offsets, f, reason, spacing)
 
 
-def adaptive_offsets(f: np.ndarray, spacing: np.ndarray, lo: float, hi: float) -> np.ndarray:
+def planes_estimate(lo: float, hi: float, *, stepover: float | None = None, f=None,
+                    spacing=None) -> float:
+    """How many planes cover centre coordinates ``lo`` .. ``hi`` (mm), before any is
+    placed: ``stepover`` apart, exactly ceil((hi - lo) / S) (at least 1); or adaptively
+    (:func:`adaptive_offsets`) for samples at ``f`` (N,) allowing ``spacing`` (N,):
+    the sum over ESTIMATE_BINS bins of the bin's width over the smallest spacing of the
+    samples from it to one widest spacing ahead (what a step from the bin can take), at
+    least 1. NaN (refused) when a spacing is 0 or not a number."""
+    if stepover is not None:
+        return float(max(1, math.ceil((hi - lo) / stepover - 1e-9)))
+    sp = np.asarray(spacing, float)
+    fin = np.isfinite(sp)
+    if np.isnan(sp).any() or (sp[fin] <= 0).any():
+        return math.nan
+    if not fin.any() or hi <= lo:
+        return 1.0
+    widest = float(sp[fin].max())
+    width = (hi - lo) / ESTIMATE_BINS
+    at = np.clip(((np.asarray(f)[fin] - lo) / width).astype(np.int64), 0, ESTIMATE_BINS - 1)
+    least = np.full(ESTIMATE_BINS, widest)
+    np.minimum.at(least, at, sp[fin])
+    ahead = min(ESTIMATE_BINS, math.ceil(widest / width))
+    padded = np.r_[least, np.full(ahead, widest)]
+    window = np.lib.stride_tricks.sliding_window_view(padded, ahead + 1).min(axis=1)
+    return max(1.0, float((width / window).sum()) + 1.0)
+
+
+def adaptive_offsets(f: np.ndarray, spacing: np.ndarray, lo: float, hi: float,
+                     limit: int = MAX_PLANES) -> np.ndarray:
     """Plane offsets from ``lo`` to ``hi`` (mm): the first within half the spacing its
     samples allow of ``lo``, each next as far from the last as the smallest ``spacing``
     (N,) of the samples whose ``f`` (N,) lies between them, the last within half a spacing
-    of ``hi``."""
+    of ``hi``. More than ``limit`` planes is an error (the estimate was wrong)."""
     order = np.argsort(f)
     fs, sp = f[order], spacing[order]
     finite = sp[np.isfinite(sp)]
@@ -232,7 +279,10 @@ def adaptive_offsets(f: np.ndarray, spacing: np.ndarray, lo: float, hi: float) -
     out = [first]
     while True:
         d = allowed(out[-1])
-        if out[-1] + 0.5 * d >= hi or len(out) > 1_000_000:
+        if out[-1] + 0.5 * d >= hi:
             break
+        if len(out) >= limit:
+            raise RuntimeError(f"adaptive spacing: more than {limit} planes, over 1.5 times "
+                               "the estimate")
         out.append(out[-1] + d)
     return np.array(out)

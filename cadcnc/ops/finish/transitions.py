@@ -34,6 +34,7 @@ from ...interp.stepper import Tangency
 from ...interp.tangency import solve_tangency
 from ...job import PairPath
 from ...program.toolpath import Toolpath
+from .check import along_pass
 from .crossings import ROOT_XTOL, Crossing
 
 __all__ = ["CONCAVE", "CONVEX", "TANGENT", "Transition", "transition"]
@@ -90,19 +91,22 @@ def transition(ps, face: int, exit_: Crossing) -> Transition:
                 and ps.setup.surfaces[g].contains(*tri.uv2)):
             return Transition(None, end)
         return Transition(CONCAVE, ps.tangency(tri.p, tri.uv1), g, tri.uv2,
-                          _entry_before(ps.crossings[g], float(np.dot(tri.p, ps.travel))))
+                          _entry_before(ps.crossings[g], np.asarray(tri.p), ps.travel))
     if entry is None:
         return Transition(None, end)
     return Transition(CONVEX, end, g, entry.uv, entry, roll=(ps, face, exit_, kg, entry))
 
 
-def _entry_before(crossings, s: float) -> Crossing | None:
-    """The entry of the piece of a face's curve that contains travel coordinate ``s``
-    (the last of its crossings at or before s, when that is an unused entry): a concave
-    transition starts the next face inside that piece, past its entry (which lies in the
-    shadow of the face left, on whichever edge of it)."""
-    before = [c for c in crossings if c.s <= s + 1e-9]
-    last = max(before, key=lambda c: (c.s, c.entry), default=None)
+def _entry_before(crossings, p: np.ndarray, travel: np.ndarray) -> Crossing | None:
+    """The entry of the piece of a face's curve that contains the centre ``p`` (the last
+    of its crossings before p in their order along the pass, :func:`.check.along_pass`,
+    when that is an unused entry): a concave transition starts the next face inside
+    that piece, past its entry (which lies in the shadow of the face left, on whichever
+    edge of it; on a wall climbed, below p)."""
+    here = Crossing(-1, -1, 0.0, (0.0, 0.0), p, np.zeros(3), float(p @ travel), False, None)
+    order = along_pass(list(crossings) + [here], travel)
+    k = next(i for i, c in enumerate(order) if c is here)
+    last = order[k - 1] if k > 0 else None
     return last if last is not None and last.entry and not last.used else None
 
 
