@@ -34,10 +34,19 @@ def add_operation_options(p, allowance_help: str) -> None:
 
 
 def add_max_cycles(p) -> None:
-    """--max-cycles: the work limit of path and pencil (docs/reliability.md)."""
+    """--max-cycles (the work limit, docs/reliability.md) and the --stream options."""
     p.add_argument("--max-cycles", type=int, default=MAX_CYCLES, metavar="N",
                    help=f"interpolation cycles the program may need, estimated before "
                         f"computing and refused over it (default {MAX_CYCLES})")
+    g = p.add_argument_group("stream (docs/controller.md)")
+    g.add_argument("--stream", action="append", metavar="OUT",
+                   help="also write the program as one position per servo period, its feed "
+                        "planned to the machine's limits: .npy or .txt (as `cadcnc stream`); "
+                        "only a complete, verified program is streamed")
+    g.add_argument("--machine", metavar="FILE.ini",
+                   help="the machine's LinuxCNC INI for --stream (default: a Tormach PCNC 770)")
+    g.add_argument("--jerk", metavar="J", help="jerk limit of every axis for --stream, mm/s^3")
+
 
 
 def operation_command(args, what: str, job_of, *, progress=None,
@@ -57,6 +66,15 @@ def operation_command(args, what: str, job_of, *, progress=None,
     from .options import gcode_keywords, wants_gcode
 
     outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])  # checked before computing
+    machine = None
+    if getattr(args, "stream", None):
+        from cadcnc.io.output_set import check_destination
+
+        from .stream import SUFFIXES as STREAM_SUFFIXES, machine_of
+
+        for out in args.stream:
+            check_destination(out, STREAM_SUFFIXES, [args.step])
+        machine = machine_of(args)
     job = job_of(args, args.step)
     t0 = time.monotonic()
     part = cadcnc.load_step(args.step, flip_material=job.flip_material)
@@ -95,4 +113,12 @@ def operation_command(args, what: str, job_of, *, progress=None,
                        for out in args.output})
         if not args.quiet:
             print(f"  wrote      {', '.join(args.output)}")
+    if machine is not None:
+        if verdict.code != 0:
+            say_error(f"cadcnc: {what}: not streamed: only a complete, verified program is")
+            return verdict.code
+        from .stream import stream_outputs
+
+        return stream_outputs(program, part, machine, args.stream, tolerances=job.tolerances,
+                              quiet=args.quiet, name=name, inputs=[args.step])
     return verdict.code

@@ -105,3 +105,17 @@ def test_hal_that_cannot_start_is_exit_1_with_the_reason(program, monkeypatch, t
 def test_stream_needs_an_output_or_hal(program):
     run = cadcnc_cli("stream", program)
     assert run.returncode == 2 and "--hal" in run.stderr
+
+
+def test_an_operation_streams_its_verified_program(tmp_path):
+    """`pencil ... --stream OUT`: the program written and its stream beside it, from the
+    program's first point to its last (exit 0)."""
+    from cadcnc.io.program_json import read_program
+
+    prog, npy = tmp_path / "p.json", tmp_path / "p.npy"
+    run = cadcnc_cli("pencil", FIXTURES / "step_block.step", "--radius", "3", "-o", prog,
+                     "--stream", npy, "-q")
+    assert run.returncode == 0, run.stderr
+    rows, program = np.load(npy), read_program(prog)
+    np.testing.assert_allclose(rows[0], program.segments[0].points[0], atol=1e-9)
+    np.testing.assert_allclose(rows[-1], program.segments[-1].points[-1], atol=1e-9)
