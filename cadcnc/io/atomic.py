@@ -14,6 +14,17 @@ from pathlib import Path
 from ..errors import OutputError
 
 
+NAME_MAX = 255  # bytes in one file name on common file systems
+_TEMP_ROOM = 16  # bytes the temporary name adds: ".", mkstemp's 8 characters, ".tmp", a dot
+
+
+def temp_prefix(path: Path) -> str:
+    """The prefix of a temporary file beside ``path``: ``.NAME.``, NAME shortened so that
+    the temporary name fits NAME_MAX bytes whenever the destination's name does."""
+    name = os.fsencode(Path(path).name)[:NAME_MAX - _TEMP_ROOM]
+    return "." + os.fsdecode(name) + "."
+
+
 @contextlib.contextmanager
 def atomic_write(path, mode: str = "w", newline: str | None = None):
     """Open a temporary file beside ``path``; on success it replaces ``path``.
@@ -26,7 +37,7 @@ def atomic_write(path, mode: str = "w", newline: str | None = None):
     if not folder.is_dir():
         raise OutputError(f"{path}: cannot write, folder {folder} does not exist")
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+        fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path), suffix=".tmp", dir=folder)
     except OSError as e:
         raise OutputError(f"{path}: cannot write ({e.strerror})") from e
     try:

@@ -18,8 +18,7 @@ from pathlib import Path
 
 from ..errors import OutputError
 from ..interrupts import sigint_deferred
-
-NAME_MAX = 255  # bytes in one file name on common file systems
+from .atomic import NAME_MAX, temp_prefix
 
 
 def _umask() -> int:
@@ -49,6 +48,9 @@ def check_destination(out, suffixes: tuple[str, ...], inputs=()) -> Path:
     target = Path(os.path.realpath(out))
     folder = target.parent
     if not folder.is_dir():
+        if out.is_symlink():
+            raise OutputError(f"{out}: a symbolic link to {os.readlink(out)}, whose folder "
+                              f"{folder} does not exist")
         raise OutputError(f"{out}: cannot write, folder {out.parent} does not exist")
     if target.is_dir():
         raise OutputError(f"{out}: is a folder")
@@ -85,7 +87,7 @@ class OutputSet:
                 target = self.targets[d]
                 data = contents[d]
                 data = data.encode("utf-8") if isinstance(data, str) else data
-                fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp",
+                fd, tmp = tempfile.mkstemp(prefix=temp_prefix(target), suffix=".tmp",
                                            dir=target.parent)
                 temps.append((tmp, target, d))
                 with os.fdopen(fd, "wb") as fh:

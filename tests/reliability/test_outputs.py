@@ -205,3 +205,20 @@ def test_ctrl_c_after_the_files_are_written_keeps_the_exit_code(tmp_path):
     proc.communicate(timeout=60)
     assert proc.returncode in (0, 130), proc.returncode
     assert _cut(json.loads(out.read_text()))["faces"] == [10, 17]
+
+
+def test_a_255_byte_name_is_written(tmp_path):
+    """The longest legal name: the temporary file beside it must fit the limit too."""
+    out = tmp_path / ("p" * 250 + ".json")
+    assert len(out.name.encode()) == 255
+    run = cadcnc_cli("path", POCKET, "--faces", "10", "17", *JOB, "-o", out, "-q")
+    assert run.returncode == 0 and out.exists(), run.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == [out.name]
+
+
+def test_a_dangling_symlink_names_its_target(tmp_path):
+    link = tmp_path / "p.json"
+    link.symlink_to(tmp_path / "gone" / "p.json")
+    run = cadcnc_cli("path", POCKET, "--faces", "10", "17", *JOB, "-o", link)
+    assert run.returncode == 4
+    assert "symbolic link" in run.stderr and str(tmp_path / "gone") in run.stderr
