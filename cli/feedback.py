@@ -21,17 +21,24 @@ def progress(args, label: str):
     return report
 
 
-def stage_progress(args, label: str, after_s: float = 0.0):
-    """A progress(stage, done, total) callback: one stderr line per stage (the stages
-    count differently) once ``after_s`` seconds have passed, or None with --quiet."""
+def stage_progress(args, label: str, after_s: float = 0.0, clock=time.monotonic):
+    """A progress(stage, done, total) callback: one stderr line when a stage starts (once
+    ``after_s`` seconds have passed) and then at least every HEARTBEAT_S seconds while
+    it runs, with its count; None with --quiet. ``clock`` is injectable for tests."""
     if args.quiet:
         return None
+    from cadcnc.work import HEARTBEAT_S, Heartbeat
+
     seen = set()
-    start = time.monotonic()
+    start = clock()
+    beat = Heartbeat(say_error, HEARTBEAT_S, clock)
 
     def report(stage: str, done: int, total: int) -> None:
-        if stage not in seen and time.monotonic() - start >= after_s:
+        if clock() - start < after_s:
+            return
+        text = f"cadcnc: {label}: {stage} ..." if stage not in seen else \
+            f"cadcnc: {label}: {stage} {done}/{total}"
+        if beat.beat(text, force=stage not in seen):
             seen.add(stage)
-            say_error(f"cadcnc: {label}: {stage} ...")
 
     return report

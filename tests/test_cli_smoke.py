@@ -46,3 +46,26 @@ def test_faces_loads_neither_numba_nor_the_interpolation_core():
                          timeout=120)
     assert run.returncode == 0, run.stderr
     assert run.stdout.splitlines()[-1] == "False False"
+
+
+def test_a_long_stage_reports_at_least_every_five_seconds():
+    """The gate's stages (and any caller of stage_progress) are never silent longer than
+    the heartbeat, by a fake clock: one line when a stage starts, then one per 5 s."""
+    from types import SimpleNamespace
+
+    from cadcnc.cli import feedback
+
+    now, lines, times = [0.0], [], []
+    feedback_say = feedback.say_error
+    feedback.say_error = lambda text: (lines.append(text), times.append(now[0]))
+    try:
+        report = feedback.stage_progress(SimpleNamespace(quiet=False), "gate",
+                                         clock=lambda: now[0])
+        for k in range(100):          # 100 steps of 0.7 s of one stage
+            now[0] += 0.7
+            report("moves", k, 100)
+    finally:
+        feedback.say_error = feedback_say
+    assert lines[0] == "cadcnc: gate: moves ..." and "/100" in lines[-1]
+    gaps = [b - a for a, b in zip(times, times[1:] + [now[0]])]
+    assert max(gaps) <= 5.0 + 0.7 + 1e-9 and len(lines) >= 12   # 5 s, to the next call
