@@ -20,6 +20,7 @@ from cadcnc.io.program_plot import program_picture_bytes
 from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.verification import gate_program, verify as run_verify
 from cadcnc.verification.program_gate import cut_label
+from cadcnc.work import MAX_VERIFY_POINTS, refuse_over
 
 from .feedback import progress, say_error, stage_progress
 from .operation import operation_command
@@ -76,6 +77,8 @@ def verify(args) -> int:
         program = program_for_job(part, job, progress=progress(args, "verify"))
     if not program.cuts:
         raise InputError(f"{args.input}: the program has no cut to verify")
+    refuse_over(f"verifying {args.input}", sum(len(s.points) for s in program.segments),
+                MAX_VERIFY_POINTS, "points", "verify a shorter program, or one cut at a time")
     reports = [run_verify(seg.path, part, tol=tol, progress=stage_progress(args, "verify"))
                for seg in program.cuts]
     labels = [cut_label(k, seg) for k, seg in enumerate(program.cuts, 1)]

@@ -226,3 +226,14 @@ def test_verify_judges_the_links_too(tmp_path):
     run = cadcnc_cli("verify", bad, "-q")
     assert run.returncode == 5 and "links fail the gouge gate" in run.stderr
     assert cadcnc_cli("verify", good, "-q").returncode == 0
+
+
+def test_verify_refuses_a_program_over_its_point_limit(tmp_path, monkeypatch):
+    """Work is bounded before it starts: over the limit, verify names the estimate."""
+    from cadcnc.cli import program_commands
+
+    out = tmp_path / "s.json"
+    cadcnc_cli("path", SHELF, *SHELF_JOB, "-o", out, "-q", check=0)
+    monkeypatch.setattr(program_commands, "MAX_VERIFY_POINTS", 100)
+    run = cadcnc_cli("verify", out)
+    assert run.returncode == 2 and "points, over the limit of 100" in run.stderr
