@@ -9,7 +9,7 @@ record (BinTools' format: little-endian doubles and int32s) read with numpy.
 Every read is checked against OCCT: the record's header (degree, counts, rational and
 periodic flags) and the first, middle and last poles and the end knots must equal the
 handle's own values exactly, and the multiplicities must sum to what the pole count implies.
-Anything else returns None, and the caller reads pole by pole as before.
+Anything else returns None, and the caller reads the B-spline pole by pole.
 """
 
 from __future__ import annotations

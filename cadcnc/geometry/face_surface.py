@@ -113,7 +113,7 @@ class FaceSurface:
     @property
     def kernel(self) -> tuple[SurfaceData, "TrimGrid"] | None:
         """(surface data, trim grid) for the compiled stepper, built on first use (the
-        grid build is planning time, reported by benchmarks/bench_trim_grid.py); None
+        grid build is planning time, reported by benchmarks/kernel/bench_trim_grid.py); None
         where the kernel cannot evaluate this face (OCCT's evaluation is used)."""
         if self._kernel is None:
             data = surface_data(self)

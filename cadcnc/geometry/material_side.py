@@ -1,6 +1,6 @@
 """Where the material is on a surface model: the rule per shell, and the faces it orients.
 
-- A **solid** (as read): its inside, as today.
+- A **solid** (as read): its inside.
 - A **closed shell**: the volume it encloses; it is made a solid (``BRepBuilderAPI_MakeSolid``
   then ``BRepLib::OrientClosedSolid``, which turns the shell so the volume is finite). A
   closed shell inside another (an odd number of others) is a void of the solid around it,

@@ -22,7 +22,7 @@ Resolution rule: a boundary with total variations Lu = sum |du_k|, Lw = sum |dw_
 Lu dw + Lw du of MIXED area, so N cells over the grid box Du x Dw are best shaped du = sqrt(C
 Lu / Lw), dw = sqrt(C Lw / Lu), C = Du Dw / N, for a MIXED share of the face box Fu x Fw of
 about 2 sqrt(Lu Lw C) / (Fu Fw); N makes that ``target_share`` (2 %), within [256,
-``max_cells`` = 4096] (benchmarks/bench_trim_grid.py). A periodic direction whose bands cover
+``max_cells`` = 4096] (benchmarks/kernel/bench_trim_grid.py). A periodic direction whose bands cover
 over 3/4 of the period spans exactly the wrap range; any other spans the bands + 1.1 clear
 cells each side (periodic ones inside a one-period window centred on them), so a point
 beyond the grid takes its nearest border cell's label.

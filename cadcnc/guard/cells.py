@@ -3,8 +3,8 @@
 A finishing pass follows one face F with the ball; the guard's own-face rule
 (:class:`~cadcnc.guard.clearance.ClearanceGuard`) asks, at every ball centre p, that
 the shank (the segment S from p up to p + L z) comes no nearer to F than the ball does,
-minus tol: dist(S, F) >= d_p - tol with d_p = dist(p, F). On a free-form face that took
-two OCCT distances per point.
+minus tol: dist(S, F) >= d_p - tol with d_p = dist(p, F). On a free-form face OCCT needs
+two distances per point for it; the bound below needs none where it holds.
 
 **The bound.** Split F's points q by height. If q_z <= p_z, p is the point of S nearest
 to q, so dist(q, S) = |q - p| >= d_p. If q_z > p_z, dist(q, S) is at least q's
@@ -168,7 +168,7 @@ class FaceBoxes:
             return self._cell_by_cell(us, ws)
         try:
             return self._refined(us, ws)
-        except Exception:   # noqa: BLE001 - OCCT refused a knot (bug32596_abc_0_13 face 3)
+        except Exception:   # noqa: BLE001 - OCCT refused a knot: box cell by cell
             return self._cell_by_cell(us, ws)
 
     def _cell_by_cell(self, us: np.ndarray, ws: np.ndarray) -> np.ndarray:
@@ -178,8 +178,8 @@ class FaceBoxes:
     def _refined(self, us: np.ndarray, ws: np.ndarray) -> np.ndarray:
         from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
         piece = self.surface.Copy()
-        # a face's range can pass its surface's knots by round-off (1 + 2e-16 on
-        # bug32596_abc_0_13 face 54): OCCT refuses a knot outside them
+        # a face's range can pass its surface's knots by round-off (a relative 2e-16):
+        # OCCT refuses a knot outside them
         u_lo, u_hi, w_lo, w_hi = piece.Bounds()
         us, ws = np.clip(us, u_lo, u_hi), np.clip(ws, w_lo, w_hi)
         for cuts, insert, degree in ((us, piece.InsertUKnots, piece.UDegree()),

@@ -227,8 +227,8 @@ class ClearanceGuard:
         """The ball's margin (mm, against R' - own_tol) from the edges of own face k: the
         ball touches face k at R' at its foot by construction, but near the face's boundary the nearest point of the
         trimmed face can be an edge nearer than the foot (a B-spline face curving towards
-        the ball past a convex edge: bug32596_abc_0_13 faces 4/67 were cut 12 um deep
-        there). Lipschitz-cached apart from the face's own bound (slope 1)."""
+        the ball past a convex edge, where the ball would cut the face beyond the gouge
+        limit). Lipschitz-cached apart from the face's own bound (slope 1)."""
         p0, d0 = self._edge_bound.get(k, (None, None))
         if p0 is not None and d0 - distance(p, p0) - self.own_threshold >= 0.0:
             return d0 - distance(p, p0) - self.own_threshold
@@ -289,8 +289,8 @@ _PART_DATA: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 def _part_data(part) -> tuple:
     """(faces, closed forms, box lows (n, 3), box highs (n, 3)) of every face of a part,
-    computed once per part and shared by its guards (the optimal boxes of a 438-face part
-    took ~1.6 s per guard, and pencil builds one per corner)."""
+    computed once per part and shared by its guards (optimal boxes cost about 4 ms a face,
+    seconds on a part of hundreds of faces, and pencil builds a guard per pair)."""
     data = _PART_DATA.get(part)
     if data is None:
         faces = [part.face(k) for k in range(1, len(part) + 1)]

@@ -2,7 +2,7 @@
 
 The sides of a finished face (a slab's walls) hang from the edge E they share with the
 followed face F. Near that edge the tool is within R' of the wall (the ball touches F at
-E), so a box bound cannot clear the wall and OCCT's distance ran at every step there;
+E), so a box bound cannot clear the wall and OCCT's distance would run at every step there;
 the guard's rule counts it clear because the wall's nearest points are on E (a contact
 on an edge of F belongs to F's own rules).
 

@@ -21,7 +21,7 @@ from .finish.passes import GuidePlane
 from .finish.setup import GUIDE_MARGIN, guide_face
 
 END_REACHED = 1e-12  # mm
-ROLLED = "rolled over"   # the stop detail of a convex roll-over arc (finish_transitions)
+ROLLED = "rolled over"   # the stop detail of a convex roll-over arc (ops/finish/transitions.py)
 
 
 def _tangency(path, k: int) -> Tangency:

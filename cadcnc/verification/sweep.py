@@ -28,7 +28,7 @@ from .material import IN, ON, OUT, Material, PartFaces
 
 EXACT_SLACK = 1e-7
 """How far (mm) OCCT's exact segment distance may sit outside the interval the samples
-allow before it is distrusted (its extrema converge to ~1e-9 mm on these parts)."""
+allow before it is distrusted (its extrema converge to ~1e-9 mm)."""
 MAX_LEVEL = 3  # a move is bisected at most 3 times (7 midpoints) before the exact step
 _STATE = {OUT: 0, ON: 1, IN: 2, None: -1}
 

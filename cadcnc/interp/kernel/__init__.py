@@ -12,8 +12,8 @@ compiles afresh, once).
 Every kernel function (and cadcnc/trim.py's reader) is compiled with ``_nrt=False``: no
 reference counting. The kernel allocates nothing, and with NRT on, each array slice or
 reshape handed from one compiled function to another costs an atomic increment and
-decrement, which took about half of a cycle (0.5-0.6 us of 1.1-1.5 us, `perf` on
-Stepper.run). Without NRT an allocation in the kernel is a compile error.
+decrement, about half of a cycle's time (0.5-0.6 us of 1.1-1.5 us). Without NRT an
+allocation in the kernel is a compile error.
 """
 
 from __future__ import annotations

@@ -37,8 +37,9 @@ osculating surface or fails). Nothing allocates: callable from Python and from o
     status = d2(*data.args, u, w, work, out)  # data.args = (kind, params, ..., weights)
 
 Compiled code is cached (``cache=True``) in this folder's __pycache__; numba does not see
-edits to a function another module calls, so delete the cached *.nbi / *.nbc files after
-editing any module here. A first compilation takes 10-20 s, a cached load well under 1 s.
+edits to a function another module calls, so the package drops the cache when any of its
+sources changes (:mod:`cadcnc.interp.kernel`). A first compilation takes 10-20 s, a
+cached load well under 1 s.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """A finishing pass's self-check: its cuts travel its way and cover what was planned.
 
 A plane's pass is planned from the crossings of its offset curve with the boundaries of
-the selected faces (:mod:`.finish_crossings`) and cut piece by piece. A wrong pairing of
+the selected faces (:mod:`.crossings`) and cut piece by piece. A wrong pairing of
 crossings, a piece run the wrong way or a chain ending early would still give cuts whose
 every point is exact on its face, so the gate alone cannot see it. This check can:
 

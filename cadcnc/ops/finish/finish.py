@@ -1,7 +1,7 @@
 """Guide-surface finishing: raster passes of the ball over selected faces, one program.
 
 :func:`finish` samples the selected faces, places vertical guide planes at the pass angle
-(:mod:`.finish_plan`: a fixed stepover, or the spacing that keeps the scallop within a
+(:mod:`.plan`: a fixed stepover, or the spacing that keeps the scallop within a
 height), runs one pass per plane (:func:`~cadcnc.ops.finish.passes.pass_cuts`: the paper's
 guide-surface interpolation, the ball touching the faces, its centre on the plane), every
 other pass reversed for a zigzag, and links the cuts (:func:`~cadcnc.program.linking.linked`):
@@ -10,7 +10,7 @@ verified clear of the part (:class:`~cadcnc.guard.stay_down.StayDown`: a cheap w
 refutes it, else :class:`~cadcnc.guard.moves.MoveClearance` proves it at least
 R' - 1 µm from every face), otherwise, and always for one-way, it retracts to the
 clearance height. What the passes left uncut (largest scallop, area not machined and
-why) is reported in the program's notes and skipped list (:mod:`.finish_uncut`). Lengths
+why) is reported in the program's notes and skipped list (:mod:`.uncut`). Lengths
 mm, feed mm/min, period s, angles degrees.
 """
 

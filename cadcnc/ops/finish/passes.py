@@ -2,14 +2,14 @@
 
 The ball (offset R' = job.tool.offset) touches a selected face and its centre stays on a
 vertical guide plane (offsets (R', 0): the plane carries the centre). Planning
-(:mod:`.finish_crossings`): where the plane's offset curve crosses the boundary of each
+(:mod:`.crossings`): where the plane's offset curve crosses the boundary of each
 selected face, exactly (contact on the edge, centre on the plane, Brent to 1e-13 of the
 edge parameter). Each entry into the selected region from outside starts a chain of cuts:
 
 - on a face, the stepper (compiled kernel where it applies) runs from the entry to the
   face's next exit along the travel, given as its end point: it lands exactly on it
   (else on the face's boundary, within the stepper's landing);
-- across an edge to another selected face (:mod:`.finish_transitions`): a tangent edge
+- across an edge to another selected face (:mod:`.transitions`): a tangent edge
   is crossed without stopping, a convex edge rolled over (centre on the arc around the
   edge, in the plane, at the cycle step), a concave edge passed at the tri-tangent point
   (the face's cut ends there, the next starts there); consecutive cuts chain exactly
@@ -293,7 +293,7 @@ class _Pass:
         return None
 
     def exact(self, face: int, tp: Toolpath, guard, keep_first: bool) -> None:
-        """Move the cut's points onto the exact offset curve (:mod:`.finish_polish`), in
+        """Move the cut's points onto the exact offset curve (:mod:`.polish`), in
         place; an exact start (an entry, a transition) and an end landed on are kept as
         they are. A point landed on a guard's zero (first after a resume, last after a
         collision) that the move made negative is put back on the zero, on the curve."""

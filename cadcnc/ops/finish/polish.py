@@ -1,7 +1,7 @@
 """Put a pass's points exactly on the offset curve: two Newton steps per point.
 
-The interpolator's points on a free-form face lie within about 5e-5 mm of its offset at
-f = 0.1 mm (the method's O(f^2) error; finish_slab, R 3); finishing promises 1 um. Each
+The interpolator's points on a free-form face lie within about 1e-4 mm of its offset at
+f = 0.1 mm (the method's carried O(f^2) error); finishing promises 1 um. Each
 point p (with its contact parameters (u, w) and the curve's tangent t = nrm x n) is
 moved to the point c(u, w) = r + R' n of the exact offset surface with
 c . nrm = off (on the guide plane) and (c - p) . t = 0 (the same place along the pass):

@@ -62,7 +62,7 @@ def _edge_index(edges, edge) -> int | None:
 
 
 def transition(ps, face: int, exit_: Crossing) -> Transition:
-    """The :class:`Transition` of pass ``ps`` (finish_pass._Pass) at ``exit_`` of ``face``."""
+    """The :class:`Transition` of pass ``ps`` (passes._Pass) at ``exit_`` of ``face``."""
     end = ps.tangency(exit_.point, exit_.uv)
     g = exit_.neighbour
     if g is None or g not in ps.setup.surfaces:

@@ -2,7 +2,7 @@
 
 Resolves the faces (part faces, CadQuery faces), checks that they make a pair a ball can
 follow, solves the start and end tangencies (defaults: the ends of the shared concave
-edge), and runs the :class:`~cadcnc.stepper.Stepper` loop. Units: radius, allowance,
+edge), and runs the :class:`~cadcnc.interp.stepper.Stepper` loop. Units: radius, allowance,
 points in mm; feed in mm/min; period in s.
 """
 

@@ -182,7 +182,7 @@ def _short_period(job: Job, st: Stretch) -> Job:
     """The job of a stretch's cut, with a shorter period (the same feed) when the stretch
     is shorter than SHORT_STEPS steps: the stepper lands on its end only after 2 steps
     (so that a closed path does not stop at its start), and would otherwise run past the
-    end of a stretch shorter than that (a 0.007 mm edge: 8 mm past it, to a boundary)."""
+    end of a stretch shorter than that (on to the next boundary)."""
     if st.closed or st.length <= POINT_STRETCH:
         return job
     chord = float(np.linalg.norm(np.subtract(st.end.p, st.start.p)))

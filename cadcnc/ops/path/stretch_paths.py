@@ -44,9 +44,9 @@ def stretch_paths(s1, s2, job: Job, guard: ClearanceGuard | None = None,
     """(stretch, toolpath) for every feasible stretch of the pair, edge by edge
     (``found``: the pair's stretches when already computed).
 
-    The stepper runs between the stretch's limits; until it carries the clearance guard
-    itself, the stretch's limits (located to 1e-7 mm) are what keep the path clear of
-    third faces, and the whole-part gouge gate stays the final check.
+    The stepper runs between the stretch's limits without the clearance guard: the
+    stretch's limits (located to 1e-7 mm) keep the path clear of third faces, and the
+    whole-part gouge gate stays the final check.
     """
     if found is None:
         found = pair_stretches(s1, s2, job, guard)

@@ -278,8 +278,8 @@ def _refine(feas, curve, samples: list[Sample], out: EdgeStretches) -> list[Samp
             elif np.linalg.norm(np.subtract(a.tangency.p, b.tangency.p)) > MAX_CHORD:
                 if b.s - a.s > floor:
                     # seeded from a's tangency, feasible or not, as the grid is: from the
-                    # anchor alone Newton may land on another branch of the curve (15 mm
-                    # off on r0901_ec 67/377), and every halving would land there again
+                    # anchor alone Newton may land on another branch of the curve (millimetres
+                    # away), and every halving would land there again
                     stack.append(_at(feas, curve, 0.5 * (a.s + b.s), a))
                     continue
                 out.missed += 1

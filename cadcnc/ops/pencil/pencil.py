@@ -14,7 +14,7 @@ Direction: ``side="climb"`` (default) runs every corner with the material on the
 of the travel (climb milling with a clockwise spindle), ``"conventional"`` the other
 way; a cut whose corner runs the other way is interpolated again from its other limit
 (not the same points backwards). Corners running mostly up or down keep their direction,
-and so do blend corners (from the blend's first seed to its second) in this version.
+and so do blend corners (from the blend's first seed to its second).
 """
 
 from __future__ import annotations
@@ -233,7 +233,7 @@ def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float,
     down to its first cut's start and left by a retract straight up from its last cut's
     end (:func:`~cadcnc.program.linking.link`). Such a point is reachable when the ball
     and a shank from it up to the link height ``z_safe`` (mm) clear the part by R' - 1 um
-    less the gate's tolerance (:func:`.guard.guard_for`, the stepper's guard with a longer
+    less the gate's tolerance (:func:`~cadcnc.guard.guard_for`, the stepper's guard with a longer
     shank): not so in a sealed
     void, or under an overhang higher than the shank. A cut whose entry or exit is
     blocked is dropped and the rest ordered again (its neighbours may then need one).
