@@ -14,7 +14,7 @@ import os
 import sys
 from importlib.metadata import version
 
-from cadcnc.errors import CadcncError  # light: the package loads OCCT lazily
+from cadcnc.errors import EXIT_INTERRUPTED, CadcncError  # light: the package loads OCCT lazily
 from cadcnc.interrupts import sigint_deferred
 
 from .operation import DEFAULT_FEED, DEFAULT_PERIOD, add_max_cycles
@@ -116,7 +116,8 @@ def build_parser() -> argparse.ArgumentParser:
             "Compute the program of faces I and J: every feasible stretch of their shared "
             "concave edges cut by the ball, linked by retract, rapid and plunge; gate it "
             "against the whole part and write it; the format follows each output's suffix. "
-            "Exit 0 complete and verified, 2 no feasible stretch, 5 gouge, 6 partial.")
+            "Exit codes: docs/reliability.md (0 complete and verified, 2 bad input, 3 no "
+            "feasible stretch, 5 gouge, 6 partial).")
     p.add_argument("step", metavar="PART.step", help="the part (STEP file, mm)")
     _job_options(p, required=True)
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
@@ -222,7 +223,7 @@ def main(argv: list[str] | None = None) -> int:
         return int(run(args) or 0)
     except KeyboardInterrupt:
         print("cadcnc: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
     except BrokenPipeError:  # `cadcnc run --stream ... | head`: the reader left, fine
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0

@@ -178,3 +178,20 @@ def test_nothing_imports_upward():
             if theirs is not None and theirs > mine:
                 upward.append(f"{name} -> {dep}")
     assert upward == []
+
+
+def test_exit_codes_come_from_their_one_definition():
+    """The commands return the codes of cadcnc.errors (EXIT_*), never a literal other than
+    0: the codes are defined once (docs/reliability.md)."""
+    literal = []
+    for name, path in MODULES.items():
+        if not (name.startswith("cadcnc.cli") or name.endswith("__main__")):
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not isinstance(node, ast.Return) or node.value is None:
+                continue
+            value = node.value
+            branches = [value.body, value.orelse] if isinstance(value, ast.IfExp) else [value]
+            literal += [f"{name}:{node.lineno}: {b.value}" for b in branches
+                        if isinstance(b, ast.Constant) and type(b.value) is int and b.value]
+    assert literal == []
