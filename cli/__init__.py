@@ -5,6 +5,8 @@ from __future__ import annotations
 import os
 import sys
 
+from cadcnc.errors import EXIT_INTERRUPTED
+
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; Ctrl-C while it starts up is exit 130 too, not a traceback.
@@ -21,7 +23,7 @@ def main(argv: list[str] | None = None) -> int:
         code = run(argv)
     except KeyboardInterrupt:  # during start-up or argument parsing
         print("cadcnc: interrupted", file=sys.stderr)
-        code = 130
+        code = EXIT_INTERRUPTED
     if argv is None:
         _exit_now(code)
     return code

@@ -21,6 +21,24 @@ CONCAVE_PAIRS = [(name, *p["faces"]) for name in FIXTURE_NAMES
 
 _parts: dict = {}
 
+SLOW_MODULES = {"test_finish.py", "test_fuzz.py", "test_fuzz_operations.py",
+                "test_hal_loop.py", "test_controller_stream.py", "test_trim_grid.py",
+                "test_gate.py", "test_finish_bounds.py"}
+CLI_MODULES = {"test_cli.py", "test_cli_program.py", "test_cli_smoke.py", "test_cli_units.py",
+               "test_pencil_cli.py", "test_finish_cli.py", "test_controller_cli.py",
+               "test_outputs.py", "test_bad_input.py", "test_bounds_and_inputs.py",
+               "test_fuzz_operations.py", "test_one_job.py", "test_surface_models.py"}
+
+
+def pytest_collection_modifyitems(config, items):
+    """The markers of pyproject.toml, by module: ``slow`` and ``cli``."""
+    for item in items:
+        name = item.path.name
+        if name in SLOW_MODULES:
+            item.add_marker(pytest.mark.slow)
+        if name in CLI_MODULES:
+            item.add_marker(pytest.mark.cli)
+
 
 def load_fixture(name: str):
     """The fixture's Part, loaded once per test session."""
