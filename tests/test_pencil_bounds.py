@@ -11,15 +11,9 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from OCP.BRep import BRep_Builder
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
-from OCP.BRepClass3d import BRepClass3d_SolidClassifier
-from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-from OCP.gp import gp_Pnt
-from OCP.TopAbs import TopAbs_IN
-from OCP.TopoDS import TopoDS_Compound
 
 import cadcnc
+from benchmarks.reliability.judge import polyline_depths
 from cadcnc.errors import EXIT_NOTHING, InputError, NothingToCutError
 from cadcnc.job import Job, PairPath, Pencil, Tool
 from cadcnc.ops.path.pair_path import plan_path
@@ -77,28 +71,6 @@ def test_a_ball_of_no_size_is_an_input_error_not_a_traceback(op):
 
 # -- 2. a tiny ball -------------------------------------------------------------------
 
-def depths(part, points: np.ndarray, ball: float) -> np.ndarray:
-    """Independent oracle: (N,) depth of the ball into the part at each point, R' - d
-    outside the solid and R' + d inside (OCCT's vertex-to-faces distance, OCCT's solid
-    classifier at every point)."""
-    faces = TopoDS_Compound()
-    builder = BRep_Builder()
-    builder.MakeCompound(faces)
-    for n in range(1, len(part) + 1):
-        builder.Add(faces, part.face(n).topods)
-    dss = BRepExtrema_DistShapeShape()
-    dss.LoadS2(faces)
-    classifier = BRepClass3d_SolidClassifier(part.shape)
-    out = np.empty(len(points))
-    for k, p in enumerate(points):
-        dss.LoadS1(BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex())
-        dss.Perform()
-        assert dss.IsDone()
-        classifier.Perform(gp_Pnt(*map(float, p)), 1e-9)
-        inside = classifier.State() == TopAbs_IN
-        out[k] = ball + dss.Value() if inside else ball - dss.Value()
-    return out
-
 
 def test_a_ball_smaller_than_the_gouge_limit_is_judged_not_refused():
     """R 0.001 mm = the gouge limit: the gate used to find every move unprovable ("every
@@ -115,7 +87,7 @@ def test_a_ball_smaller_than_the_gouge_limit_is_judged_not_refused():
         p = cut.points
         t = np.linspace(0.0, 1.0, 10, endpoint=False)[None, :, None]
         along = (p[:-1, None, :] * (1 - t) + p[1:, None, :] * t).reshape(-1, 3)
-        assert depths(part, np.vstack([along, p[-1:]]), job.tool.offset).max() <= lam
+        assert polyline_depths(part, np.vstack([along, p[-1:]]), job.tool.offset).max() <= lam
 
 
 # -- 3. degenerate edges and short stretches ------------------------------------------

@@ -39,7 +39,6 @@ from __future__ import annotations
 import argparse
 import json
 import re
-import sys
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -53,8 +52,8 @@ from cadcnc.controller.hal.linuxcnc_sim import run_ngc
 from cadcnc.io.program_gcode import program_ngc
 from cadcnc.ops.stream_steppers import stepper_factory
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from stream_cost import programs  # noqa: E402
+from benchmarks.controller.linuxcnc_baseline import violations
+from benchmarks.controller.stream_cost import programs
 
 QUANTUM = 1e-9          # mm: the samples' resolution (µm printed with 6 decimals)
 REF_PERIOD = 5e-5       # s: the reference's period ...
@@ -113,19 +112,10 @@ def measure(pos: np.ndarray, first: np.ndarray, ref: Reference, m: Machine) -> d
     err = ref.distance(run)
     w = pos[max(start - 3, 0):end + 4]
     dt = m.period
-    v = np.diff(w, axis=0) / dt
-    a = np.diff(v, axis=0) / dt
-    j = np.diff(a, axis=0) / dt
     out = {"cycle_time_s": (end - start) * dt, "contour_max_mm": float(err.max()),
            "contour_p99_mm": float(np.percentile(err, 99)),
            "contour_p50_mm": float(np.percentile(err, 50))}
-    for name, d, lim, q in (("v", v, m.max_velocity, 2 * QUANTUM / dt),
-                            ("a", a, m.max_acceleration, 4 * QUANTUM / dt ** 2),
-                            ("j", j, m.max_jerk, 8 * QUANTUM / dt ** 3)):
-        lim = np.asarray(lim, dtype=float)
-        over = np.abs(d) > lim * (1 + 1e-6) + q
-        out[f"{name}_over"] = int(over.any(axis=1).sum())
-        out[f"{name}_share"] = float((np.abs(d) / lim).max())
+    out.update({k.replace("_peak_share", "_share"): x for k, x in violations(w, m).items()})
     return out
 
 

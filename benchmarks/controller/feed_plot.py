@@ -18,7 +18,7 @@ from cadcnc.controller import Machine, stream_program  # noqa: E402
 from cadcnc.controller.pieces import constant_speed  # noqa: E402
 from cadcnc.ops.stream_steppers import stepper_factory  # noqa: E402
 
-from stream_cost import programs  # noqa: E402
+from benchmarks.controller.stream_cost import programs
 
 OUT = Path(__file__).resolve().parents[2] / "docs" / "img" / "controller_feed.png"
 

@@ -111,6 +111,25 @@ def write_ngc(points: np.ndarray, feed: float, p: float, path: Path) -> int:
     return len(head) + 1  # 1-based line of the first G1
 
 
+
+def violations(w: np.ndarray, m) -> dict:
+    """Per limit (v, a, j) of ``m``, the samples of positions ``w`` (K, 3) over it by
+    finite differences at the servo period (1e-6 relative slack, plus the samples'
+    resolution), and the peak share of the limit."""
+    dt = m.period
+    v = np.diff(w, axis=0) / dt
+    a = np.diff(v, axis=0) / dt
+    j = np.diff(a, axis=0) / dt
+    out = {}
+    for name, d, lim, q in (("v", v, m.max_velocity, 2 * QUANTUM / dt),
+                            ("a", a, m.max_acceleration, 4 * QUANTUM / dt ** 2),
+                            ("j", j, m.max_jerk, 8 * QUANTUM / dt ** 3)):
+        lim = np.asarray(lim, dtype=float)
+        over = np.abs(d) > lim * (1 + 1e-6) + q
+        out[f"{name}_over"] = int(over.any(axis=1).sum())
+        out[f"{name}_peak_share"] = float((np.abs(d) / lim).max())
+    return out
+
 def measure(pos: np.ndarray, start: int, exact: Exact, m, end_point) -> dict:
     """Cycle time, contour error and limit violations of sampled positions (mm, s)."""
     moving = np.nonzero(np.abs(np.diff(pos, axis=0)).max(1) > QUANTUM)[0]
@@ -119,19 +138,10 @@ def measure(pos: np.ndarray, start: int, exact: Exact, m, end_point) -> dict:
     err = exact.distance(cut)
     w = pos[max(start - 3, 0):end + 4]
     dt = m.period
-    v = np.diff(w, axis=0) / dt
-    a = np.diff(v, axis=0) / dt
-    j = np.diff(a, axis=0) / dt
     out = {"cycle_time_s": (end - start) * dt, "periods": end - start,
            "contour_max_mm": float(err.max()), "contour_p99_mm": float(np.percentile(err, 99)),
            "end_error_mm": float(np.linalg.norm(pos[end] - end_point))}
-    for name, d, lim, q in (("v", v, m.max_velocity, 2 * QUANTUM / dt),
-                            ("a", a, m.max_acceleration, 4 * QUANTUM / dt**2),
-                            ("j", j, m.max_jerk, 8 * QUANTUM / dt**3)):
-        lim = np.asarray(lim, dtype=float)
-        over = np.abs(d) > lim * (1 + 1e-6) + q
-        out[f"{name}_over"] = int(over.any(axis=1).sum())
-        out[f"{name}_peak_share"] = float((np.abs(d) / lim).max())
+    out.update(violations(w, m))
     return out
 
 
