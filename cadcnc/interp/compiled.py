@@ -116,7 +116,7 @@ class CompiledStepper(Stepper):
             S[E.ARG_U], S[E.ARG_W] = uv
             if self._call(E.OP_MOVE_TO, -1, 0.0, side)[0] != 0:
                 raise GeometryError(f"surface {side + 1}: the compiled evaluator cannot "
-                                    f"evaluate the start contact {tuple(uv)}")
+                                    f"evaluate the start contact ({uv[0]:.6g}, {uv[1]:.6g})")
         self.closed, self.max_cycles, self.check_boundary = closed, max_cycles, check_boundary
         self.guard, self.stop_reason, self.stop_detail = guard, None, ""
         self._watch, self._margin, self.landing_trials = None, math.nan, 0

@@ -67,7 +67,7 @@ def solve_tangency(s1, s2, offsets: tuple[float, float], seed_uv1, seed_uv2, anc
     """
     x = [float(v) for v in (*seed_uv1, *seed_uv2)]
     anchor = tuple(float(v) for v in anchor)
-    label = tuple(np.round(anchor, 4))
+    label = "(" + ", ".join(f"{v:.4f}" for v in anchor) + ")"
 
     def residual(x):
         o1, j1, n1 = offset_point_and_jacobian(s1, offsets[0], x[0], x[1])

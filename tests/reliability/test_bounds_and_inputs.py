@@ -140,3 +140,13 @@ def test_a_wrong_argument_type_is_named(block, case):
     call, needle = API_CASES[case]
     with pytest.raises(InputError, match=needle):
         call(block)
+
+
+def test_a_run_message_prints_plain_numbers(tmp_path):
+    """Was: "at the start tangency (np.float64(42.9968), ...)" in a `run` error."""
+    apt = tmp_path / "big.apt"
+    apt.write_text(f"PARTNO/'t'\nPART = '{FIXTURES / 'bspline_boss.step'}'\nCUTTER/R=30\n"
+                   "FEED/1500\nPERIOD/4ms\nBOSS = P/[F4, F5, EDGE, EDGE]\nFINI\n")
+    run = cadcnc_cli("run", apt)
+    assert run.returncode == 3 and "np.float64" not in run.stderr + run.stdout
+    assert re.search(r"tangency \(-?\d+\.\d{4}, -?\d+\.\d{4}, -?\d+\.\d{4}\)", run.stderr)

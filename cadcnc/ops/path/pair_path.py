@@ -134,7 +134,8 @@ def plan_path(s1: FaceSurface, s2: FaceSurface, job: Job) -> PathPlan:
             # an end beyond a face is fine: the path stops where the contact leaves it
             if which == "start" and not s.contains(*uv):
                 raise StartPointError(
-                    f"{which}: at the {which} tangency {tuple(np.round(tan.p, 4))} the ball "
+                    f"{which}: at the {which} tangency ({', '.join(f'{v:.4f}' for v in tan.p)})"
+                    " the ball "
                     f"touches {label} outside the face (its contact lies beyond the face's "
                     f"boundary); give a {which} point further inside the intersection")
         solved.append(tan)
