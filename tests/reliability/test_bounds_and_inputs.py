@@ -150,3 +150,28 @@ def test_a_run_message_prints_plain_numbers(tmp_path):
     run = cadcnc_cli("run", apt)
     assert run.returncode == 3 and "np.float64" not in run.stderr + run.stdout
     assert re.search(r"tangency \(-?\d+\.\d{4}, -?\d+\.\d{4}, -?\d+\.\d{4}\)", run.stderr)
+
+
+def test_pencil_refuses_a_clearance_below_the_top(tmp_path):
+    """Was: `pencil step_block --clearance -1000` started with G0 Z13 under the top (20)
+    and rapid sideways there. Now refused before computing, naming the lowest value."""
+    out = tmp_path / "p.ngc"
+    run = cadcnc_cli("pencil", FIXTURES / "step_block.step", "--radius", "3",
+                     "--clearance", "-1000", "-o", out)
+    assert run.returncode == 2 and "lowest allowed is 23 mm" in run.stderr
+    assert not out.exists()
+
+
+def test_a_refused_program_says_so_after_its_summary(tmp_path):
+    """Was: a refused finish printed "status complete", then "refused". The summary's
+    last line is the verdict: nothing written, with the exit code (a 0.016 mm ball over
+    the ridge's convex edge, which the gate refuses: docs/reliability.md)."""
+    out = tmp_path / "p.json"
+    run = cadcnc_cli("finish", FIXTURES / "finish_ridge.step", "--faces", "3", "4",
+                     "--radius", "0.0160072", "--stepover", "10.9", "-o", out, "-o",
+                     tmp_path / "p.ngc")
+    assert run.returncode == 5 and not out.exists()
+    summary = run.stdout.splitlines()
+    verdict = next(k for k, line in enumerate(summary) if line.startswith("  verdict"))
+    assert summary[verdict - 1] == "  result     complete"
+    assert summary[verdict] == "  verdict    nothing written (exit 5: see the message above)"
