@@ -43,6 +43,7 @@ from OCP.GeomAbs import GeomAbs_BSplineCurve
 from scipy.spatial import cKDTree
 
 from ..trim import OUTSIDE
+from .clearance import distance
 
 CELL_MM = 1.0
 """About this many mm of surface per cell side (at most ``MAX_CELLS`` cells)."""
@@ -298,14 +299,14 @@ class HeightCells:
         if self._proof is not None:
             x0, y0, z0, rho0, q = self._proof
             if pz >= z0:
-                room = rho0 - math.hypot(px - x0, py - y0) - _dist(p, q)
+                room = rho0 - math.hypot(px - x0, py - y0) - distance(p, q)
                 if room >= 0.0:
                     best = min(pz - z0, 0.5 * room)
                     if best >= REUSE:
                         return best
         cached = self._proof
         q = tuple(self.points[self.tree.query((px, py, pz))[1]].tolist())
-        d = _dist(p, q)
+        d = distance(p, q)
         for drop in DROPS:
             rho0 = self.rho(p, pz - drop, d + 2.0 * drop + SEARCH)
             if rho0 >= d and min(drop, 0.5 * (rho0 - d)) > best:
@@ -333,7 +334,3 @@ def shared(kind, face):
     if kind not in per_face:
         per_face[kind] = kind(face)
     return per_face[kind]
-
-
-def _dist(a, b) -> float:
-    return math.sqrt((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 + (a[2] - b[2]) ** 2)
