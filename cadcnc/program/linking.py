@@ -5,11 +5,15 @@ next is the polyline a -> (a.x, a.y, z_safe) -> (b.x, b.y, z_safe) -> (b.x, b.y,
 approach) -> b: the retract and the move across are rapids, the last part a feed move at
 the plunge feed (``approach`` mm above b, or all of the descent when z_safe is lower).
 The program's first cut is reached the same way from above its start, and the last cut
-leaves straight up to z_safe. Whether a link clears the part is decided by the gouge gate,
+leaves straight up to z_safe. Where a cut is entered or left otherwise (:class:`Visit`:
+from a point outside the part at the cut's height, or along cut points retraced), the
+link runs that way (:mod:`cadcnc.ops.entries` decides it). Whether a link clears the part is decided by the gouge gate,
 which checks every move of the program, links included.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -35,60 +39,126 @@ def _descent(xy: np.ndarray, z_from: float, z_to: float, approach: float):
     return pts, rapid
 
 
-def link(a: np.ndarray, b: np.ndarray, z_safe: float, approach: float = APPROACH
-         ) -> LinkSegment:
-    """The link from point ``a`` (a cut's end) to ``b`` (the next cut's start), (3,) mm."""
+@dataclass
+class Visit:
+    """Cuts machined between one entry and one exit: ``segments`` (cuts, and the feed links
+    retracing cut points between them), entered at the first cut's start and left at the
+    last cut's end. ``side_in`` / ``side_out``: None where the tool comes straight down /
+    goes straight up there, else the point (3,) mm outside the part at the same height
+    from which it comes in / to which it leaves horizontally (:mod:`cadcnc.ops.entries`)."""
+
+    segments: list
+    side_in: np.ndarray | None = None
+    side_out: np.ndarray | None = None
+
+    @property
+    def cuts(self) -> list[CutSegment]:
+        return [s for s in self.segments if s.kind == "cut"]
+
+    @property
+    def points(self) -> np.ndarray:
+        """(2, 3): where the visit starts and ends, mm (what :func:`order_cuts` reads)."""
+        return np.array([self.segments[0].points[0], self.segments[-1].points[-1]])
+
+
+def _visit(item) -> Visit:
+    return item if isinstance(item, Visit) else Visit([item])
+
+
+def _up(a: np.ndarray, side, top: float) -> tuple[list, list]:
+    """Points and flags after ``a`` up to ``top``: straight up (rapid), or first out to
+    ``side`` at the plunge feed then up."""
+    pts, rapid, at = [], [], a
+    if side is not None:
+        at = np.asarray(side, dtype=float)
+        pts.append(tuple(at))
+        rapid.append(False)
+    if top > at[2]:
+        pts.append((at[0], at[1], top))
+        rapid.append(True)
+    return pts, rapid
+
+
+def _down(b: np.ndarray, side, top: float, approach: float) -> tuple[list, list]:
+    """Points and flags from above (at ``top``) down to ``b``: the descent (rapid, then
+    feed for the last ``approach``) onto b, or onto ``side`` and then across to b."""
+    at = b if side is None else np.asarray(side, dtype=float)
+    pts, rapid = _descent(at[:2], top, at[2], approach)
+    if side is not None:
+        pts.append(tuple(b))
+        rapid.append(False)
+    return pts, rapid
+
+
+def link(a: np.ndarray, b: np.ndarray, z_safe: float, approach: float = APPROACH,
+         side_out=None, side_in=None) -> LinkSegment:
+    """The link from point ``a`` (a cut's end) to ``b`` (the next cut's start), (3,) mm:
+    up from a (or out to ``side_out`` first), across at the clearance height, down onto b
+    (or onto ``side_in`` and across to b)."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     top = max(z_safe, a[2], b[2])
-    pts = [tuple(a)]
-    rapid = []
-    if top > a[2]:
-        pts.append((a[0], a[1], top))
+    pts, rapid = _up(a, side_out, top)
+    pts.insert(0, tuple(a))
+    over_a = np.asarray(pts[-1])
+    over_b = b if side_in is None else np.asarray(side_in, dtype=float)
+    if over_a[2] < top:   # a or its side point lies at the top already
+        pts.append((over_a[0], over_a[1], top))
         rapid.append(True)
-    if np.hypot(*(b[:2] - a[:2])) > 0.0:
-        pts.append((b[0], b[1], top))
+    if np.hypot(*(over_b[:2] - over_a[:2])) > 0.0:
+        pts.append((over_b[0], over_b[1], top))
         rapid.append(True)
-    down, flags = _descent(b[:2], top, b[2], approach)
-    pts += down
-    rapid += flags
-    return LinkSegment(np.array(pts), np.array(rapid))
+    down, flags = _down(b, side_in, top, approach)
+    return LinkSegment(np.array(pts + down), np.array(rapid + flags))
 
 
-def approach(b: np.ndarray, z_safe: float, approach: float = APPROACH) -> LinkSegment:
-    """From above ``b`` at z_safe down to b (rapid, then feed for the last ``approach``)."""
+def approach(b: np.ndarray, z_safe: float, approach: float = APPROACH,
+             side=None) -> LinkSegment:
+    """From above ``b`` (or ``side``) at z_safe down to b (rapid, then feed for the last
+    ``approach``; then across from ``side`` to b at feed)."""
     b = np.asarray(b, dtype=float)
-    top = max(z_safe, b[2] + approach)
-    down, flags = _descent(b[:2], top, b[2], approach)
-    return LinkSegment(np.array([(b[0], b[1], top), *down]), np.array(flags))
+    at = b if side is None else np.asarray(side, dtype=float)
+    top = max(z_safe, at[2] + approach, b[2])
+    down, flags = _down(b, side, top, approach)
+    return LinkSegment(np.array([(at[0], at[1], top), *down]), np.array(flags))
 
 
-def retract(a: np.ndarray, z_safe: float) -> LinkSegment:
-    """From ``a`` straight up to z_safe (a rapid)."""
+def retract(a: np.ndarray, z_safe: float, side=None) -> LinkSegment:
+    """From ``a`` straight up to z_safe (a rapid), or out to ``side`` first (feed)."""
     a = np.asarray(a, dtype=float)
-    return LinkSegment(np.array([a, (a[0], a[1], max(z_safe, a[2]))]), np.array([True]))
+    top = max(z_safe, a[2])
+    pts, rapid = _up(a, side, top)
+    if not pts:   # already at the top
+        pts, rapid = [(a[0], a[1], top)], [True]
+    return LinkSegment(np.array([a, *pts]), np.array(rapid))
 
 
-def linked(cuts: list[CutSegment], z_safe: float, approach_mm: float = APPROACH,
+def linked(cuts: list, z_safe: float, approach_mm: float = APPROACH,
            join: float = 0.0, stay_down=None) -> list:
     """``cuts`` in order with an approach before the first, a link between each two, and a
     retract after the last: the segments of a program. Two cuts whose gap is at most
     ``join`` mm (a chain: the next starts where the last stopped, both located to within
     their limits' accuracy) are joined by one straight feed move instead of a lift, and so
     are two cuts for which ``stay_down(a, b)`` (the end of one and the start of the next,
-    (3,) mm) says that straight move is verified clear (a zigzag's pass ends)."""
+    (3,) mm) says that straight move is verified clear (a zigzag's pass ends). An item of
+    ``cuts`` may be a :class:`Visit`: its segments in order, entered and left its way."""
     if not cuts:
         return []
-    out: list = [approach(cuts[0].points[0], z_safe, approach_mm)]
-    for k, cut in enumerate(cuts):
-        a = cuts[k - 1].points[-1] if k else cut.points[0]
-        gap = float(np.linalg.norm(cut.points[0] - a))
+    visits = [_visit(c) for c in cuts]
+    first = visits[0]
+    out: list = [approach(first.points[0], z_safe, approach_mm, first.side_in)]
+    for k, v in enumerate(visits):
+        start = v.points[0]
+        prev = visits[k - 1] if k else None
+        a = prev.points[-1] if prev is not None else start
+        gap = float(np.linalg.norm(start - a))
         if gap > JOINED and (gap <= join or (stay_down is not None
-                                             and stay_down(a, cut.points[0]))):
-            out.append(LinkSegment(np.array([a, cut.points[0]]), np.array([False])))
+                                             and stay_down(a, start))):
+            out.append(LinkSegment(np.array([a, start]), np.array([False])))
         elif gap > JOINED:
-            out.append(link(a, cut.points[0], z_safe, approach_mm))
-        out.append(cut)
-    out.append(retract(cuts[-1].points[-1], z_safe))
+            out.append(link(a, start, z_safe, approach_mm, prev.side_out, v.side_in))
+        out += v.segments
+    last = visits[-1]
+    out.append(retract(last.points[-1], z_safe, last.side_out))
     return out
 
 

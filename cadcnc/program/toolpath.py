@@ -153,9 +153,38 @@ def toolpath_head(path: Toolpath, n: int, stop_reason: str, stop_detail: str) ->
     ``stop_reason``: a cut cut back to its last verified point."""
     if not 2 <= n <= len(path):
         raise ValueError(f"a cut back path needs 2..{len(path)} points, got {n}")
+    return replace(toolpath_piece(path, 0, n - 1), stop_reason=stop_reason,
+                   stop_detail=stop_detail)
+
+
+POINT_FIELDS = ("eps", "k", "k_max", "k_min", "tau")
+"""Fields of :class:`SurfaceBounds` that describe a point (the others bound the step
+leaving it)."""
+
+
+def toolpath_piece(path: Toolpath, lo: int, hi: int, reverse: bool = False) -> Toolpath:
+    """Points ``lo``..``hi`` (inclusive, lo < hi) of ``path`` as a toolpath of their own,
+    run from hi back to lo when ``reverse``: the same positions, so every check of the
+    path holds for the piece. Reversed, a point's step is the same chord run the other way
+    (``steps``, ``commanded`` shifted by one; the start keeps the path's first row), and
+    the bound of the step leaving a point is the forward bound of that same chord
+    (computed at its other end); point properties (``POINT_FIELDS``) stay with their
+    points."""
+    if not 0 <= lo < hi < len(path):
+        raise ValueError(f"a piece of a {len(path)}-point path needs 0 <= lo < hi < "
+                         f"{len(path)}, got {lo}, {hi}")
+    sl = slice(lo, hi + 1)
+    if not reverse:
+        pick = lambda a: a[sl]  # noqa: E731
+        chord = pick
+        run = lambda a: np.concatenate([a[:1], a[lo + 1:hi + 1]])  # noqa: E731
+    else:
+        pick = lambda a: a[sl][::-1]  # noqa: E731
+        chord = lambda a: np.append(a[lo:hi][::-1], a[lo])  # noqa: E731
+        run = lambda a: np.concatenate([a[:1], a[lo + 1:hi + 1][::-1]])  # noqa: E731
     bounds = None if path.bounds is None else tuple(
-        replace(b, **{f.name: getattr(b, f.name)[:n] for f in fields(b)}) for b in path.bounds)
-    return replace(path, points=path.points[:n], contacts=path.contacts[:n],
-                   normals=path.normals[:n], uv=path.uv[:n], steps=path.steps[:n],
-                   commanded=path.commanded[:n], stop_reason=stop_reason,
-                   stop_detail=stop_detail, bounds=bounds)
+        replace(b, **{f.name: (pick if f.name in POINT_FIELDS else chord)(getattr(b, f.name))
+                      for f in fields(b)}) for b in path.bounds)
+    return replace(path, points=pick(path.points), contacts=pick(path.contacts),
+                   normals=pick(path.normals), uv=pick(path.uv), steps=run(path.steps),
+                   commanded=run(path.commanded), bounds=bounds)

@@ -4,14 +4,15 @@ An operation that builds a program (pencil) does not throw the whole program awa
 cut gouges: :func:`cut_back` gates each cut on its own points and moves
 (:func:`~cadcnc.verification.gate.gouge_gate`), keeps every cut that passes, cuts a
 failing one back to the last point before its first failing centre or move, lists the rest
-under ``skipped`` (reason ``gouge``, with the gate's message), and links the cuts again.
+under ``skipped`` (reason ``gouge``, with the gate's message), and links the cuts again,
+each entered by the operations' rule (:mod:`cadcnc.ops.entries`).
 The program it returns is then gated whole, written moves and links included, as any
 program. Lengths mm.
 """
 
 from __future__ import annotations
 
-from ..program.linking import linked
+from ..ops.entries import entered_program_segments
 from ..program.program import CutSegment, Program, Skipped
 from ..program.toolpath import toolpath_head
 from .gate import gouge_gate
@@ -54,4 +55,6 @@ def cut_back(program: Program, part, z_safe: float, join: float = 0.0) -> Progra
             f"{len(seg.points)} points: {gate.message}"), seg.edge))
     if not changed:
         return program
-    return Program(program.job, linked(cuts, z_safe, join=join), skipped, program.notes)
+    segments, unreachable, _ = entered_program_segments(part, program.job, cuts, z_safe,
+                                                        join=join)
+    return Program(program.job, segments, skipped + unreachable, program.notes)

@@ -9,7 +9,9 @@ a zigzag stays down between two cuts only where that straight move of the ball a
 verified clear of the part (:class:`~cadcnc.guard.stay_down.StayDown`: a cheap witness
 refutes it, else :class:`~cadcnc.guard.moves.MoveClearance` proves it at least
 R' - 1 µm from every face), otherwise, and always for one-way, it retracts to the
-clearance height. What the passes left uncut (largest scallop, area not machined and
+clearance height. Each pass is entered where the tool can get to it, as every cut is
+(:mod:`cadcnc.ops.entries`: a pass under an overhang from its other end, a point between
+or the side). What the passes left uncut (largest scallop, area not machined and
 why) is reported in the program's notes and skipped list (:mod:`.uncut`). Lengths
 mm, feed mm/min, period s, angles degrees.
 """
@@ -24,7 +26,6 @@ import numpy as np
 from ...errors import InputError
 from ...geometry.part import Part
 from ...job import Finish, Job, Tool
-from ...program.linking import linked
 from ...program.program import CutSegment, Program, Skipped
 from ...tolerances import DEFAULT, Tolerances
 from ...guard.stay_down import StayDown
@@ -34,6 +35,7 @@ from .setup import pass_setup
 from .plan import MAX_SAMPLES, centre_chord, plan_planes, sample_faces
 from .uncut import uncut_report
 from ..common import safe_height
+from ..entries import entered_program_segments
 from ...job import DEFAULT_FEED, DEFAULT_PERIOD
 
 JOIN = 1e-6
@@ -103,8 +105,9 @@ def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX
         stay_down = StayDown(part, {f: (part.face(f), setup.guard(f).height_cells(f))
                                     for f in op.faces}, job.tool.offset, job.tool.shank,
                              tol.hit)
-    program = Program(job, linked(cuts, safe_height(part, job), join=JOIN,
-                                  stay_down=stay_down), skipped)
+    segments, unreachable, notes = entered_program_segments(
+        part, job, cuts, safe_height(part, job), join=JOIN, stay_down=stay_down)
+    program = Program(job, segments, skipped + unreachable, notes)
     report = uncut_report(program, part, samples, plan)
     program.skipped += report.skipped()
     program.notes += report.notes()

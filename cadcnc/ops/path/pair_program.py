@@ -18,14 +18,14 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...errors import InputError, StartPointError
+from ...errors import InputError, NothingToCutError, StartPointError
 from ...interp.cycle import BOUNDARY, COLLISION
 from ...interp.stepper import Tangency
 from ...job import Job
-from ...program.linking import linked
 from ...program.program import STOPPED_SHORT, CutSegment, Program, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
 from ..common import require_ball, run_stretch, safe_height
+from ..entries import entered_program_segments
 from ...guard import guard_for
 from .pair_path import PathPlan, plan_path, shared_edge_for, stepper_for
 from .stretch_paths import nearest_start, plan_for_stretch, refuse_without_stretch
@@ -84,7 +84,20 @@ def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000, progress=Non
         n = max(len(e.stretches) for e in found)
         raise InputError(f"faces {i} and {j}: there is no stretch {op.stretch} (the edges "
                          f"have at most {n})")
-    return Program(job, linked(cuts, safe_height(part, job)), skipped)
+    return entered_program(part, job, cuts, skipped)
+
+
+def entered_program(part, job: Job, cuts: list[CutSegment], skipped: list[Skipped],
+                    notes: list[str] | None = None) -> Program:
+    """The program of a pair's ``cuts``, each entered where the tool can get to it
+    (:mod:`cadcnc.ops.entries`); NothingToCutError (exit 3) naming why when none can."""
+    segments, unreachable, entries = entered_program_segments(part, job, cuts,
+                                                              safe_height(part, job))
+    if cuts and not segments:
+        i, j = job.operation.faces
+        raise NothingToCutError(f"faces {i} and {j}: no cut can be reached: " + "; ".join(
+            f"{s.reason}: {s.detail}" for s in unreachable))
+    return Program(job, segments, skipped + unreachable, (notes or []) + entries)
 
 
 def climb_measure(tp: Toolpath) -> float:
@@ -221,4 +234,4 @@ def _from_start(part, job, s1, s2, guard, max_cycles, progress) -> Program:
         plan = plan_path(s1, s2, moved)
     tp = run_stretch(plan, guard, max_cycles, progress)
     cut = CutSegment(tp, edge=None, at_limit=tp.stop_reason in (BOUNDARY, COLLISION))
-    return Program(plan.job, linked([cut], safe_height(part, job)), [], notes)
+    return entered_program(part, plan.job, [cut], [], notes)

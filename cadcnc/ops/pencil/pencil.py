@@ -7,7 +7,8 @@ them), cuts every feasible stretch of each (edge corners: :mod:`.stretches` and
 to the other), with the third-face and shank guard inside the stepper, then orders the
 cuts (chains first, where one stops tri-tangent or on a boundary exactly where the next
 starts; nearest neighbour; 2-opt) and links them (retract, rapid, plunge; a chain's cuts
-follow each other by one short feed move). Corners that cannot be cut are listed in the
+follow each other by one short feed move), each cut entered where the tool can get to it
+(:mod:`cadcnc.ops.entries`: its start, its end, a point between, or from the side). Corners that cannot be cut are listed in the
 program's ``skipped`` with the reason. Lengths mm, feed mm/min, period s.
 
 Direction: ``side="climb"`` (default) runs every corner with the material on the right
@@ -28,13 +29,14 @@ import numpy as np
 from ...errors import CadcncError
 from ...geometry.part import Part
 from ...job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
-from ...program.linking import linked, order_cuts
+from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program, Skipped
 from ...tolerances import DEFAULT, Tolerances
 from ...work import MAX_CYCLES, Heartbeat, refuse_over
 from .corners import BLEND, EDGE, Corner, find_corners
 from ...guard import guard_for
 from ..common import refuse_cycles, require_ball, run_stretch, safe_height
+from ..entries import UNREACHABLE, entered_program_segments
 from ..path.pair_program import CLIMB, stretch_cuts
 from ..path.pair_path import plan_path
 from ..path.stretches import (LIMIT_TOL, MIN_SAMPLES, SPACING, Feasibility,
@@ -157,11 +159,12 @@ def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = 
         if progress is not None:
             progress(k, len(todo), at)
             beat.last = beat.clock()
-    with stage("linking"):
-        z_safe = safe_height(part, job)
-        ordered, unreachable = reachable_order(part, job, cuts, z_safe, beat)
-        segments = linked(ordered, z_safe, join=CHAIN_GAP)
-    return Program(job, segments, skipped + unreachable)
+    with stage("linking"):   # entries (ops/entries.py), ordering and links
+        beat.beat(f"linking: entries of {len(cuts)} cuts")
+        segments, unreachable, notes = entered_program_segments(
+            part, job, cuts, safe_height(part, job), join=CHAIN_GAP,
+            order=lambda items: order_cuts(items, CHAIN_GAP))
+    return Program(job, segments, skipped + unreachable, notes)
 
 
 MAX_SAMPLES = 400_000
@@ -222,61 +225,8 @@ class _Clock:
                 time.perf_counter() - self.t0)
 
 
-NOT_REACHABLE = "not reachable from +Z"
-
-
-def reachable_order(part: Part, job: Job, cuts: list[CutSegment], z_safe: float,
-                    beat: Heartbeat | None = None
-                    ) -> tuple[list[CutSegment], list[Skipped]]:
-    """The cuts the tool can reach from above, in linking order (:func:`order_cuts`), and
-    the others skipped as "not reachable from +Z". A chain is entered by a plunge straight
-    down to its first cut's start and left by a retract straight up from its last cut's
-    end (:func:`~cadcnc.program.linking.link`). Such a point is reachable when the ball
-    and a shank from it up to the link height ``z_safe`` (mm) clear the part by R' - 1 um
-    less the gate's tolerance (:func:`~cadcnc.guard.guard_for`, the stepper's guard with a longer
-    shank): not so in a sealed
-    void, or under an overhang higher than the shank. A cut whose entry or exit is
-    blocked is dropped and the rest ordered again (its neighbours may then need one).
-    ``beat``: a :class:`~cadcnc.work.Heartbeat` told of every cut checked."""
-    lo, _ = part.bounding_box()
-    shank = max(z_safe - float(lo[2]), job.tool.shank)
-    guards: dict = {}
-    skipped: list[Skipped] = []
-
-    def blocked(cut: CutSegment, which: str, p) -> str | None:
-        faces = cut.path.faces
-        if faces not in guards:
-            guards[faces] = guard_for(part, faces, job, shank=shank)
-        margin, detail = guards[faces].margin(p)
-        # a cut's end landed on a collision sits at margin ~0 (-1e-8 mm is landing
-        # round-off): only a deeper hit blocks the way; the gate judges every move anyway
-        return None if margin >= -job.tolerances.gouge else (
-            f"its {which} ({p[0]:.4f}, {p[1]:.4f}, {p[2]:.4f}): {detail} "
-            f"({-margin:.4g} mm too near) on the way to Z {z_safe:.3f}")
-
-    while True:
-        ordered = order_cuts(cuts, CHAIN_GAP)
-        bad = {}
-        for k, cut in enumerate(ordered):
-            if beat is not None:
-                beat.beat(f"linking: {k} of {len(ordered)} cuts checked for reach from +Z")
-            why = []
-            if k == 0 or np.linalg.norm(cut.points[0] - ordered[k - 1].points[-1]) > CHAIN_GAP:
-                why.append(blocked(cut, "start", cut.points[0]))
-            if k == len(ordered) - 1 or np.linalg.norm(
-                    ordered[k + 1].points[0] - cut.points[-1]) > CHAIN_GAP:
-                why.append(blocked(cut, "end", cut.points[-1]))
-            why = [w for w in why if w]
-            if why:
-                bad[id(cut)] = why
-        if not bad:
-            return ordered, skipped
-        for cut in ordered:
-            if id(cut) in bad:
-                skipped.append(Skipped(cut.path.faces, NOT_REACHABLE, (
-                    f"cut of {cut.path.length:.3f} mm: " + "; ".join(bad[id(cut)])),
-                    cut.edge))
-        cuts = [c for c in ordered if id(c) not in bad]
+NOT_REACHABLE = UNREACHABLE
+"""The reason of a cut no entry reaches (:mod:`cadcnc.ops.entries`)."""
 
 
 def _blend_cut(s1, s2, job: Job, corner, guard, max_cycles: int, progress) -> CutSegment:
