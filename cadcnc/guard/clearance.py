@@ -302,6 +302,13 @@ def _part_data(part) -> tuple:
     return data
 
 
+def face_boxes(part) -> tuple[np.ndarray, np.ndarray]:
+    """(lows (n, 3), highs (n, 3)) of every face's optimal box, widened by BOX_SLACK mm:
+    the boxes every guard of the part shares (computed once per part)."""
+    _, _, lo, hi = _part_data(part)
+    return lo, hi
+
+
 def _needs_own_rule(face) -> bool:
     """False where a shank above the ball can never come nearer to this face than the
     ball's own contact: a plane whose outward normal has n_z >= 0, or a cylinder whose

@@ -22,7 +22,7 @@ from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.TopoDS import TopoDS_Compound
 from OCP.gp import gp_Pnt
 
-from ..geometry.part import optimal_box
+from .clearance import face_boxes
 
 FLAT = 1e-9  # mm: a move this short horizontally sweeps a vertical segment
 
@@ -34,11 +34,8 @@ class MoveClearance:
 
     def __init__(self, part, offset: float, shank: float):
         self.part, self.offset, self.shank = part, float(offset), float(shank)
-        faces = part.faces
-        self._topods = [f.topods for f in faces]
-        boxes = [optimal_box(t, use_triangulation=False) for t in self._topods]
-        self._lo = np.array([b[0] for b in boxes])
-        self._hi = np.array([b[1] for b in boxes])
+        self._topods = [f.topods for f in part.faces]
+        self._lo, self._hi = face_boxes(part)   # shared with the part's guards
 
     def distance(self, a, b) -> float:
         """The distance (mm) from the tool axis swept from ``a`` to ``b`` ((3,) ball

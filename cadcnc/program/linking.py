@@ -7,8 +7,9 @@ the plunge feed (``approach`` mm above b, or all of the descent when z_safe is l
 The program's first cut is reached the same way from above its start, and the last cut
 leaves straight up to z_safe. Where a cut is entered or left otherwise (:class:`Visit`:
 from a point outside the part at the cut's height, or along cut points retraced), the
-link runs that way (:mod:`cadcnc.ops.entries` decides it). Whether a link clears the part is decided by the gouge gate,
-which checks every move of the program, links included.
+link runs that way (:mod:`cadcnc.ops.entries` decides it). Whether a link clears the
+part is decided by the gouge gate, which checks every move of the program, links
+included.
 """
 
 from __future__ import annotations

@@ -4,7 +4,9 @@
 every feasible stretch of the pair's shared concave edges (or of edge ``edge`` alone,
 and stretch ``stretch`` alone, when the job names them; :mod:`.stretches`), runs the
 stepper along each from its start limit to its end limit with the third-face and shank
-guard inside it (stop rule ``collision``), and links the cuts (retract, rapid, plunge).
+guard inside it (stop rule ``collision``), and links the cuts (retract, rapid, plunge),
+each entered where the tool can get to it (:mod:`cadcnc.ops.entries`; a cut none
+reaches is skipped as ``unreachable``).
 With a start point it runs one path as :func:`~cadcnc.ops.path.pair_path.path_for_job` does,
 except that a start outside every stretch moves to the nearest stretch limit, and the
 program's ``notes`` say so. Edges with no feasible position are listed in ``skipped``

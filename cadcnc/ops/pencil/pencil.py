@@ -8,8 +8,8 @@ to the other), with the third-face and shank guard inside the stepper, then orde
 cuts (chains first, where one stops tri-tangent or on a boundary exactly where the next
 starts; nearest neighbour; 2-opt) and links them (retract, rapid, plunge; a chain's cuts
 follow each other by one short feed move), each cut entered where the tool can get to it
-(:mod:`cadcnc.ops.entries`: its start, its end, a point between, or from the side). Corners that cannot be cut are listed in the
-program's ``skipped`` with the reason. Lengths mm, feed mm/min, period s.
+(:mod:`cadcnc.ops.entries`: its start, its end, a point between, or from the side).
+Corners that cannot be cut are listed in the program's ``skipped`` with the reason. Lengths mm, feed mm/min, period s.
 
 Direction: ``side="climb"`` (default) runs every corner with the material on the right
 of the travel (climb milling with a clockwise spindle), ``"conventional"`` the other
@@ -24,7 +24,6 @@ import math
 import time
 from dataclasses import replace
 
-import numpy as np
 
 from ...errors import CadcncError
 from ...geometry.part import Part
