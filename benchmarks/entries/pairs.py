@@ -59,7 +59,7 @@ def run_path(step: Path, faces, radius: float, out: str) -> dict:
             "message": (err[0] if err else "")[:400], "summary": res.stdout}
 
 
-def measure(step: Path, faces, radius: float) -> dict:
+def measure(step: Path, faces, radius: float, sample: int = SAMPLE) -> dict:
     rec = {"part": step.name, "faces": list(faces), "radius": radius}
     o = Oracle(read_shape(str(step)))
     offset, shank = radius, 10.0 * radius
@@ -77,7 +77,7 @@ def measure(step: Path, faces, radius: float) -> dict:
     hit = covered(fit, lines)
     rec["covered"] = int(hit.sum())
     missed = [p for p, h in zip(fit, hit) if not h]
-    pick = np.unique(np.linspace(0, len(missed) - 1, min(SAMPLE, len(missed))).round()
+    pick = np.unique(np.linspace(0, len(missed) - 1, min(sample, len(missed))).round()
                      .astype(int)) if missed else []
     reach = [entries_at(o, missed[k], offset, shank, z_safe) for k in pick]
     rec["uncovered_checked"] = len(reach)
@@ -109,13 +109,15 @@ def main(argv=None) -> int:
     ap.add_argument("--only", help="parts whose name contains this")
     ap.add_argument("--fixtures", action="store_true", help="the entry fixtures too")
     ap.add_argument("--json", help="write the records here")
+    ap.add_argument("--sample", type=int, default=SAMPLE,
+                    help=f"uncovered positions checked per pair (default {SAMPLE})")
     args = ap.parse_args(argv)
     cases = PAIRS + (fixture_pairs() if args.fixtures else [])
     if args.only:
         cases = [c for c in cases if args.only in c[0].name]
     records = []
     for step, faces in cases:
-        rec = measure(step, faces, args.radius)
+        rec = measure(step, faces, args.radius, args.sample)
         rec["load"] = [round(x, 2) for x in os.getloadavg()]
         records.append(rec)
         print(json.dumps({k: v for k, v in rec.items() if k != "summary"}), flush=True)

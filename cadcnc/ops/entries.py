@@ -25,8 +25,11 @@ entry is skipped as UNREACHABLE, naming its start and the face in the way. Lengt
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
+from ..interp.cycle import END
 from ..guard import FINISH_OWN_SHARE, PAIR_OWN_SHARE, MoveClearance, guard_for
 from ..job import Job
 from ..program.linking import Visit, linked
@@ -102,6 +105,20 @@ def _indices(n: int, count: int) -> list[int]:
     return sorted(set(np.linspace(0, n, count + 2).round().astype(int)[1:-1]) - {0, n})
 
 
+def _piece(cut: CutSegment, lo: int, hi: int, reverse: bool) -> CutSegment:
+    """Points lo..hi of ``cut`` as a cut of their own (from hi to lo when ``reverse``), its
+    job's start and end its own ends. A forward piece keeps the cut's stop (it ends where
+    the cut ended); a reversed one ends where the cut began, an intended end (``end``)."""
+    tp = toolpath_piece(cut.path, lo, hi, reverse)
+    op = replace(tp.job.operation, start=tuple(map(float, tp.points[0])),
+                 end=tuple(map(float, tp.points[-1])))
+    tp = replace(tp, job=replace(tp.job, operation=op))
+    if reverse:
+        tp = replace(tp, stop_reason=END, stop_detail="end point reached: the cut's start, "
+                     "cut the other way from where it was entered")
+    return CutSegment(tp, cut.edge, cut.stretch, cut.at_limit)
+
+
 def _retrace(path, lo: int, hi: int, reverse: bool) -> LinkSegment:
     """Back along points lo..hi of ``path`` (already cut), at feed."""
     pts = path.points[lo:hi + 1]
@@ -139,8 +156,7 @@ def visit_for(cut: CutSegment, access: Access) -> Visit | Skipped:
     if k < 0:
         return Skipped(path.faces, UNREACHABLE, f"cut of {path.length:.3f} mm: {why}",
                        cut.edge)
-    piece = lambda lo, hi, rev: CutSegment(  # noqa: E731
-        toolpath_piece(path, lo, hi, rev), cut.edge, cut.stretch, cut.at_limit)
+    piece = lambda lo, hi, rev: _piece(cut, lo, hi, rev)  # noqa: E731
     if k == 0:
         segments, last = [cut], n
     elif k == n:
