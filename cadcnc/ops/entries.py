@@ -171,12 +171,16 @@ def visit_for(cut: CutSegment, access: Access) -> Visit | Skipped:
     return Visit(segments, side, side)
 
 
-def entered(cuts: list[CutSegment], access: Access) -> tuple[list, list[Skipped], list[str]]:
+def entered(cuts: list[CutSegment], access: Access, tick=None
+            ) -> tuple[list, list[Skipped], list[str]]:
     """Each cut as it is entered (the cut itself when a plunge onto its start and out of
     its end are clear, else its :class:`Visit`), those skipped as UNREACHABLE, and a note
-    counting the cuts entered otherwise than at their start (none when every one is)."""
+    counting the cuts entered otherwise than at their start (none when every one is).
+    ``tick(k, n)``: called before cut k of n is looked at (a heartbeat)."""
     out, skipped, ways = [], [], {}
-    for cut in cuts:
+    for k, cut in enumerate(cuts):
+        if tick is not None:
+            tick(k, len(cuts))
         v = visit_for(cut, access)
         if isinstance(v, Skipped):
             skipped.append(v)
@@ -207,12 +211,12 @@ def _way(cut: CutSegment, v: Visit) -> str:
 
 
 def entered_program_segments(part, job: Job, cuts: list[CutSegment], z_safe: float,
-                             join: float = 0.0, stay_down=None, order=None
+                             join: float = 0.0, stay_down=None, order=None, tick=None
                              ) -> tuple[list, list[Skipped], list[str]]:
     """The segments of a program of ``cuts`` (each entered by the rule of the module doc,
     then ordered by ``order(items)`` when given, and linked), the cuts skipped, and the
-    note on entries (:func:`entered`)."""
-    items, skipped, notes = entered(cuts, Access(part, job, z_safe))
+    note on entries (:func:`entered`, with ``tick``)."""
+    items, skipped, notes = entered(cuts, Access(part, job, z_safe), tick)
     if order is not None:
         items = order(items)
     return linked(items, z_safe, join=join, stay_down=stay_down), skipped, notes

@@ -106,7 +106,8 @@ def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX
                                     for f in op.faces}, job.tool.offset, job.tool.shank,
                              tol.hit)
     segments, unreachable, notes = entered_program_segments(
-        part, job, cuts, safe_height(part, job), join=JOIN, stay_down=stay_down)
+        part, job, cuts, safe_height(part, job), join=JOIN, stay_down=stay_down,
+        tick=lambda k, n: beat.beat(f"entries: {k} of {n} cuts"))
     program = Program(job, segments, skipped + unreachable, notes)
     report = uncut_report(program, part, samples, plan)
     program.skipped += report.skipped()

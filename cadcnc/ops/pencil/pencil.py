@@ -159,10 +159,10 @@ def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = 
             progress(k, len(todo), at)
             beat.last = beat.clock()
     with stage("linking"):   # entries (ops/entries.py), ordering and links
-        beat.beat(f"linking: entries of {len(cuts)} cuts")
         segments, unreachable, notes = entered_program_segments(
             part, job, cuts, safe_height(part, job), join=CHAIN_GAP,
-            order=lambda items: order_cuts(items, CHAIN_GAP))
+            order=lambda items: order_cuts(items, CHAIN_GAP),
+            tick=lambda k, n: beat.beat(f"linking: {k} of {n} cuts entered"))
     return Program(job, segments, skipped + unreachable, notes)
 
 
