@@ -92,6 +92,8 @@ def operation_command(args, what: str, job_of, *, progress=None,
     job = job_of(args, args.step)
     t0 = time.monotonic()
     part = setup_part(cadcnc.load_step(args.step, flip_material=job.flip_material), job)
+    if setup_in(part) is not None:
+        what = f"{what} (tool axis {setup_in(part).name})"
     for n in getattr(job.operation, "faces", None) or ():
         if n is not None:
             part.face(n)   # face numbers checked before anything is computed

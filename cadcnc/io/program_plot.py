@@ -120,7 +120,7 @@ def program_picture_bytes(program: Program, part, out, title: str = "") -> bytes
     setup, axis = job_setup(program.job, part), None
     if setup is not None:
         program, part, axis = in_part_coordinates(program, setup), original_part(part), setup.axis
-        title = f"{title} (tool axis {setup.name})".strip()
+        title = title if "tool axis" in title else f"{title} (tool axis {setup.name})".strip()
     if suffix == ".png":
         import matplotlib.pyplot as plt
 
