@@ -99,8 +99,13 @@ def operation_command(args, what: str, job_of, *, progress=None,
             part.face(n)   # face numbers checked before anything is computed
     if args.max_cycles < 1:
         raise InputError(f"--max-cycles must be at least 1, got {args.max_cycles}")
-    program = cadcnc.run(part, job, progress=progress, times=times,
-                         max_cycles=args.max_cycles)
+    try:
+        program = cadcnc.run(part, job, progress=progress, times=times,
+                             max_cycles=args.max_cycles)
+    except NothingToCutError as e:   # a setup that reaches nothing says which it is
+        if setup_in(part) is None:
+            raise
+        raise NothingToCutError(f"{what}: {e}") from None
     t_cut = time.monotonic() - t0
     name = Path(args.step).name
     join = cut_back_gap(job)

@@ -33,12 +33,13 @@ from ...program.program import CutSegment, Program, Skipped
 from ...program.transform import in_part_coordinates
 from ...units import check_axis
 from ..common import safe_height
-from .pencil import CHAIN_GAP, pencil_program, reachable_order
+from .pencil import CHAIN_GAP, keyword_job, pencil as pencil_one, pencil_program, reachable_order
 
 SPACING = 0.5      # mm between two positions along a concave edge
 REACH_RADII = 5.0  # a ball centre farther than this many R' from its corner's edge counts nothing
 VOXEL = 1.0        # mm: the grid of a blend corner's positions
 AUTO = "auto"
+AUTO_ORDER = ("+Z", "-Z", "+X", "-X", "+Y", "-Y")  # the candidates of AUTO, +Z first on ties
 TRIMMED = "setup boundary"  # the stop reason of a cut trimmed where an earlier setup cut
 
 
@@ -112,7 +113,7 @@ def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
         raise InputError("setups are for the pencil operation")
     if not (isinstance(overlap, (int, float)) and overlap >= 0 and np.isfinite(overlap)):
         raise InputError(f"setup overlap must be a length >= 0 mm, got {overlap!r}")
-    axes = list(PRINCIPAL_AXES.values()) if parse_setups(setups) == AUTO else \
+    axes = [PRINCIPAL_AXES[n] for n in AUTO_ORDER] if parse_setups(setups) == AUTO else \
         parse_setups(setups)
     part = original_part(part)
     samples = _positions(part, job)
@@ -153,6 +154,20 @@ def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
         taken |= reach_sets[k]
         result.runs.append(run)
     return result
+
+
+def pencil(part, *, setups=None, setup_overlap: float = 0.0, **keywords):
+    """``cadcnc.pencil``: the pencil program of ``part`` (keywords of
+    :func:`cadcnc.ops.pencil.pencil.pencil`, ``axis`` among them), or with ``setups``
+    (AUTO or a list of axes) the :class:`SetupsResult` of :func:`pencil_setups`, each
+    chosen setup's program in ``result.runs`` (not yet gated: :func:`cadcnc.gate_program`
+    with ``run.part``), ``setup_overlap`` mm of lap at their boundaries."""
+    if setups is None:
+        return pencil_one(part, **keywords)
+    progress = keywords.pop("progress", None)
+    keywords.pop("times", None)
+    part, job = keyword_job(part, **keywords)
+    return pencil_setups(part, job, setups, setup_overlap, progress=progress)
 
 
 def _fewest(reach: list[set], universe: set) -> tuple[list[int], int]:
