@@ -31,7 +31,7 @@ _LAZY = {
     "Toolpath": "program.toolpath",
     "VerificationReport": "verification", "verify": "verification",
     "gouge_gate": "verification",
-    "pencil": "ops.pencil.pencil", "finish": "ops.finish.finish", "Program": "program.program",
+    "pencil": "ops.pencil.setups", "finish": "ops.finish.finish", "Program": "program.program",
     "to_cq": "io.program_cq", "to_cq_compound": "io.program_cq",
     "show_program": "io.program_cq",
     "run": "ops.run", "program_for_job": "ops.path.pair_program",

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 from .errors import InputError
 from .tolerances import DEFAULT, Tolerances
+from .units import PRINCIPAL_AXES, axis_name, check_axis  # noqa: F401 - the Job's axis
 
 SHANK_LENGTH_RADII = 10.0  # default shank length, in ball radii
 DEFAULT_FEED = 1500.0  # mm/min: with DEFAULT_PERIOD, the paper's 0.1 mm step
@@ -281,6 +282,11 @@ class Job:
     docs/notes/surface_models.md), so that a saved path is verified on the same side.
     ``plunge_feed`` (mm/min): the feed of the links' plunges (None: the feed);
     ``spindle`` (rpm): written as ``S.. M3`` in the G-code (None: no spindle word).
+    ``axis``: the tool axis in part coordinates (a unit vector from the ball centre up the
+    shank; a name of PRINCIPAL_AXES or a vector), ``origin``: the work zero in part
+    coordinates (None: the centre of the part's top seen along the axis; with +Z, the
+    part's own origin): see :mod:`cadcnc.geometry.setup`. ``clearance`` is then a height
+    in the setup's work coordinates.
     """
 
     tool: Tool
@@ -293,8 +299,12 @@ class Job:
     flip_material: bool = False
     plunge_feed: float | None = None
     spindle: float | None = None
+    axis: tuple[float, float, float] = PRINCIPAL_AXES["+Z"]
+    origin: Point | None = None
 
     def __post_init__(self):
+        object.__setattr__(self, "axis", check_axis(self.axis))
+        object.__setattr__(self, "origin", check_point("origin", self.origin))
         object.__setattr__(self, "feed", check_number("feed", self.feed, "mm/min"))
         object.__setattr__(self, "period", check_number("period", self.period, "s"))
         check_step(self.feed, self.period)
@@ -335,7 +345,9 @@ class Job:
                       feed=self.feed, period=self.period, offsets=list(self.offsets),
                       source=self.source, shank_length=self.tool.shank_length,
                       clearance=self.clearance, flip_material=self.flip_material,
-                      plunge_feed=self.plunge_feed, spindle=self.spindle)
+                      plunge_feed=self.plunge_feed, spindle=self.spindle,
+                      axis=list(self.axis),
+                      origin=None if self.origin is None else list(self.origin))
         return {**common, **self.operation.to_inputs()}
 
     @classmethod
@@ -366,7 +378,9 @@ class Job:
             return cls(tool, inputs["feed"], inputs["period"], op, inputs.get("source"),
                        inputs.get("clearance"),
                        flip_material=bool(inputs.get("flip_material", False)),
-                       plunge_feed=inputs.get("plunge_feed"), spindle=inputs.get("spindle"))
+                       plunge_feed=inputs.get("plunge_feed"), spindle=inputs.get("spindle"),
+                       axis=inputs.get("axis", PRINCIPAL_AXES["+Z"]),
+                       origin=inputs.get("origin"))
         except KeyError as e:
             raise InputError(f"the recorded job has no {e.args[0]!r}") from None
         except TypeError as e:

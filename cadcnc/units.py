@@ -84,3 +84,39 @@ def format_duration(seconds: float) -> str:
         if abs(seconds) >= scale:
             return f"{seconds / scale:g} {unit}"
     return f"{seconds:g} s"
+
+
+PRINCIPAL_AXES = {"+X": (1.0, 0.0, 0.0), "-X": (-1.0, 0.0, 0.0), "+Y": (0.0, 1.0, 0.0),
+                  "-Y": (0.0, -1.0, 0.0), "+Z": (0.0, 0.0, 1.0), "-Z": (0.0, 0.0, -1.0)}
+"""The six principal tool axes by name (the axis points from the ball centre up the shank)."""
+
+
+def check_axis(value) -> tuple[float, float, float]:
+    """A tool axis as a unit (x, y, z) tuple: one of PRINCIPAL_AXES' names (``Z`` is
+    ``+Z``) or a finite non-zero vector (normalised), as a sequence or "x,y,z"."""
+    if isinstance(value, str):
+        name = value.strip().upper()
+        name = name if name[:1] in "+-" else "+" + name
+        if name in PRINCIPAL_AXES:
+            return PRINCIPAL_AXES[name]
+        if "," not in value:
+            raise InputError(f"axis must be one of {', '.join(PRINCIPAL_AXES)} or a vector "
+                             f"x,y,z, got {value!r}")
+        value = value.split(",")
+    try:
+        xyz = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        xyz = ()
+    norm = math.sqrt(sum(v * v for v in xyz)) if len(xyz) == 3 else math.nan
+    if not (math.isfinite(norm) and norm > 0):
+        raise InputError(f"axis must be one of {', '.join(PRINCIPAL_AXES)} or a finite "
+                         f"non-zero vector (x, y, z), got {value!r}")
+    return tuple(v / norm + 0.0 for v in xyz)
+
+
+def axis_name(axis) -> str:
+    """"+Z", "-X", ... for a principal axis, else its components."""
+    for name, xyz in PRINCIPAL_AXES.items():
+        if tuple(axis) == xyz:
+            return name
+    return "(" + ", ".join(f"{v:.6g}" for v in axis) + ")"

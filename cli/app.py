@@ -17,7 +17,7 @@ from importlib.metadata import version
 from cadcnc.errors import EXIT_INTERRUPTED, CadcncError  # light: the package loads OCCT lazily
 from cadcnc.interrupts import sigint_deferred
 
-from .operation import DEFAULT_FEED, DEFAULT_PERIOD, add_max_cycles
+from .operation import DEFAULT_FEED, DEFAULT_PERIOD, add_axis_options, add_max_cycles
 
 UNITS = "Units: lengths mm, feed mm/min, period with a unit (4ms, 0.004s, 250us)."
 
@@ -129,6 +129,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plunge-feed", metavar="F",
                    help="feed of the links' plunge moves, mm/min (default: the feed)")
     add_max_cycles(p)
+    add_axis_options(p)
 
     from . import finish, pencil, stream  # light: their commands import the library when run
     pencil.add_parser(add, _flip_option, _gouge_options, _gcode_options)
@@ -184,15 +185,16 @@ def _version() -> str:
         return "cadcnc (version unknown)"
 
 
-POINT_OPTIONS = ("--start", "--end")
+POINT_OPTIONS = ("--start", "--end", "--origin", "--axis", "--setups")
 
 
 def _negative_points_joined(argv: list[str]) -> list[str]:
-    """``--start -6,6,5`` as ``--start=-6,6,5``: argparse takes a value that starts with a
-    minus sign for an option."""
+    """``--start -6,6,5`` as ``--start=-6,6,5`` and ``--axis -Z`` as ``--axis=-Z``:
+    argparse takes a value that starts with a minus sign for an option."""
     out: list[str] = []
     for arg in argv:
-        if out and out[-1] in POINT_OPTIONS and arg.startswith("-") and arg[1:2].isdigit():
+        if out and out[-1] in POINT_OPTIONS and arg.startswith("-") and (
+                arg[1:2].isdigit() or arg[1:2] in ".xyzXYZ"):
             out[-1] = f"{out[-1]}={arg}"
         else:
             out.append(arg)

@@ -31,6 +31,19 @@ def add_operation_options(p, allowance_help: str) -> None:
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
                    help=OUTPUT_HELP)
     add_max_cycles(p)
+    add_axis_options(p)
+
+
+def add_axis_options(p) -> None:
+    """--axis and --origin: the setup (docs/setups.md)."""
+    g = p.add_argument_group("setup (docs/setups.md)")
+    g.add_argument("--axis", metavar="AXIS",
+                   help="tool axis in part coordinates, from the ball up the shank: +Z "
+                        "(default), -Z, +X, -X, +Y, -Y or a vector x,y,z; the G-code is in "
+                        "the setup's work coordinates")
+    g.add_argument("--origin", metavar="X,Y,Z",
+                   help="work zero in part coordinates, mm (default: the centre of the "
+                        "part's top seen along the axis; with +Z, the part's origin)")
 
 
 def add_max_cycles(p) -> None:
@@ -59,6 +72,7 @@ def operation_command(args, what: str, job_of, *, progress=None,
     from cadcnc.io.output_set import OutputSet
     from cadcnc.io.outputs import SUFFIXES, render
     from cadcnc.ops.common import safe_height
+    from cadcnc.geometry.setup import setup_in, setup_part
     from cadcnc.ops.run import cut_back_gap
     from cadcnc.verification.judgement import judge, settle
 
@@ -77,14 +91,21 @@ def operation_command(args, what: str, job_of, *, progress=None,
         machine = machine_of(args)
     job = job_of(args, args.step)
     t0 = time.monotonic()
-    part = cadcnc.load_step(args.step, flip_material=job.flip_material)
+    part = setup_part(cadcnc.load_step(args.step, flip_material=job.flip_material), job)
+    if setup_in(part) is not None:
+        what = f"{what} (tool axis {setup_in(part).name})"
     for n in getattr(job.operation, "faces", None) or ():
         if n is not None:
             part.face(n)   # face numbers checked before anything is computed
     if args.max_cycles < 1:
         raise InputError(f"--max-cycles must be at least 1, got {args.max_cycles}")
-    program = cadcnc.run(part, job, progress=progress, times=times,
-                         max_cycles=args.max_cycles)
+    try:
+        program = cadcnc.run(part, job, progress=progress, times=times,
+                             max_cycles=args.max_cycles)
+    except NothingToCutError as e:   # a setup that reaches nothing says which it is
+        if setup_in(part) is None:
+            raise
+        raise NothingToCutError(f"{what}: {e}") from None
     t_cut = time.monotonic() - t0
     name = Path(args.step).name
     join = cut_back_gap(job)
@@ -101,6 +122,8 @@ def operation_command(args, what: str, job_of, *, progress=None,
         say_error(line)
     if not args.quiet:
         print(program.summary(name))
+        if setup_in(part) is not None:
+            print("  setup      " + "; ".join(setup_in(part).describe()))
         print("  verdict    " + ("written" if verdict.write else "nothing written") + (
             "" if verdict.code == 0 else f" (exit {verdict.code}: see the message above)"))
         staged = "" if not times else "; " + ", ".join(f"{k} {v:.1f} s"

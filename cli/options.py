@@ -42,7 +42,18 @@ def job_of(args, operation, source: str) -> Job:
                source=source, clearance=z, tolerances=tolerances(args),
                flip_material=getattr(args, "flip_material", False),
                plunge_feed=None if plunge is None else parse_feed(plunge, "plunge feed"),
-               spindle=None if spindle is None else check_number("--spindle", spindle, "rpm"))
+               spindle=None if spindle is None else check_number("--spindle", spindle, "rpm"),
+               **setup_keywords(args))
+
+
+def setup_keywords(args) -> dict:
+    """``axis`` and ``origin`` of the Job from --axis and --origin (when given)."""
+    out = {}
+    if getattr(args, "axis", None) is not None:
+        out["axis"] = args.axis
+    if getattr(args, "origin", None) is not None:
+        out["origin"] = parse_point(args.origin, "origin")
+    return out
 
 
 def path_job(args, source: str) -> Job:

@@ -29,6 +29,13 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
     p.add_argument("--side", choices=("climb", "conventional"), default="climb",
                    help="direction along the corners (default climb: material on the "
                         "right of the travel, clockwise spindle)")
+    p.add_argument("--setups", metavar="AXES",
+                   help="the fewest setups: auto (among +Z -Z +X -X +Y -Y) or a list such "
+                        "as +Z,-X; one program per setup, its axis added to each output name "
+                        "(docs/setups.md)")
+    p.add_argument("--setup-overlap", default="0", metavar="MM",
+                   help="with --setups: lap a later setup this far into what an earlier "
+                        "one cut, mm (default 0: nothing cut twice)")
     job_flip(p)
     gouge(p)
     gcode(p)
@@ -36,6 +43,11 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
 
 def pencil_command(args) -> int:
     from .options import pencil_job
+
+    if args.setups is not None:
+        from .setups import setups_command
+
+        return setups_command(args)
 
     report = None if args.quiet else (
         lambda done, total, what: say_error(f"cadcnc: pencil: corner {done}/{total} ({what})"))

@@ -15,7 +15,9 @@ import io
 from pathlib import Path
 
 from ..errors import OutputError
+from ..geometry.setup import job_setup
 from ..program.program import Program
+from ..program.transform import in_part_coordinates
 from .program_gcode import program_ngc
 from .program_json import program_json
 from .program_plot import program_picture_bytes
@@ -42,14 +44,19 @@ def program_csv(program: Program) -> str:
 
 def render(program: Program, out, part=None, title: str = "", **gcode) -> str | bytes:
     """The content of ``out`` by its suffix. ``gcode``: :func:`program_ngc` keywords
-    (tolerance, tool_tip, spindle, plunge_feed); ``part`` is needed for pictures."""
+    (tolerance, tool_tip, spindle, plunge_feed); ``part`` is needed for pictures and for
+    a program of another tool axis than +Z (in its work coordinates: JSON, CSV and
+    pictures are written in part coordinates, the G-code in work coordinates with the
+    setup in a comment)."""
     kind = Path(out).suffix.lower()
+    setup = job_setup(program.job, part)
     if kind == ".json":
-        return program_json(program)
+        return program_json(program, setup)
     if kind == ".csv":
-        return program_csv(program)
+        return program_csv(in_part_coordinates(program, setup))
     if kind == ".ngc":
-        return program_ngc(program, title=title, **gcode)
+        notes = () if setup is None else tuple(f"setup: {s}" for s in setup.describe())
+        return program_ngc(program, title=title, notes=notes, **gcode)
     if kind in (".png", ".glb"):
         return program_picture_bytes(program, part, out, title)
     raise OutputError(f"{out}: unknown output format {kind!r}; use one of "

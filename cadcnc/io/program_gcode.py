@@ -31,9 +31,10 @@ from .gcode import (
 
 def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: bool = False,
                 spindle: float | None = None, plunge_feed: float | None = None,
-                blend: float | None = None, title: str = "") -> str:
+                blend: float | None = None, title: str = "", notes=()) -> str:
     """One RS274/NGC program for ``program`` (see the module doc); InputError on a point
-    or word that cannot be written. ``spindle`` and ``plunge_feed`` default to the job's."""
+    or word that cannot be written. ``spindle`` and ``plunge_feed`` default to the job's;
+    ``notes``: comment lines after the title (a setup's axis and work zero)."""
     if not program.segments:
         raise InputError("the program has no segment: nothing to write")
     tol = DEFAULT_TOLERANCE if tolerance is None else float(tolerance)
@@ -60,6 +61,7 @@ def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: b
     lines = [
         "%",
         comment(f"cadcnc {title}".strip()),
+        *(comment(note) for note in notes),
         comment(f"programmed point: {point_name}; units mm; +Z is the spindle axis"),
         comment(f"tolerance {tol:g} mm ({'points dropped' if tolerance else 'every point kept'}"
                  f"); {digits} decimals; feed {num(feed, 3)}, plunge {num(plunge, 3)} "

@@ -15,7 +15,9 @@ Layout (``format: "cadcnc-program"``, ``version: 2``)::
      "summary": {"complete": ..., "cut_length_mm": ..., "link_length_mm": ...,
                  "time_at_feed_s": ..., "cuts": ..., "links": ..., "skipped": ...}}
 
-Points are ball centres in mm; ``rapid[k]`` says whether link move k (point k to k + 1) is
+Points are ball centres in mm, in part coordinates; a program of another tool axis than +Z
+(:mod:`cadcnc.geometry.setup`) adds ``"setup": {"axis", "rotation", "origin"}`` and is
+read back into its work coordinates; ``rapid[k]`` says whether link move k (point k to k + 1) is
 a rapid (else a feed move at the plunge feed). Written atomically.
 """
 
@@ -30,7 +32,9 @@ from ..errors import require
 from ..errors import InputError
 from ..job import Job
 from ..jsonable import plain
+from ..geometry.setup import Setup
 from ..program.program import CutSegment, LinkSegment, Program, Skipped
+from ..program.transform import in_part_coordinates, in_setup_coordinates
 from . import toolpath_json as v1
 from .atomic import write_text
 
@@ -104,11 +108,35 @@ def program_from_dict(d: dict) -> Program:
                          f"{e})") from None
     if not cuts and not skipped:
         raise InputError("program JSON has no cut segment and nothing skipped")
-    return Program(job, segments, skipped, [str(n) for n in d.get("notes", [])])
+    program = Program(job, segments, skipped, [str(n) for n in d.get("notes", [])])
+    return in_setup_coordinates(program, setup_of_dict(d.get("setup")))
 
 
-def program_json(program: Program) -> str:
-    return json.dumps(program_to_dict(program), separators=(",", ":")) + "\n"
+def setup_of_dict(d) -> Setup | None:
+    """The recorded setup (None when there is none); InputError when malformed."""
+    if d is None:
+        return None
+    try:
+        setup = Setup.from_dict(d)
+        ok = setup.axis.shape == (3,) and setup.rotation.shape == (3, 3) and \
+            setup.origin.shape == (3,) and np.allclose(setup.rotation @ setup.rotation.T,
+                                                       np.eye(3), atol=1e-9)
+    except (KeyError, TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise InputError("the program's setup must hold an axis (3), a rotation (3 x 3, "
+                         "orthonormal) and an origin (3)")
+    return setup
+
+
+def program_json(program: Program, setup: Setup | None = None) -> str:
+    """The JSON text of ``program``; a ``setup``'s program (in its work coordinates) is
+    written in part coordinates with the setup."""
+    if setup is None or setup.identity:
+        return json.dumps(program_to_dict(program), separators=(",", ":")) + "\n"
+    d = program_to_dict(in_part_coordinates(program, setup))
+    d["setup"] = setup.to_dict()
+    return json.dumps(d, separators=(",", ":")) + "\n"
 
 
 def write_program_json(program: Program, out) -> None:

@@ -16,7 +16,10 @@ import numpy as np
 
 from ..errors import OutputError
 from ..geometry.mesh import tessellate
+from ..geometry.setup import job_setup, original_part
+from ..job import axis_name
 from ..program.program import Program
+from ..program.transform import in_part_coordinates
 from .output_set import write_one
 
 LINK_COLOUR = (0.45, 0.45, 0.45)
@@ -39,8 +42,9 @@ def _title(program: Program, title: str) -> str:
             f"{t['link_length_mm']:.1f} mm links, {t['skipped']} skipped, {state}")
 
 
-def program_figure(program: Program, part, title: str = ""):
-    """A matplotlib Figure of ``program`` over ``part`` (None: the moves alone)."""
+def program_figure(program: Program, part, title: str = "", axis=None):
+    """A matplotlib Figure of ``program`` over ``part`` (None: the moves alone), in part
+    coordinates; ``axis`` (3,): the tool axis, drawn as an arrow above the moves."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -67,6 +71,10 @@ def program_figure(program: Program, part, title: str = ""):
         else:
             ax.plot(*seg.points.T, color=LINK_COLOUR, lw=0.8, ls="--")
     centre, half = (lo + hi) / 2, max(float((hi - lo).max()) / 2, 1e-3)
+    if axis is not None:   # from the centre of the box out along the axis, named
+        tip = centre + np.asarray(axis) * half * 0.95
+        ax.quiver(*centre, *(tip - centre), color="crimson", lw=2.0, arrow_length_ratio=0.15)
+        ax.text(*tip, f"tool axis {axis_name(tuple(axis))}", color="crimson", fontsize=9)
     for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
         setter(c - half, c + half)
     ax.set_xlabel("x (mm)")
@@ -77,8 +85,9 @@ def program_figure(program: Program, part, title: str = ""):
     return fig
 
 
-def program_scene(program: Program, part):
-    """A trimesh Scene: the part's faces, cut lines coloured one per cut, links grey."""
+def program_scene(program: Program, part, axis=None):
+    """A trimesh Scene: the part's faces, cut lines coloured one per cut, links grey, in
+    part coordinates; ``axis`` (3,): the tool axis as a red line named ``tool_axis``."""
     import trimesh  # ~0.5 s to import: only .glb scenes need it
 
     sc = trimesh.Scene()
@@ -95,22 +104,33 @@ def program_scene(program: Program, part):
         line = trimesh.load_path(np.asarray(seg.points, dtype=float))
         line.colors = np.tile([int(255 * c) for c in rgb] + [255], (len(line.entities), 1))
         sc.add_geometry(line, geom_name=f"{seg.kind}{k}")
+    if axis is not None:
+        moves = program.all_moves()
+        centre, size = moves.mean(axis=0), float(np.ptp(moves, axis=0).max()) or 1.0
+        line = trimesh.load_path(np.array([centre, centre + np.asarray(axis) * size]))
+        line.colors = np.tile([220, 20, 60, 255], (len(line.entities), 1))
+        sc.add_geometry(line, geom_name=f"tool_axis {axis_name(tuple(axis))}")
     return sc
 
 
 def program_picture_bytes(program: Program, part, out, title: str = "") -> bytes:
-    """The picture of ``program`` in the format of ``out``'s suffix (.png or .glb)."""
+    """The picture of ``program`` in the format of ``out``'s suffix (.png or .glb), in part
+    coordinates; a program of another tool axis than +Z shows and names its axis."""
     suffix = Path(out).suffix.lower()
+    setup, axis = job_setup(program.job, part), None
+    if setup is not None:
+        program, part, axis = in_part_coordinates(program, setup), original_part(part), setup.axis
+        title = title if "tool axis" in title else f"{title} (tool axis {setup.name})".strip()
     if suffix == ".png":
         import matplotlib.pyplot as plt
 
-        fig = program_figure(program, part, title)
+        fig = program_figure(program, part, title, axis)
         buf = io.BytesIO()
         fig.savefig(buf, format="png", dpi=110)
         plt.close(fig)
         return buf.getvalue()
     if suffix == ".glb":
-        return program_scene(program, part).export(file_type="glb")
+        return program_scene(program, part, axis).export(file_type="glb")
     raise OutputError(f"{out}: unknown picture format {suffix or '(no suffix)'!r}; "
                       "use .png or .glb")
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from ..errors import InputError
 from ..geometry.part import Part
+from ..geometry.setup import setup_part
 from ..job import Finish, Job, PairPath, Pencil
 from ..program.program import Program
 from ..work import MAX_CYCLES
@@ -27,6 +28,7 @@ def run(part, job: Job, *, progress=None, times: dict | None = None,
         raise InputError(f"job must be a cadcnc.Job, got {type(job).__name__}")
     if not isinstance(part, Part):
         part = Part.from_cadquery(part, job.tolerances)
+    part = setup_part(part, job)   # the tool axis up: the program in work coordinates
     check_clearance(part, job)
     op = job.operation
     if isinstance(op, PairPath):

@@ -11,7 +11,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ..errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL, NothingToCutError
+from ..errors import (EXIT_GOUGE, EXIT_INPUT, EXIT_INTERNAL, EXIT_NOTHING, EXIT_OK,
+                      EXIT_OUTPUT, EXIT_PARTIAL, NothingToCutError)
 from ..io.program_gcode import program_written_moves
 from ..program.program import FAILED, STOPPED_SHORT, Program
 from ..program.summary import skipped_counts
@@ -74,6 +75,18 @@ def judge(program: Program, part, what: str, *, gcode: dict | None = None,
         verdict.messages.append(f"{what}: refused: {why}; nothing written. "
                                 f"{_hint(program, gate, gcode)}--allow-gouge writes it")
     return verdict
+
+
+SEVERITY = (EXIT_OK, EXIT_NOTHING, EXIT_PARTIAL, EXIT_GOUGE, EXIT_OUTPUT, EXIT_INPUT,
+            EXIT_INTERNAL)
+"""Exit codes from the least to the most severe: a run of several programs (setups)
+exits with its worst."""
+
+
+def worst(codes) -> int:
+    """The most severe of ``codes`` (SEVERITY order; EXIT_OK for none)."""
+    return max(codes, key=lambda c: SEVERITY.index(c) if c in SEVERITY else len(SEVERITY),
+               default=EXIT_OK)
 
 
 def _hint(program: Program, gate: ProgramGate, gcode: dict | None) -> str:

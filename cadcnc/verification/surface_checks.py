@@ -11,6 +11,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..geometry.part import load_step
+from ..geometry.setup import setup_part
 from ..tolerances import Tolerances
 from ..trim import OUTSIDE
 from .probe import FaceProbe
@@ -22,14 +23,16 @@ TICK = 5000  # progress is reported every 5000 cycles
 
 
 def resolve_part(toolpath, part):
-    """``part``, or the part loaded from the STEP file the toolpath's job names."""
+    """``part``, or the part loaded from the STEP file the toolpath's job names, in the
+    setup of the toolpath's job (its tool axis: :mod:`cadcnc.geometry.setup`)."""
     if part is not None:
-        return part
+        return setup_part(part, toolpath.job)
     source = toolpath.job.source
     if not source or str(source).startswith("<"):
         raise InputError("verify needs the part: the toolpath does not name a STEP file "
                          "(pass part=...)")
-    return load_step(source, flip_material=toolpath.job.flip_material)
+    return setup_part(load_step(source, flip_material=toolpath.job.flip_material),
+                      toolpath.job)
 
 
 def prepare(toolpath, part, tol: Tolerances):

@@ -27,6 +27,7 @@ from dataclasses import replace
 
 from ...errors import CadcncError
 from ...geometry.part import Part
+from ...geometry.setup import setup_part
 from ...job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
 from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program, Skipped
@@ -47,7 +48,7 @@ CHAIN_GAP = 1e-3
 
 def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT_FEED,
            period: float = DEFAULT_PERIOD, faces=None, clearance: float | None = None,
-           shank_length: float | None = None, side: str = CLIMB,
+           shank_length: float | None = None, side: str = CLIMB, axis="+Z",
            tol: Tolerances = DEFAULT, progress=None, times: dict | None = None) -> Program:
     """The pencil program of ``part`` (a :class:`~cadcnc.geometry.part.Part`, or a CadQuery
     Workplane or Shape, read with :meth:`Part.from_cadquery`) for a ball of radius
@@ -57,15 +58,25 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
     ``faces``: face numbers to restrict the corners to (both faces of a corner must be
     among them); ``clearance``: ball-centre Z of the links (default the part's top + 10
     mm); ``side``: "climb" (default: the material on the right of the travel, for a
-    clockwise spindle) or "conventional"; ``progress``, ``times``: see
+    clockwise spindle) or "conventional"; ``axis``: the tool axis (docs/setups.md: the
+    program is then in the setup's work coordinates); ``progress``, ``times``: see
     :func:`pencil_program`.
     """
+    part, job = keyword_job(part, radius, allowance, feed, period, faces, clearance,
+                            shank_length, side, axis, tol)
+    return pencil_program(setup_part(part, job), job, progress=progress, times=times)
+
+
+def keyword_job(part, radius: float, allowance: float = 0.0, feed: float = DEFAULT_FEED,
+                period: float = DEFAULT_PERIOD, faces=None, clearance: float | None = None,
+                shank_length: float | None = None, side: str = CLIMB, axis="+Z",
+                tol: Tolerances = DEFAULT) -> tuple[Part, Job]:
+    """(part, job) of :func:`pencil`'s keywords (a CadQuery part read as a Part)."""
     if not isinstance(part, Part):
         part = Part.from_cadquery(part, tol)
-    job = Job(Tool(radius, allowance, shank_length), feed, period,
-              Pencil(faces, side),
-              source=part.source, clearance=clearance, tolerances=tol)
-    return pencil_program(part, job, progress=progress, times=times)
+    return part, Job(Tool(radius, allowance, shank_length), feed, period,
+                     Pencil(faces, side), source=part.source, clearance=clearance,
+                     tolerances=tol, axis=axis)
 
 
 def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = None,

@@ -1,0 +1,300 @@
+"""The fewest setups: the pencil program of a part from several tool axes (issue 23).
+
+Each candidate axis (the six principal ones, or those given) gets its pencil program in its
+own setup (:mod:`cadcnc.geometry.setup`). What a setup reaches is counted in *positions*:
+the part's concave shared edges (of the selected faces) sampled every SPACING mm along
+their length; a cut point (ball centre, part coordinates) reaches the sample of its corner
+nearest to it (within REACH_RADII R'). A blend corner (two faces sharing no edge) counts
+its ball centres on a VOXEL mm grid instead. The setups chosen are the fewest whose union
+reaches every position any candidate reaches: checked over every subset of the
+candidates (2^6 = 64 at most), so the count is optimal; among the smallest covering
+subsets the one reaching the most positions in total wins, machined in decreasing reach
+(+Z first on ties). A later setup does not cut what an earlier one cut: its cuts are
+trimmed to the positions still to cut, plus ``overlap`` mm of arc length either side
+(a lap at the boundary), then ordered and linked again. Positions no candidate reaches
+are listed per corner with each axis's reason. Lengths mm.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field, fields, replace
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ...errors import CadcncError, InputError, NothingToCutError
+from ...geometry.edge_curve import EdgeCurve
+from ...geometry.part import CONCAVE, Part
+from ...geometry.setup import Setup, original_part, setup_in, setup_part
+from ...job import PRINCIPAL_AXES, Job, Pencil, axis_name
+from ...program.linking import linked
+from ...program.program import CutSegment, Program, Skipped
+from ...program.transform import in_part_coordinates
+from ...units import check_axis
+from ..common import safe_height
+from .pencil import CHAIN_GAP, keyword_job, pencil as pencil_one, pencil_program, reachable_order
+
+SPACING = 0.5      # mm between two positions along a concave edge
+REACH_RADII = 5.0  # a ball centre farther than this many R' from its corner's edge counts nothing
+VOXEL = 1.0        # mm: the grid of a blend corner's positions
+AUTO = "auto"
+AUTO_ORDER = ("+Z", "-Z", "+X", "-X", "+Y", "-Y")  # the candidates of AUTO, +Z first on ties
+TRIMMED = "setup boundary"  # the stop reason of a cut trimmed where an earlier setup cut
+
+
+@dataclass
+class SetupRun:
+    """One setup's program (work coordinates), its part turned into the setup, and the
+    positions it reaches (``reached``) and cuts (``assigned``: not cut by an earlier
+    setup)."""
+
+    setup: Setup
+    part: Part
+    program: Program
+    reached: int
+    assigned: int = 0
+    error: str = ""   # why it reaches nothing (its operation refused the part), or ""
+
+
+@dataclass
+class SetupsResult:
+    """The setups chosen, in machining order (``runs``), every candidate's reach by name,
+    the positions reachable (``positions``), those no candidate reaches (``unreached``:
+    (faces, count, reasons per axis)), and the subsets checked for the fewest."""
+
+    runs: list[SetupRun]
+    reach: dict[str, int]
+    positions: int
+    unreached: list[tuple[tuple[int, int], int, str]] = field(default_factory=list)
+    subsets_checked: int = 0
+    candidates: list[SetupRun] = field(default_factory=list)
+
+    def summary_lines(self) -> list[str]:
+        """Sentences for the user: the setups, their cuts and shares, what no axis reaches."""
+        n = max(self.positions, 1)
+        out = [f"setups     {len(self.runs)} of {len(self.reach)} candidate axes reach all "
+               f"{self.positions} reachable corner positions ({SPACING:g} mm apart); fewest "
+               f"(optimal: every one of {self.subsets_checked} subsets checked)",
+               "reach      " + ", ".join(f"{k} {v}" for k, v in self.reach.items())]
+        for r in self.runs:
+            out.append(f"setup {r.setup.name:<4} {len(r.program.cuts)} cuts, "
+                       f"{r.program.cut_length:.1f} mm, {r.assigned} positions "
+                       f"({100.0 * r.assigned / n:.1f} %), reaches {r.reached}")
+        for faces, count, why in self.unreached:
+            where = "" if faces == (0, 0) else f"faces {faces[0]} {faces[1]}: "
+            out.append(f"unreached  {where}{count} positions: {why}")
+        return out
+
+
+def parse_setups(value) -> list[tuple[float, float, float]] | str:
+    """AUTO, or the axes of "+Z,-X,..." / a sequence of axes (InputError naming the bad one)."""
+    if isinstance(value, str) and value.strip().lower() == AUTO:
+        return AUTO
+    items = value.split(",") if isinstance(value, str) else list(value)
+    axes = []
+    for item in items:
+        if isinstance(item, str) and item.strip().upper().lstrip("+-") not in ("X", "Y", "Z"):
+            raise InputError(f"setups: {item!r} is not an axis name (+Z, -Z, +X, -X, +Y, -Y)"
+                             " nor auto")
+        axes.append(check_axis(item))
+    if not axes:
+        raise InputError("setups: give auto or at least one axis")
+    return list(dict.fromkeys(axes))
+
+
+def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
+                  progress=None, max_cycles: int | None = None) -> SetupsResult:
+    """The fewest setups of ``job`` (a :class:`~cadcnc.job.Pencil` job) on ``part`` among
+    ``setups`` (AUTO: the six principal axes; or a list of axes): module doc. ``overlap``:
+    mm of lap at a boundary with an earlier setup. Raises NothingToCutError when no
+    candidate reaches anything."""
+    if not isinstance(job.operation, Pencil):
+        raise InputError("setups are for the pencil operation")
+    if not (isinstance(overlap, (int, float)) and overlap >= 0 and np.isfinite(overlap)):
+        raise InputError(f"setup overlap must be a length >= 0 mm, got {overlap!r}")
+    axes = [PRINCIPAL_AXES[n] for n in AUTO_ORDER] if parse_setups(setups) == AUTO else \
+        parse_setups(setups)
+    part = original_part(part)
+    samples = _positions(part, job)
+    runs, keys = [], []
+    for axis in axes:
+        sub = replace(job, axis=axis, origin=None if axis != job.axis else job.origin)
+        sp = setup_part(part, sub)
+        setup = setup_in(sp) or Setup(np.asarray(axis), np.eye(3), np.zeros(3))
+        extra = {} if max_cycles is None else {"max_cycles": max_cycles}
+        try:
+            program = pencil_program(sp, sub, progress=progress, **extra)
+            error = ""
+        except NothingToCutError as e:
+            program, error = Program(sub), str(e)
+        except CadcncError as e:   # the others may still reach: said per setup
+            if isinstance(e, InputError):
+                raise
+            program, error = Program(sub), f"{type(e).__name__}: {e}"
+        point_keys = _keys(in_part_coordinates(program, setup_in(sp)), samples, job)
+        reached = set().union(*point_keys) if point_keys else set()
+        reached.discard(None)
+        keys.append(point_keys)
+        runs.append(SetupRun(setup, sp, program, len(reached), error=error))
+    reach_sets = [set().union(*k) - {None} if k else set() for k in keys]
+    universe = set().union(*reach_sets)
+    chosen, checked = _fewest(reach_sets, universe)
+    result = SetupsResult([], {r.setup.name: r.reached for r in runs}, len(universe),
+                          _unreached(samples, universe, runs), checked, runs)
+    if not universe:
+        why = "; ".join(f"{r.setup.name}: {r.error or 'no cut'}" for r in runs)
+        raise NothingToCutError(f"no setup reaches any corner position ({why})")
+    taken: set = set()
+    for k in chosen:
+        run = runs[k]
+        run.assigned = len(reach_sets[k] - taken)
+        if taken:
+            run.program = _trimmed(run, keys[k], taken, overlap)
+        taken |= reach_sets[k]
+        result.runs.append(run)
+    return result
+
+
+def pencil(part, *, setups=None, setup_overlap: float = 0.0, **keywords):
+    """``cadcnc.pencil``: the pencil program of ``part`` (keywords of
+    :func:`cadcnc.ops.pencil.pencil.pencil`, ``axis`` among them), or with ``setups``
+    (AUTO or a list of axes) the :class:`SetupsResult` of :func:`pencil_setups`, each
+    chosen setup's program in ``result.runs`` (not yet gated: :func:`cadcnc.gate_program`
+    with ``run.part``), ``setup_overlap`` mm of lap at their boundaries."""
+    if setups is None:
+        return pencil_one(part, **keywords)
+    progress = keywords.pop("progress", None)
+    keywords.pop("times", None)
+    part, job = keyword_job(part, **keywords)
+    return pencil_setups(part, job, setups, setup_overlap, progress=progress)
+
+
+def _fewest(reach: list[set], universe: set) -> tuple[list[int], int]:
+    """Indices of the fewest sets covering ``universe`` (the most positions in total among
+    those, then candidate order), ordered by decreasing reach; and the subsets checked."""
+    checked = 0
+    for k in range(0 if not universe else 1, len(reach) + 1):
+        best = None
+        for combo in itertools.combinations(range(len(reach)), k):
+            checked += 1
+            if set().union(*(reach[i] for i in combo)) >= universe:
+                score = sum(len(reach[i]) for i in combo)
+                if best is None or score > best[0]:
+                    best = (score, combo)
+        if best is not None:
+            return sorted(best[1], key=lambda i: (-len(reach[i]), i)), checked
+    return [], checked
+
+
+def _positions(part: Part, job: Job) -> dict[tuple[int, int], np.ndarray]:
+    """Per concave pair (i < j) of the selected faces, its edges' samples (M, 3), mm."""
+    faces = None if job.operation.faces is None else set(job.operation.faces)
+    out = {}
+    for pair, edges in part.adjacency.items():
+        if faces is not None and not set(pair) <= faces:
+            continue
+        pts = []
+        for e in edges:
+            if e.edge_class != CONCAVE:
+                continue
+            curve = EdgeCurve(e)
+            n = max(int(np.ceil(curve.length / SPACING)), 1)
+            pts += [curve.point_tangent(s)[0] for s in np.linspace(0.0, curve.length, n + 1)]
+        if pts:
+            out[pair] = np.array(pts)
+    return out
+
+
+def _keys(program: Program, samples: dict, job: Job) -> list[list]:
+    """Per cut of ``program`` (part coordinates), per point its position key or None."""
+    reach = REACH_RADII * job.tool.offset
+    out, trees = [], {}
+    for cut in program.cuts:
+        pair = tuple(sorted(cut.path.faces))
+        pts = cut.points
+        if pair in samples:
+            if pair not in trees:
+                trees[pair] = cKDTree(samples[pair])
+            d, near = trees[pair].query(pts)
+            ok = d <= reach
+            out.append([(pair, int(k)) if good else None for k, good in zip(near, ok)])
+        else:   # a blend corner: its ball centres on a grid
+            out.append([(pair, tuple(np.round(p / VOXEL).astype(int))) for p in pts])
+    return out
+
+
+def _unreached(samples: dict, universe: set, runs: list[SetupRun]) -> list:
+    """(faces, count, reasons) of the edge positions no candidate reaches: per corner no
+    setup cuts at all, each reason with the axes that give it; then, as faces (0, 0), the
+    positions at the ends of corners that are cut (where a third face or the shank stops
+    every ball: the stretches' limits)."""
+    out, ends = [], 0
+    for pair, pts in samples.items():
+        missing = sum((pair, k) not in universe for k in range(len(pts)))
+        if not missing:
+            continue
+        if missing < len(pts):
+            ends += missing
+            continue
+        why: dict[str, list[str]] = {}
+        for r in runs:
+            reasons = sorted({s.reason for s in r.program.skipped
+                              if tuple(sorted(s.faces)) == pair}) or [
+                r.error or "no corner found"]
+            for reason in reasons:
+                why.setdefault(reason, []).append(r.setup.name)
+        out.append((pair, missing, "; ".join(f"{k} ({' '.join(v)})" for k, v in why.items())))
+    if ends:
+        out.append(((0, 0), ends, "at the ends of corners that are cut: beyond every "
+                                  "stretch's limits (a third face or the shank)"))
+    return out
+
+
+def _trimmed(run: SetupRun, keys: list[list], taken: set, overlap: float) -> Program:
+    """``run``'s program without the points of positions already cut (module doc)."""
+    pieces, skipped = [], list(run.program.skipped)
+    for cut, point_keys in zip(run.program.cuts, keys):
+        new = np.array([k is None or k not in taken for k in point_keys])
+        if overlap > 0 and new.any():
+            s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(cut.points, axis=0),
+                                                                axis=1))])
+            near = np.abs(s[:, None] - s[new][None, :]).min(axis=1) <= overlap
+            new = new | near
+        for i, j in _runs(new):
+            if j - i >= 2:
+                pieces.append(CutSegment(_piece(cut.path, i, j), cut.edge, cut.stretch,
+                                         at_limit=True))
+    job, part = run.program.job, run.part
+    z_safe = safe_height(part, job)
+    ordered, blocked = reachable_order(part, job, pieces, z_safe)
+    skipped += blocked
+    return Program(job, linked(ordered, z_safe, join=CHAIN_GAP), skipped,
+                   list(run.program.notes))
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """[start, end) of every run of True in ``mask``."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
+    return list(zip(edges[::2], edges[1::2]))
+
+
+def _piece(path, i: int, j: int):
+    """Points i..j-1 of a toolpath as one of its own (its per-point arrays sliced)."""
+    n = len(path.points)
+    per_point = {f.name: getattr(path, f.name)[i:j] for f in fields(path)
+                 if isinstance(getattr(path, f.name), np.ndarray)
+                 and len(getattr(path, f.name)) == n}
+    per_point["steps"] = np.concatenate([[0.0], per_point["steps"][1:]])
+    bounds = None if path.bounds is None else tuple(
+        replace(b, **{f.name: getattr(b, f.name)[i:j] for f in fields(b)}) for b in path.bounds)
+    return replace(path, **per_point, bounds=bounds,
+                   stop_reason=path.stop_reason if j == n else TRIMMED,
+                   stop_detail=path.stop_detail if j == n else
+                   "an earlier setup cuts on from here")
+
+
+def axis_tag(setup: Setup) -> str:
+    """The suffix of a setup's output names: "+Z", "-X", ... or "axis" and its components."""
+    return setup.name if setup.name in PRINCIPAL_AXES else "axis" + axis_name(
+        tuple(setup.axis)).replace(" ", "")
