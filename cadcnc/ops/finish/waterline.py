@@ -17,6 +17,8 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ...geometry.offset_section import offset_face
 from ...geometry.part import Part
 from ...guard.stay_down import StayDown
@@ -25,7 +27,7 @@ from ...program.linking import linked
 from ...program.program import CutSegment, Program, Skipped
 from ...work import MAX_PLANES, Heartbeat
 from ..common import safe_height
-from .levels import LevelPlan, check_stepdown, critical_heights, plan_levels
+from .levels import CRITICAL_MM, LevelPlan, check_stepdown, critical_heights, plan_levels
 from .loops import level_cuts
 from .plan import MAX_SAMPLES, FaceSamples, centre_chord, sample_faces
 from .setup import pass_setup
@@ -70,7 +72,11 @@ def waterline_cuts(part: Part, job: Job, samples: FaceSamples, *, progress=None,
     op, tool = job.operation, job.tool
     check_stepdown(op.stepdown, tool.radius)
     work = {} if work is None else work
-    critical = critical_heights(part, op.faces, samples, tool.offset)
+    setup = pass_setup(part, op.faces, job)
+    critical = critical_heights(part, op.faces, samples, tool.offset) + [
+        (float(c[:, 2].mean()), f"face {f}, a horizontal edge's offset")
+        for f, fe in setup.edges.items() for _, c, _ in fe.samples
+        if float(np.ptp(c[:, 2])) <= CRITICAL_MM]
     plan = plan_levels(samples, tool.radius, tool.allowance, stepdown=op.stepdown,
                        scallop=op.scallop, critical=critical, max_levels=max_levels,
                        work=work)
@@ -78,7 +84,6 @@ def waterline_cuts(part: Part, job: Job, samples: FaceSamples, *, progress=None,
     total, done = len(plan.offsets), 0
     beat = Heartbeat(progress and (lambda text: progress(done, total, text)), clock=clock)
     work.update(planes=total, samples=len(samples), cycles=0)
-    setup = pass_setup(part, op.faces, job)
     offsets = {f: offset_face(part.face(f).topods, tool.offset) for f in op.faces}
     near = None
     for k, z in enumerate(plan.offsets):
