@@ -221,6 +221,39 @@ class Pencil:
 
 
 FINISH_PATTERNS = ("zigzag", "oneway")
+FINISH_STRATEGIES = ("raster", "waterline", "steep-shallow")
+LOOP_SIDES = ("climb", "conventional")
+
+
+def check_strategy(op) -> None:
+    """Validate a :class:`Finish`'s strategy and its waterline fields, in place: which of
+    stepover, stepdown and scallop it needs, threshold (deg, 0 < A < 90), side, overlap."""
+    if op.strategy not in FINISH_STRATEGIES:
+        raise InputError(f"strategy must be one of {', '.join(FINISH_STRATEGIES)}, got "
+                         f"{_show(op.strategy)}")
+    if op.side not in LOOP_SIDES:
+        raise InputError(f"side must be one of {', '.join(LOOP_SIDES)}, got {_show(op.side)}")
+    if op.stepdown is not None:
+        object.__setattr__(op, "stepdown", check_number("stepdown", op.stepdown, "mm"))
+    object.__setattr__(op, "overlap", check_number("overlap", op.overlap, "mm",
+                                                   allow_zero=True))
+    a = op.threshold
+    if isinstance(a, bool) or not isinstance(a, numbers.Real) or not 0.0 < a < 90.0:
+        raise InputError(f"threshold must be a slope in degrees between 0 and 90 "
+                         f"(exclusive), got {_show(a)}")
+    object.__setattr__(op, "threshold", float(a))
+    given = {k for k in ("stepover", "stepdown", "scallop") if getattr(op, k) is not None}
+    if op.strategy == "raster":
+        ok, need = "stepdown" not in given, "stepover or scallop (stepdown is for waterline)"
+    elif op.strategy == "waterline":
+        ok, need = given in ({"stepdown"}, {"scallop"}), "exactly one of stepdown and scallop"
+    else:
+        ok, need = given in ({"scallop"}, {"stepover", "stepdown"}), \
+            "scallop alone, or both stepover (raster) and stepdown (waterline)"
+    if not ok:
+        raise InputError(f"finishing with strategy {op.strategy} needs {need}, got "
+                         + (", ".join(f"{k} {_show(getattr(op, k))}" for k in sorted(given))
+                            or "none"))
 
 
 @dataclass(frozen=True)
@@ -239,12 +272,23 @@ class Finish:
     scallop: float | None = None
     angle: float = 0.0
     pattern: str = "zigzag"
+    stepdown: float | None = None
+    """mm: the waterline levels' fixed spacing (strategy waterline or steep-shallow)."""
+    strategy: str = "raster"
+    """raster (vertical guide planes), waterline (horizontal levels) or steep-shallow."""
+    threshold: float = 45.0
+    """deg: steep-shallow cuts waterline where the slope exceeds it, raster elsewhere."""
+    side: str = "climb"
+    """waterline loops: climb or conventional."""
+    overlap: float = 0.0
+    """mm: steep-shallow's two regions overlap this much at their boundary."""
 
     def __post_init__(self):
         if isinstance(self.faces, (tuple, list)) and not self.faces:
             raise InputError("finishing needs at least one face")
         object.__setattr__(self, "faces", check_faces(self.faces))
-        if (self.stepover is None) == (self.scallop is None):
+        check_strategy(self)
+        if self.strategy == "raster" and (self.stepover is None) == (self.scallop is None):
             raise InputError("give exactly one of stepover (the planes' spacing, mm) and "
                              "scallop (the largest scallop height, mm)"
                              + ("" if self.stepover is None else
@@ -269,7 +313,9 @@ class Finish:
 
     def to_inputs(self) -> dict:
         return dict(operation="finish", faces=list(self.faces), stepover=self.stepover,
-                    scallop=self.scallop, angle=self.angle, pattern=self.pattern)
+                    scallop=self.scallop, angle=self.angle, pattern=self.pattern,
+                    stepdown=self.stepdown, strategy=self.strategy,
+                    threshold=self.threshold, side=self.side, overlap=self.overlap)
 
 
 @dataclass(frozen=True)
@@ -362,7 +408,10 @@ class Job:
             kind = inputs.get("operation", "path")
             if kind == "finish":
                 op = Finish(inputs["faces"], inputs.get("stepover"), inputs.get("scallop"),
-                            inputs.get("angle", 0.0), inputs.get("pattern", "zigzag"))
+                            inputs.get("angle", 0.0), inputs.get("pattern", "zigzag"),
+                            inputs.get("stepdown"), inputs.get("strategy", "raster"),
+                            inputs.get("threshold", 45.0), inputs.get("side", "climb"),
+                            inputs.get("overlap", 0.0))
             elif kind == "pencil":
                 op = Pencil(inputs.get("faces"), inputs.get("side", "climb"))
             elif kind == "path":

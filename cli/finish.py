@@ -31,7 +31,7 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
     p.add_argument("--faces", nargs="+", type=int, required=True, metavar="N",
                    help="the faces to finish, numbered as `cadcnc faces`")
     p.add_argument("--radius", required=True, metavar="R", help="ball radius, mm")
-    spacing = p.add_mutually_exclusive_group(required=True)
+    spacing = p.add_mutually_exclusive_group()
     spacing.add_argument("--stepover", metavar="S", help="distance between the passes' "
                          "guide planes, mm")
     spacing.add_argument("--scallop", metavar="H", help="largest scallop height, mm: the "
@@ -42,6 +42,19 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
                    help="zigzag (default: every other pass reversed, staying down where the "
                         "move is verified clear) or oneway (every pass the same way, "
                         "retracting between)")
+    p.add_argument("--strategy", choices=("raster", "waterline", "steep-shallow"),
+                   default="raster", help="raster (default: vertical guide planes), "
+                   "waterline (horizontal levels, top to bottom) or steep-shallow "
+                   "(waterline where the slope exceeds --threshold, raster elsewhere; "
+                   "docs/finish.md)")
+    p.add_argument("--stepdown", metavar="D", help="waterline: distance between levels, mm "
+                   "(or --scallop: the levels' spacing follows the walls' slope)")
+    p.add_argument("--threshold", default="45", metavar="A", help="steep-shallow: slope "
+                   "in degrees from horizontal above which waterline cuts (default 45)")
+    p.add_argument("--side", choices=("climb", "conventional"), default="climb",
+                   help="waterline loops: climb (default) or conventional")
+    p.add_argument("--overlap", default="0", metavar="MM", help="steep-shallow: the "
+                   "regions overlap this much at their boundary, mm (default 0)")
     add_operation_options(p, "stock allowance left on the faces")
     job_flip(p)
     gouge(p)

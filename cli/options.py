@@ -82,12 +82,15 @@ def finish_job(args, source: str) -> Job:
     """The :class:`Job` of ``finish``'s options."""
     spacing = {name: None if getattr(args, name) is None else
                parse_length(getattr(args, name), name, allow_zero=False)
-               for name in ("stepover", "scallop")}
+               for name in ("stepover", "scallop", "stepdown")}
     try:
-        angle = float(args.angle)
+        angle, threshold = float(args.angle), float(args.threshold)
     except ValueError:
-        raise InputError(f"--angle: expected degrees, got {args.angle!r}") from None
-    return job_of(args, Finish(args.faces, angle=angle, pattern=args.pattern, **spacing),
+        raise InputError(f"--angle, --threshold: expected degrees, got {args.angle!r}, "
+                         f"{args.threshold!r}") from None
+    return job_of(args, Finish(args.faces, angle=angle, pattern=args.pattern,
+                               strategy=args.strategy, threshold=threshold, side=args.side,
+                               overlap=parse_length(args.overlap, "overlap"), **spacing),
                   source)
 
 

@@ -35,8 +35,13 @@ def _operation(job) -> str:
             "corners of faces " + " ".join(map(str, op.faces))
         return f"pencil, {which}, {op.side}"
     if isinstance(op, Finish):
-        spacing = (f"stepover {op.stepover:g} mm" if op.stepover is not None
-                   else f"scallop {op.scallop:g} mm")
+        spacing = ", ".join(f"{k} {getattr(op, k):g} mm" for k in (
+            "stepover", "stepdown", "scallop") if getattr(op, k) is not None)
+        if op.strategy != "raster":
+            how = (f"{op.side}" if op.strategy == "waterline" else
+                   f"threshold {op.threshold:g} deg, overlap {op.overlap:g} mm, {op.side}")
+            return (f"finish faces {' '.join(map(str, op.faces))}, {op.strategy}, "
+                    f"{spacing}, {how}")
         return (f"finish faces {' '.join(map(str, op.faces))}, {spacing}, angle "
                 f"{op.angle:g} deg, {op.pattern}")
     return type(op).__name__

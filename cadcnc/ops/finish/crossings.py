@@ -132,16 +132,19 @@ class FaceEdges:
             count = (count - 1) * int(math.ceil(turn / TURN_DEG)) + 1
         return ts, centres, vel
 
-    def crossings(self, nrm: np.ndarray, off: float, travel: np.ndarray) -> list[Crossing]:
+    def crossings(self, nrm: np.ndarray, off: float, travel: np.ndarray,
+                  tangent=None) -> list[Crossing]:
         """Every crossing of the plane dot(p, nrm) = off by this face's offset contact
         curve (module doc: close roots and grazes included), classified for a centre
-        moving along ``travel`` (the pass direction (3,) times the travel sense)."""
+        moving along ``travel`` (the pass direction (3,) times the travel sense), or
+        along ``tangent(n)`` (the curve's unit tangent at a contact of normal n, ValueError
+        where it has none) when given (a horizontal plane's loops)."""
         out: list[Crossing] = []
         for k, (curve, (ts, centres, vel)) in enumerate(zip(self.edges, self.samples)):
             for t in self._roots(curve, ts, centres @ nrm - off, vel @ nrm, nrm, off):
                 c, uv, n = self.centre(curve, t)
                 try:
-                    entry = self._enters(k, t, uv, n, nrm, travel)
+                    entry = self._enters(k, t, uv, n, nrm, travel, tangent)
                 except ValueError:
                     continue   # parallel to the plane there: no pass crosses it
                 if any(o.entry == entry and np.linalg.norm(o.point - c) <= 1e-9 for o in out):
@@ -186,12 +189,12 @@ class FaceEdges:
         return sorted(roots)
 
     def _enters(self, k: int, t: float, uv, n: np.ndarray, nrm: np.ndarray,
-                travel: np.ndarray) -> bool:
+                travel: np.ndarray, tangent=None) -> bool:
         """Whether the contact moves into the face when the centre moves along the
         plane's curve in the travel sense (:func:`pass_tangent`): the contact's move
         through the whole shape operator (the interpolator's exact inverse), against the
         face's inward direction."""
-        tau = pass_tangent(n, travel)
+        tau = pass_tangent(n, travel) if tangent is None else tangent(n)
         contact = Contact(self.face, self.offset, *uv)
         du, dw = inverse_exact(contact, add(contact.centre(), tuple(map(float, tau))))
         move = du * np.array(contact.ru) + dw * np.array(contact.rw)

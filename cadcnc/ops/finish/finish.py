@@ -28,10 +28,10 @@ from ...geometry.part import Part
 from ...job import Finish, Job, Tool
 from ...program.program import CutSegment, Program, Skipped
 from ...tolerances import DEFAULT, Tolerances
-from ...guard.stay_down import StayDown
 from ...work import MAX_PLANES, Heartbeat
 from .passes import GuidePlane, pass_cuts
-from .setup import pass_setup
+from .steep_shallow import strategy_program
+from .waterline import stay_down_links
 from .plan import MAX_SAMPLES, centre_chord, plan_planes, sample_faces
 from .uncut import uncut_report
 from ..common import safe_height
@@ -50,7 +50,9 @@ def finish(part, faces, *, radius: float, allowance: float = 0.0,
            angle: float = 0.0, pattern: str = "zigzag", feed: float = DEFAULT_FEED,
            period: float = DEFAULT_PERIOD, clearance: float | None = None,
            shank_length: float | None = None, tol: Tolerances = DEFAULT,
-           progress=None, max_planes: int = MAX_PLANES) -> Program:
+           progress=None, max_planes: int = MAX_PLANES, strategy: str = "raster",
+           stepdown: float | None = None, threshold: float = 45.0, side: str = "climb",
+           overlap: float = 0.0) -> Program:
     """The finishing program of ``faces`` of ``part`` (see the module doc).
 
     ``part``: a :class:`~cadcnc.geometry.part.Part`, or a CadQuery Workplane or Shape;
@@ -61,10 +63,14 @@ def finish(part, faces, *, radius: float, allowance: float = 0.0,
     ``pattern``: "zigzag" or "oneway". ``clearance``: ball-centre Z of the retracts
     (default the part's top + 10 mm). ``progress(done, total, what)`` after each plane. A
     keyword convenience that builds the :class:`~cadcnc.job.Job` of :func:`finish_program`.
+    ``strategy``: "raster", "waterline" (``stepdown`` or ``scallop``; loops ``side``
+    "climb" or "conventional") or "steep-shallow" (waterline where the slope exceeds
+    ``threshold`` deg, raster elsewhere, ``overlap`` mm at the boundary; docs/finish.md).
     """
     if not isinstance(part, Part):
         part = Part.from_cadquery(part, tol)
-    op = Finish(face_numbers(part, faces), stepover, scallop, angle, pattern)
+    op = Finish(face_numbers(part, faces), stepover, scallop, angle, pattern, stepdown,
+                strategy, threshold, side, overlap)
     job = Job(Tool(radius, allowance, shank_length), feed, period, op, source=part.source,
               clearance=clearance, tolerances=tol)
     return finish_program(part, job, progress=progress, max_planes=max_planes)
@@ -79,9 +85,12 @@ def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX
     (:class:`~cadcnc.work.WorkLimitError`, exit 2); the face samples are at most
     MAX_SAMPLES. ``work``: a dict given ``planes_estimate``, ``planes``,
     ``samples_estimate``, ``samples`` and ``cycles`` (every stepper cycle run)."""
-    op, tol, pattern = job.operation, job.tolerances, job.operation.pattern
+    op, pattern = job.operation, job.operation.pattern
     for n in op.faces:
         part.face(n)  # FaceNumberError names the range
+    if op.strategy != "raster":   # waterline, steep-shallow (this function their raster)
+        return strategy_program(part, job, finish_program, progress=progress,
+                                max_planes=max_planes, clock=clock, work=work)
     work = {} if work is None else work
     plan, samples = plan_for_job(part, job, max_planes=max_planes, work=work)
     total, done = len(plan.offsets), 0
@@ -99,12 +108,7 @@ def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX
         work["cycles"] += res.cycles
         done = k + 1   # reported now, which restarts the heartbeat's interval
         beat.beat(f"plane {done} at {offset:.3f} mm", force=True)
-    stay_down = None
-    if pattern == "zigzag":
-        setup = pass_setup(part, op.faces, job)
-        stay_down = StayDown(part, {f: (part.face(f), setup.guard(f).height_cells(f))
-                                    for f in op.faces}, job.tool.offset, job.tool.shank,
-                             tol.hit)
+    stay_down = stay_down_links(part, job) if pattern == "zigzag" else None
     segments, unreachable, notes = entered_program_segments(
         part, job, cuts, safe_height(part, job), join=JOIN, stay_down=stay_down,
         tick=lambda k, n: beat.beat(f"entries: {k} of {n} cuts"))

@@ -51,6 +51,7 @@ WHY = {
                      "apart on it",
     "too steep": "too steep for the pass direction",
     "missed": "passes stopped or failed there (see the passes' skipped records)",
+    "flat": "within 5 deg of horizontal: left to raster (waterline levels do not cut it)",
 }
 
 
@@ -97,8 +98,10 @@ class UncutReport:
 def scallop_limit(job) -> float:
     """L (mm): the scallop height asked for, or the flat-floor cusp of the stepover."""
     op = job.operation
-    return op.scallop if op.scallop is not None else stepover_scallop(op.stepover,
-                                                                       job.tool.radius)
+    if op.scallop is not None:
+        return op.scallop
+    spacing = max(s for s in (op.stepover, getattr(op, "stepdown", None)) if s is not None)
+    return stepover_scallop(spacing, job.tool.radius)
 
 
 def uncut_report(program, part, samples, plan) -> UncutReport:
@@ -198,6 +201,8 @@ def _reasons(reason, left, samples, q, part, job, n) -> np.ndarray:
         nearest = cKDTree(q[probe]).query(q[idx])[1]
         why[idx[hit[nearest]]] = "collision"
     nrm = samples.normals
+    if abs(n[2]) == 1.0:   # waterline levels: a miss is a miss
+        return why
     facing_across = np.abs(nrm @ n) > np.abs(nrm @ np.cross(n, (0.0, 0.0, 1.0)))
     steep = np.abs(nrm[:, 2]) < math.sin(math.radians(STEEP_DEG))
     still = open_ & (why == "missed")
