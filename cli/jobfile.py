@@ -80,20 +80,15 @@ def read(path) -> JobFile:
         text = path.read_text()
     except OSError as e:
         raise InputError(f"{path}: cannot read the job file ({e.strerror or e})") from None
-    if path.suffix.lower() == ".json":
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as e:
-            raise JobFileError(f"{path}:{e.lineno}: not JSON: {e.msg}") from None
-        lines = json_lines(text)
-    elif path.suffix.lower() == ".toml":
-        try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as e:
-            raise JobFileError(f"{path}: not TOML: {e}") from None
-        lines = toml_lines(text)
-    else:
+    kind = path.suffix.lower()
+    if kind not in READERS:
         raise InputError(f"{path}: a job file is .toml or .json")
+    loads, error, locate = READERS[kind]
+    try:
+        data = loads(text)
+    except error as e:   # each names the line and column
+        raise JobFileError(f"{path}: not {kind[1:].upper()}: {e}") from None
+    lines = locate(text)
     if not isinstance(data, dict):
         raise JobFileError(f"{path}:1: the job file must be a table of keys")
     job = JobFile(path, [], [], {}, {}, path.with_name(path.stem + "-out"), DEFAULT_OUTPUTS,
@@ -103,6 +98,7 @@ def read(path) -> JobFile:
 
 
 def _check(job: JobFile, data: dict) -> None:
+    """The keys and values of ``data``, into ``job`` (JobFileError: line and key)."""
     for key in data:
         if key not in TOP_KEYS:
             raise job.error((key,), f"unknown key; the keys are {', '.join(TOP_KEYS)}")
@@ -282,3 +278,8 @@ def json_lines(text: str) -> dict:
             value_starts()
         i += 1
     return lines
+
+
+READERS = {".json": (json.loads, json.JSONDecodeError, json_lines),
+           ".toml": (tomllib.loads, tomllib.TOMLDecodeError, toml_lines)}
+"""The reader, its error and the key lines of each job file format, by suffix."""

@@ -193,15 +193,14 @@ def test_a_worker_killed_mid_run_is_retried_on_the_separate_cluster(cluster, tmp
     assert len(retried) == 1 and f"pid {killed[0]} " in retried[0]["message"], by_part
     assert by_part["broken"]["exit"] == 2
     reference = embedded[0].parent / "jobs-out"
-    for name in GOOD:   # the embedded run's outputs; the JSON records its own part's path
+    for name in GOOD:   # the embedded run's outputs, but for the part's path they record
         assert by_part[name]["exit"] == 0 and by_part[name]["worker"] != ""
         mine, theirs = jobs.parent / "jobs-out" / name, reference / name
         assert (mine / "pencil.ngc").read_bytes() == (theirs / "pencil.ngc").read_bytes()
-        programs = [json.loads((d / "pencil.json").read_text()) for d in (mine, theirs)]
-        part = str((jobs.parent / f"{name}.step").resolve())
-        assert programs[0]["job"].pop("source") == part
-        programs[1]["job"].pop("source")
-        assert programs[0] == programs[1]
+        texts = [(d / "pencil.json").read_text().replace(str((j.parent / f"{name}.step")
+                                                             .resolve()), "PART")
+                 for d, j in ((mine, jobs), (theirs, embedded[0]))]
+        assert '"source":"PART"' in texts[0].replace(" ", "") and texts[0] == texts[1]
 
 
 BAD_TOML = [
