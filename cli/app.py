@@ -131,10 +131,11 @@ def build_parser() -> argparse.ArgumentParser:
     add_max_cycles(p)
     add_axis_options(p)
 
-    from . import finish, pencil, stream  # light: their commands import the library when run
+    from . import batch, finish, pencil, stream  # light: their commands import the library when run
     pencil.add_parser(add, _flip_option, _gouge_options, _gcode_options)
     finish.add_parser(add, _flip_option, _gouge_options, _gcode_options)
     stream.add_parser(add, _flip_option, _gouge_options)
+    batch.add_parser(add, parser)
 
     p = add("run", "execute an APT-like part program (PATH = P/[...])",
             "Execute an APT-like part program (grammar: docs/cli.md). Prints a summary per "
@@ -215,12 +216,13 @@ def main(argv: list[str] | None = None) -> int:
             else:
                 from . import commands
 
+                from .batch import batch_command
                 from .finish import finish_command
                 from .pencil import pencil_command
                 from .stream import stream_command
 
                 run = {"pencil": pencil_command, "finish": finish_command,
-                       "stream": stream_command}.get(
+                       "stream": stream_command, "batch": batch_command}.get(
                     args.command) or commands.COMMANDS[args.command]
         return int(run(args) or 0)
     except KeyboardInterrupt:

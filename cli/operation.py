@@ -4,7 +4,6 @@ verdict, the summary, the outputs written all at once, the library's exit code."
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 from cadcnc.job import DEFAULT_FEED as FEED, DEFAULT_PERIOD as PERIOD
@@ -67,17 +66,13 @@ def operation_command(args, what: str, job_of, *, progress=None,
     """Run one operation from the command line (module doc). ``job_of(args, source)``
     builds its Job; ``progress``: the operation's progress callback; ``times``: per-stage
     seconds (pencil)."""
-    import cadcnc
-    from cadcnc.errors import InputError, NothingToCutError
+    from cadcnc.batch.operate import operate, rendered
+    from cadcnc.geometry.setup import setup_in
     from cadcnc.io.output_set import OutputSet
-    from cadcnc.io.outputs import SUFFIXES, render
-    from cadcnc.ops.common import safe_height
-    from cadcnc.geometry.setup import setup_in, setup_part
-    from cadcnc.ops.run import cut_back_gap
-    from cadcnc.verification.judgement import judge, settle
+    from cadcnc.io.outputs import SUFFIXES
 
     from .feedback import say_error, stage_progress
-    from .options import gcode_keywords, wants_gcode
+    from .options import settings_of
 
     outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])  # checked before computing
     machine = None
@@ -90,58 +85,32 @@ def operation_command(args, what: str, job_of, *, progress=None,
             check_destination(out, STREAM_SUFFIXES, [args.step])
         machine = machine_of(args)
     job = job_of(args, args.step)
-    t0 = time.monotonic()
-    part = setup_part(cadcnc.load_step(args.step, flip_material=job.flip_material), job)
-    if setup_in(part) is not None:
-        what = f"{what} (tool axis {setup_in(part).name})"
-    for n in getattr(job.operation, "faces", None) or ():
-        if n is not None:
-            part.face(n)   # face numbers checked before anything is computed
-    if args.max_cycles < 1:
-        raise InputError(f"--max-cycles must be at least 1, got {args.max_cycles}")
-    try:
-        program = cadcnc.run(part, job, progress=progress, times=times,
-                             max_cycles=args.max_cycles)
-    except NothingToCutError as e:   # a setup that reaches nothing says which it is
-        if setup_in(part) is None:
-            raise
-        raise NothingToCutError(f"{what}: {e}") from None
-    t_cut = time.monotonic() - t0
-    name = Path(args.step).name
-    join = cut_back_gap(job)
-    if join is not None:
-        program = settle(program, part, safe_height(part, job), join, f"{args.step}: {what}",
-                         args.allow_gouge)
-    elif not program.cuts:
-        raise NothingToCutError(f"{args.step}: {what}: nothing to cut")
-    gcode = gcode_keywords(args) if wants_gcode(args.output) else None
-    verdict = judge(program, part, f"cadcnc: {what}", gcode=gcode,
-                    allow_partial=args.allow_partial, allow_gouge=args.allow_gouge,
-                    progress=stage_progress(args, f"{what}: gouge check", after_s=1.0))
+    settings = settings_of(args)
+    done = operate(args.step, job, what, settings, progress=progress, times=times,
+                   gate_progress=stage_progress(args, f"{what}: gouge check", after_s=1.0))
+    program, part, verdict = done.program, done.part, done.verdict
     for line in verdict.messages:
         say_error(line)
     if not args.quiet:
-        print(program.summary(name))
+        print(program.summary(Path(args.step).name))
         if setup_in(part) is not None:
             print("  setup      " + "; ".join(setup_in(part).describe()))
         print("  verdict    " + ("written" if verdict.write else "nothing written") + (
             "" if verdict.code == 0 else f" (exit {verdict.code}: see the message above)"))
         staged = "" if not times else "; " + ", ".join(f"{k} {v:.1f} s"
                                                        for k, v in times.items())
-        print(f"  time       computed in {t_cut:.1f} s, gated in "
-              f"{time.monotonic() - t0 - t_cut:.1f} s{staged}")
+        print(f"  time       computed in {done.seconds_computed:.1f} s, gated in "
+              f"{done.seconds_gated:.1f} s{staged}")
     if verdict.write:
-        title = f"{what} R {job.tool.radius:g} of {name}"
-        outputs.write({out: render(program, out, part, title, **(gcode or {}))
-                       for out in args.output})
+        outputs.write(rendered(done, args.output, done.what, settings))
         if not args.quiet:
             print(f"  wrote      {', '.join(args.output)}")
     if machine is not None:
         if verdict.code != 0:
-            say_error(f"cadcnc: {what}: not streamed: only a complete, verified program is")
+            say_error(f"cadcnc: {done.what}: not streamed: only a complete, verified program is")
             return verdict.code
         from .stream import stream_outputs
 
         return stream_outputs(program, part, machine, args.stream, tolerances=job.tolerances,
-                              quiet=args.quiet, name=name, inputs=[args.step])
+                              quiet=args.quiet, name=Path(args.step).name, inputs=[args.step])
     return verdict.code

@@ -7,6 +7,7 @@ import dataclasses
 import math
 from pathlib import Path
 
+from cadcnc.batch.operate import Settings
 from cadcnc.errors import InputError
 from cadcnc.io.gcode import blend_for
 from cadcnc.job import Finish, Job, PairPath, Pencil, Tool, check_number
@@ -92,6 +93,18 @@ def finish_job(args, source: str) -> Job:
                                strategy=args.strategy, threshold=threshold, side=args.side,
                                overlap=parse_length(args.overlap, "overlap"), **spacing),
                   source)
+
+
+BUILDERS = {"path": path_job, "pencil": pencil_job, "finish": finish_job}
+"""The Job of each operation command's options (``cadcnc batch`` maps a job file's
+operations through it)."""
+
+
+def settings_of(args) -> Settings:
+    """How an operation command's program is judged and written: ``--max-cycles``, the
+    G-code keywords when a .ngc is among the outputs, ``--allow-partial/gouge``."""
+    return Settings(args.max_cycles, gcode_keywords(args) if wants_gcode(args.output)
+                    else None, args.allow_partial, args.allow_gouge)
 
 
 def clearance(args) -> float | None:

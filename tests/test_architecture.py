@@ -157,7 +157,7 @@ def test_no_private_name_imported_across_modules():
 
 
 STAGES = ["geometry", "interp", "program", "guard", "ops", "controller", "io",
-          "verification", "apt", "cli"]
+          "verification", "batch", "apt", "cli"]
 """The data flow, in order; a stage imports only from itself and the stages before it
 (io and verification read programs; verification may use io's written-move readers)."""
 

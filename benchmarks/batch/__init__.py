@@ -1,0 +1,2 @@
+"""``cadcnc batch`` on Dask: throughput with 1 and 2 workers, overhead per task
+(``throughput.py``)."""

@@ -1,0 +1,94 @@
+"""One operation on one STEP part, end to end, as ``cadcnc path``/``pencil``/``finish`` run
+it: load, compute (:func:`cadcnc.run`), cut gouging cuts back, gate and judge
+(:mod:`cadcnc.verification.judgement`), render the outputs by suffix
+(:mod:`cadcnc.io.outputs`). The command line and every batch task call this one function,
+so that a part in a batch gives the bytes it gives alone.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import InputError, NothingToCutError
+from ..geometry.part import Part, load_step
+from ..geometry.setup import setup_in, setup_part
+from ..io.outputs import render
+from ..job import Job
+from ..ops.common import safe_height
+from ..ops.run import cut_back_gap, run
+from ..program.program import Program
+from ..verification.judgement import Verdict, judge, settle
+from ..work import MAX_CYCLES
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How a program is judged and written besides its Job: ``max_cycles`` (the work
+    limit), ``gcode`` (keywords of :func:`~cadcnc.io.program_gcode.program_ngc` when a
+    .ngc is written, else None: the gate then checks the program's own points),
+    ``allow_partial`` / ``allow_gouge`` (write a partial or gouging program anyway)."""
+
+    max_cycles: int = MAX_CYCLES
+    gcode: dict | None = field(default=None, hash=False)
+    allow_partial: bool = False
+    allow_gouge: bool = False
+
+
+@dataclass
+class Outcome:
+    """What :func:`operate` leaves: the part (turned to its setup), the program, the
+    verdict, the seconds spent computing (load and :func:`cadcnc.run`) and settling and
+    gating, and ``what``: the operation's name in messages, with its tool axis."""
+
+    part: Part
+    program: Program
+    verdict: Verdict
+    seconds_computed: float
+    seconds_gated: float
+    what: str
+
+
+def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progress=None,
+            times: dict | None = None, gate_progress=None) -> Outcome:
+    """Run ``job`` on the STEP file ``step`` and judge it (module doc). ``what``: the
+    command's name in messages ("pencil"); ``progress`` and ``times``: as
+    :func:`cadcnc.run`; ``gate_progress``: the gate's ``(stage, done, total)`` callback.
+    Raises the library's errors (bad face number, nothing to cut, ...)."""
+    if settings.max_cycles < 1:
+        raise InputError(f"--max-cycles must be at least 1, got {settings.max_cycles}")
+    t0 = time.monotonic()
+    part = setup_part(load_step(step, flip_material=job.flip_material), job)
+    if setup_in(part) is not None:
+        what = f"{what} (tool axis {setup_in(part).name})"
+    for n in getattr(job.operation, "faces", None) or ():
+        if n is not None:
+            part.face(n)   # face numbers checked before anything is computed
+    try:
+        program = run(part, job, progress=progress, times=times,
+                      max_cycles=settings.max_cycles)
+    except NothingToCutError as e:   # a setup that reaches nothing says which it is
+        if setup_in(part) is None:
+            raise
+        raise NothingToCutError(f"{what}: {e}") from None
+    t_cut = time.monotonic() - t0
+    join = cut_back_gap(job)
+    if join is not None:
+        program = settle(program, part, safe_height(part, job), join, f"{step}: {what}",
+                         settings.allow_gouge)
+    elif not program.cuts:
+        raise NothingToCutError(f"{step}: {what}: nothing to cut")
+    verdict = judge(program, part, f"cadcnc: {what}", gcode=settings.gcode,
+                    allow_partial=settings.allow_partial, allow_gouge=settings.allow_gouge,
+                    progress=gate_progress)
+    return Outcome(part, program, verdict, t_cut, time.monotonic() - t0 - t_cut, what)
+
+
+def rendered(outcome: Outcome, outputs, what: str, settings: Settings) -> dict:
+    """``{output: bytes or str}`` of every output, by its suffix, titled by the operation,
+    the ball and the part's file name."""
+    job = outcome.program.job
+    title = f"{what} R {job.tool.radius:g} of {Path(job.source or '').name}"
+    return {out: render(outcome.program, out, outcome.part, title, **(settings.gcode or {}))
+            for out in outputs}
