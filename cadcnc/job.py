@@ -18,27 +18,13 @@ from dataclasses import dataclass, field
 from .errors import InputError
 from .tolerances import DEFAULT, Tolerances
 from .units import PRINCIPAL_AXES, axis_name, check_axis  # noqa: F401 - the Job's axis
+from .units import Point, check_faces, check_number, check_point, shown  # noqa: F401 - checks of every record
 
 SHANK_LENGTH_RADII = 10.0  # default shank length, in ball radii
 DEFAULT_FEED = 1500.0  # mm/min: with DEFAULT_PERIOD, the paper's 0.1 mm step
 DEFAULT_PERIOD = 0.004  # s: the interpolation period
 SAFE_MARGIN = 10.0  # mm above the part's top where links travel when no clearance is given
 MIN_STEP = 1e-6  # mm: the shortest commanded step f = F Ts per period a job may ask for
-Point = tuple[float, float, float]
-
-
-def check_number(name: str, value, unit: str, *, allow_zero: bool = False) -> float:
-    """``value`` as a float if it is a real finite number > 0 (>= 0 with ``allow_zero``).
-
-    Booleans are refused (``radius=True`` is a mistake, not 1 mm); numpy scalars are
-    numbers. The error names the parameter and its unit.
-    """
-    ok = (isinstance(value, numbers.Real) and not isinstance(value, bool)
-          and math.isfinite(float(value)))
-    if not ok or value < 0 or (value == 0 and not allow_zero):
-        need = ">= 0" if allow_zero else "> 0"
-        raise InputError(f"{name} must be a number {need} {unit}, got {_show(value)}")
-    return float(value)
 
 
 def check_step(feed: float, period: float) -> float:
@@ -50,30 +36,10 @@ def check_step(feed: float, period: float) -> float:
     """
     f = feed * period / 60.0
     if not f >= MIN_STEP:
-        raise InputError(f"feed {_show(feed)} mm/min and period {_show(period)} s give a "
+        raise InputError(f"feed {shown(feed)} mm/min and period {shown(period)} s give a "
                          f"step of {f:.3g} mm per period, below the minimum {MIN_STEP:g} mm: "
                          "raise the feed or the period (is the period in seconds?)")
     return f
-
-
-def check_point(name: str, value) -> Point | None:
-    """A point (x, y, z) in mm as a float tuple, or None."""
-    if value is None:
-        return None
-    try:
-        xyz = tuple(float(v) for v in value)
-    except (TypeError, ValueError):
-        xyz = ()
-    if isinstance(value, (str, bytes)) or len(xyz) != 3 or not all(map(math.isfinite, xyz)):
-        raise InputError(f"{name} must be a point (x, y, z) in mm, got {_show(value)}")
-    return xyz
-
-
-def _show(value) -> str:
-    """A value as a user reads it: plain numbers, not numpy reprs."""
-    if isinstance(value, numbers.Real) and not isinstance(value, bool):
-        return f"{float(value):g}"
-    return repr(value)
 
 
 @dataclass(frozen=True)
@@ -136,15 +102,15 @@ class PairPath:
         except TypeError:
             faces = ()
         if len(faces) != 2:
-            raise InputError(f"a path needs two faces, got {_show(self.faces)}")
+            raise InputError(f"a path needs two faces, got {shown(self.faces)}")
         for n in faces:
             if n is not None and (isinstance(n, bool) or not isinstance(n, numbers.Integral)
                                   or n < 1):
-                raise InputError(f"face numbers are integers from 1, got {_show(n)}")
+                raise InputError(f"face numbers are integers from 1, got {shown(n)}")
         object.__setattr__(self, "faces", tuple(None if n is None else int(n) for n in faces))
         offsets = tuple(self.offsets) if self.offsets is not None else (None, None)
         if len(offsets) != 2:
-            raise InputError(f"offsets needs one value per surface, got {_show(self.offsets)}")
+            raise InputError(f"offsets needs one value per surface, got {shown(self.offsets)}")
         object.__setattr__(self, "offsets", tuple(
             None if o is None else check_number("offset", o, "mm", allow_zero=True)
             for o in offsets))
@@ -156,12 +122,12 @@ class PairPath:
             if isinstance(self.edge, bool) or not isinstance(self.edge, numbers.Integral) \
                     or self.edge < 0:
                 raise InputError(f"edge must be an index >= 0 among the shared concave "
-                                 f"edges (or None: every edge), got {_show(self.edge)}")
+                                 f"edges (or None: every edge), got {shown(self.edge)}")
             object.__setattr__(self, "edge", int(self.edge))
         if self.stretch is not None:
             if isinstance(self.stretch, bool) or not isinstance(
                     self.stretch, numbers.Integral) or self.stretch < 1:
-                raise InputError(f"stretch numbers start at 1, got {_show(self.stretch)}")
+                raise InputError(f"stretch numbers start at 1, got {shown(self.stretch)}")
             object.__setattr__(self, "stretch", int(self.stretch))
 
     def resolved_offsets(self, tool: Tool) -> tuple[float, float]:
@@ -176,20 +142,6 @@ class PairPath:
 
 
 SIDES = ("climb", "conventional")
-
-
-def check_faces(faces) -> tuple[int, ...]:
-    """Face numbers (integers from 1) as a tuple, each once, in the order given."""
-    try:
-        items = tuple(faces)
-    except TypeError:
-        raise InputError(f"faces must be face numbers, got {_show(faces)}") from None
-    if not items:
-        raise InputError("no face given: give at least one face number")
-    for n in items:
-        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 1:
-            raise InputError(f"face numbers are integers from 1, got {_show(n)}")
-    return tuple(dict.fromkeys(int(n) for n in items))
 
 
 @dataclass(frozen=True)
@@ -209,7 +161,7 @@ class Pencil:
             object.__setattr__(self, "faces", tuple(sorted(check_faces(self.faces))))
         if self.side not in SIDES:
             raise InputError(f"side must be one of {', '.join(SIDES)}, got "
-                             f"{_show(self.side)}")
+                             f"{shown(self.side)}")
 
     def resolved_offsets(self, tool: Tool) -> tuple[float, float]:
         """(R', R'): the ball touches both faces of every corner."""
@@ -230,9 +182,9 @@ def check_strategy(op) -> None:
     stepover, stepdown and scallop it needs, threshold (deg, 0 < A < 90), side, overlap."""
     if op.strategy not in FINISH_STRATEGIES:
         raise InputError(f"strategy must be one of {', '.join(FINISH_STRATEGIES)}, got "
-                         f"{_show(op.strategy)}")
+                         f"{shown(op.strategy)}")
     if op.side not in LOOP_SIDES:
-        raise InputError(f"side must be one of {', '.join(LOOP_SIDES)}, got {_show(op.side)}")
+        raise InputError(f"side must be one of {', '.join(LOOP_SIDES)}, got {shown(op.side)}")
     if op.stepdown is not None:
         object.__setattr__(op, "stepdown", check_number("stepdown", op.stepdown, "mm"))
     object.__setattr__(op, "overlap", check_number("overlap", op.overlap, "mm",
@@ -240,7 +192,7 @@ def check_strategy(op) -> None:
     a = op.threshold
     if isinstance(a, bool) or not isinstance(a, numbers.Real) or not 0.0 < a < 90.0:
         raise InputError(f"threshold must be a slope in degrees between 0 and 90 "
-                         f"(exclusive), got {_show(a)}")
+                         f"(exclusive), got {shown(a)}")
     object.__setattr__(op, "threshold", float(a))
     given = {k for k in ("stepover", "stepdown", "scallop") if getattr(op, k) is not None}
     if op.strategy == "raster":
@@ -252,7 +204,7 @@ def check_strategy(op) -> None:
             "scallop alone, or both stepover (raster) and stepdown (waterline)"
     if not ok:
         raise InputError(f"finishing with strategy {op.strategy} needs {need}, got "
-                         + (", ".join(f"{k} {_show(getattr(op, k))}" for k in sorted(given))
+                         + (", ".join(f"{k} {shown(getattr(op, k))}" for k in sorted(given))
                             or "none"))
 
 
@@ -292,8 +244,8 @@ class Finish:
             raise InputError("give exactly one of stepover (the planes' spacing, mm) and "
                              "scallop (the largest scallop height, mm)"
                              + ("" if self.stepover is None else
-                                f", got stepover {_show(self.stepover)} and scallop "
-                                f"{_show(self.scallop)}"))
+                                f", got stepover {shown(self.stepover)} and scallop "
+                                f"{shown(self.scallop)}"))
         if self.stepover is not None:
             object.__setattr__(self, "stepover", check_number("stepover", self.stepover,
                                                               "mm"))
@@ -301,11 +253,11 @@ class Finish:
             object.__setattr__(self, "scallop", check_number("scallop", self.scallop, "mm"))
         a = self.angle
         if isinstance(a, bool) or not isinstance(a, numbers.Real) or not math.isfinite(a):
-            raise InputError(f"angle must be a finite number of degrees, got {_show(a)}")
+            raise InputError(f"angle must be a finite number of degrees, got {shown(a)}")
         object.__setattr__(self, "angle", float(a))
         if self.pattern not in FINISH_PATTERNS:
             raise InputError(f"pattern must be one of {', '.join(FINISH_PATTERNS)}, got "
-                             f"{_show(self.pattern)}")
+                             f"{shown(self.pattern)}")
 
     def resolved_offsets(self, tool: Tool) -> tuple[float, float]:
         """(R', 0): the faces at the tool's offset, the guide plane carrying the centre."""
@@ -357,7 +309,7 @@ class Job:
         if self.clearance is not None:
             c = self.clearance
             if isinstance(c, bool) or not isinstance(c, numbers.Real) or not math.isfinite(c):
-                raise InputError(f"clearance must be a finite height in mm, got {_show(c)}")
+                raise InputError(f"clearance must be a finite height in mm, got {shown(c)}")
             object.__setattr__(self, "clearance", float(c))
         if self.source is not None:
             object.__setattr__(self, "source", str(self.source))
@@ -422,7 +374,7 @@ class Job:
                               start=inputs.get("start"), end=inputs.get("end"),
                               edge=inputs.get("edge", 0), stretch=inputs.get("stretch"))
             else:
-                raise InputError(f"the recorded job's operation {_show(kind)} is not one of "
+                raise InputError(f"the recorded job's operation {shown(kind)} is not one of "
                                  "path, pencil, finish")
             return cls(tool, inputs["feed"], inputs["period"], op, inputs.get("source"),
                        inputs.get("clearance"),

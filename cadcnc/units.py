@@ -9,6 +9,7 @@ the parameter and the unit it expects.
 from __future__ import annotations
 
 import math
+import numbers
 import re
 
 from .errors import InputError
@@ -120,3 +121,54 @@ def axis_name(axis) -> str:
         if tuple(axis) == xyz:
             return name
     return "(" + ", ".join(f"{v:.6g}" for v in axis) + ")"
+
+
+Point = tuple[float, float, float]
+
+
+def check_number(name: str, value, unit: str, *, allow_zero: bool = False) -> float:
+    """``value`` as a float if it is a real finite number > 0 (>= 0 with ``allow_zero``).
+
+    Booleans are refused (``radius=True`` is a mistake, not 1 mm); numpy scalars are
+    numbers. The error names the parameter and its unit.
+    """
+    ok = (isinstance(value, numbers.Real) and not isinstance(value, bool)
+          and math.isfinite(float(value)))
+    if not ok or value < 0 or (value == 0 and not allow_zero):
+        need = ">= 0" if allow_zero else "> 0"
+        raise InputError(f"{name} must be a number {need} {unit}, got {shown(value)}")
+    return float(value)
+
+
+def check_point(name: str, value) -> Point | None:
+    """A point (x, y, z) in mm as a float tuple, or None."""
+    if value is None:
+        return None
+    try:
+        xyz = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        xyz = ()
+    if isinstance(value, (str, bytes)) or len(xyz) != 3 or not all(map(math.isfinite, xyz)):
+        raise InputError(f"{name} must be a point (x, y, z) in mm, got {shown(value)}")
+    return xyz
+
+
+def shown(value) -> str:
+    """A value as a user reads it: plain numbers, not numpy reprs."""
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        return f"{float(value):g}"
+    return repr(value)
+
+
+def check_faces(faces) -> tuple[int, ...]:
+    """Face numbers (integers from 1) as a tuple, each once, in the order given."""
+    try:
+        items = tuple(faces)
+    except TypeError:
+        raise InputError(f"faces must be face numbers, got {shown(faces)}") from None
+    if not items:
+        raise InputError("no face given: give at least one face number")
+    for n in items:
+        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 1:
+            raise InputError(f"face numbers are integers from 1, got {shown(n)}")
+    return tuple(dict.fromkeys(int(n) for n in items))

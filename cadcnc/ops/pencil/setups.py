@@ -28,12 +28,13 @@ from ...geometry.edge_curve import EdgeCurve
 from ...geometry.part import CONCAVE, Part
 from ...geometry.setup import Setup, original_part, setup_in, setup_part
 from ...job import PRINCIPAL_AXES, Job, Pencil, axis_name
-from ...program.linking import linked
-from ...program.program import CutSegment, Program, Skipped
+from ...program.linking import order_cuts
+from ...program.program import CutSegment, Program
 from ...program.transform import in_part_coordinates
 from ...units import check_axis
 from ..common import safe_height
-from .pencil import CHAIN_GAP, keyword_job, pencil as pencil_one, pencil_program, reachable_order
+from ..entries import entered_program_segments
+from .pencil import CHAIN_GAP, keyword_job, pencil as pencil_one, pencil_program
 
 SPACING = 0.5      # mm between two positions along a concave edge
 REACH_RADII = 5.0  # a ball centre farther than this many R' from its corner's edge counts nothing
@@ -267,10 +268,10 @@ def _trimmed(run: SetupRun, keys: list[list], taken: set, overlap: float) -> Pro
                                          at_limit=True))
     job, part = run.program.job, run.part
     z_safe = safe_height(part, job)
-    ordered, blocked = reachable_order(part, job, pieces, z_safe)
-    skipped += blocked
-    return Program(job, linked(ordered, z_safe, join=CHAIN_GAP), skipped,
-                   list(run.program.notes))
+    segments, unreachable, _ = entered_program_segments(
+        part, job, pieces, z_safe, join=CHAIN_GAP,
+        order=lambda items: order_cuts(items, CHAIN_GAP))
+    return Program(job, segments, skipped + unreachable, list(run.program.notes))
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
