@@ -109,6 +109,7 @@ class Part:
     def __init__(self, shape, source: str = "<shape>", tol: Tolerances = DEFAULT,
                  flip_material: bool = False):
         self.shape = _shape_of(shape)
+        self.input_shape = self.shape  # as given, before sewing: what a worker rebuilds from
         self.source = source
         self.tol = tol
         self.flip_material = bool(flip_material)

@@ -53,12 +53,16 @@ def _box(shape, optimal: bool) -> tuple[np.ndarray, np.ndarray]:
 class PartFaces:
     """Every face of a part: OCCT probes (made when first needed) and bounding boxes.
 
-    ``probes``: probes already made (the pair's), by face number.
+    ``probes``: probes already made (the pair's), by face number. ``memo``: a dict that
+    keeps every exact point-to-face distance of :meth:`distance` by face and point, so
+    that gates on the same part share them (None: none kept, the reference gate).
     """
 
-    def __init__(self, part, probes: dict[int, FaceProbe], tol: Tolerances):
+    def __init__(self, part, probes: dict[int, FaceProbe], tol: Tolerances,
+                 memo: dict | None = None):
         self.part, self.tol = part, tol
         self.probes = dict(probes)
+        self.memo = memo
         n = len(part)
         self.loose = np.empty((n + 1, 2, 3))
         self.loose[0, 0], self.loose[0, 1] = np.inf, -np.inf
@@ -73,6 +77,18 @@ class PartFaces:
         if n not in self.probes:
             self.probes[n] = FaceProbe(self.part.face(n).topods, self.tol)
         return self.probes[n]
+
+    def distance(self, n: int, point) -> tuple[float, float]:
+        """(signed, unsigned) distance from ``point`` to face ``n``
+        (:meth:`FaceProbe.face_distance`), from the memo when the same point was asked
+        before (OCCT's answer for the same input: the same numbers)."""
+        if self.memo is None:
+            return self.probe(n).face_distance(point)
+        key = (n, np.asarray(point, float).tobytes())
+        found = self.memo.get(key)
+        if found is None:
+            found = self.memo[key] = self.probe(n).face_distance(point)
+        return found
 
     def box(self, n: int) -> tuple[np.ndarray, np.ndarray]:
         """The face's optimal box grown by :data:`BOX_MARGIN` (computed once)."""

@@ -12,7 +12,9 @@ import math
 import time
 
 import numpy as np
+from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
+from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
 from OCP.BRepClass import BRepClass_FaceClassifier
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_IsInFace
@@ -23,7 +25,9 @@ from OCP.Geom import Geom_OffsetSurface
 from OCP.GeomAdaptor import GeomAdaptor_Surface
 from OCP.GeomAPI import GeomAPI_IntSS, GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
-from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
 
 from ..geometry.part import optimal_box
 from ..tolerances import DEFAULT, Tolerances
@@ -63,6 +67,7 @@ class FaceProbe:
         self._bbox = None
         self._fclass = None
         self._project = None
+        self._edges = None
 
     # -- surface -----------------------------------------------------------------------
     def normal(self, u: float, w: float) -> np.ndarray:
@@ -180,6 +185,35 @@ class FaceProbe:
         if not self._dss.IsDone() or self._dss.NbSolution() == 0:
             return math.nan
         return self._dss.Value()
+
+    def edge_gap(self, point, enough: float = math.inf) -> float:
+        """The distance from ``point`` to the face's boundary, or a lower bound of it
+        that is at least ``enough``: edges whose box (``BRepBndLib::Add``) lies ``enough``
+        away count by that box; nearer ones by OCCT's projection on the edge's curve over
+        its range and the distances to its ends (inf without edges)."""
+        if self._edges is None:
+            self._edges = []
+            explorer = TopExp_Explorer(self.face, TopAbs_EDGE)
+            while explorer.More():
+                edge, box = TopoDS.Edge_s(explorer.Current()), Bnd_Box()
+                BRepBndLib.Add_s(edge, box, False)
+                if not box.IsVoid() and not BRep_Tool.Degenerated_s(edge):
+                    t0, t1 = BRep_Tool.Range_s(edge)
+                    curve = BRep_Tool.Curve_s(edge, t0, t1)  # located: in the part's frame
+                    self._edges.append((np.array(box.Get()), curve, t0, t1))
+                explorer.Next()
+        p = np.asarray(point, float)
+        best = math.inf
+        for box, curve, t0, t1 in self._edges:
+            gap = np.maximum(np.maximum(box[:3] - p, p - box[3:]), 0.0)
+            lower = float(np.sqrt(gap @ gap))
+            if lower >= min(enough, best) or curve is None:  # no 3-D curve: its box
+                best = min(best, lower)
+                continue
+            ends = [float(np.linalg.norm(p - curve.Value(t).Coord())) for t in (t0, t1)]
+            found = project_on_curve(curve, p, t0, t1)
+            best = min(best, *ends, found[1] if found is not None else math.inf)
+        return best
 
     def bbox(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) corners of the face's optimal bounding box, mm (computed once)."""
