@@ -21,12 +21,19 @@ from __future__ import annotations
 import atexit
 import multiprocessing
 import os
+import signal
+import threading
+import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Sequence
 
 from .errors import CadcncError, InputError
 
+PRELOAD = ["cadcnc.ops.run", "cadcnc.verification.gate_jobs"]
+"""Modules the workers' server imports once (every worker starts with them loaded)."""
+WATCH_S = 0.5
+"""How often (s) a worker checks that its parent process is still there."""
 _STATE: dict[str, Any] = {}   # in a worker: the part it rebuilt
 _POOLS: dict[int, tuple[Any, int, ProcessPoolExecutor]] = {}  # id(part) -> (part, jobs, pool)
 
@@ -52,9 +59,22 @@ def check_jobs(jobs: int | None) -> int:
     return jobs
 
 
-def _init(build: Callable, args: tuple) -> None:
-    """In a worker: rebuild the part once (imports and compiled kernels come with it)."""
+def _init(build: Callable, args: tuple, parent: int) -> None:
+    """In a worker: rebuild the part once (imports and compiled kernels come with it).
+    Ctrl-C is the parent's to handle: it terminates the workers; a worker whose parent
+    is gone (killed, or ended by ``os._exit``) ends too."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_watch, args=(parent,), daemon=True).start()
     _STATE["part"] = build(*args)
+
+
+def _watch(parent: int) -> None:
+    while True:
+        time.sleep(WATCH_S)
+        try:
+            os.kill(parent, 0)
+        except OSError:
+            os._exit(1)
 
 
 def _call(fn: Callable, task) -> Any:
@@ -67,11 +87,21 @@ def _pool(part, jobs: int, build: Callable, args: Callable[[], tuple]) -> Proces
         return held[2]
     if held is not None:
         _shutdown(id(part))
-    method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
-    pool = ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context(method),
-                               initializer=_init, initargs=(build, args()))
+    pool = ProcessPoolExecutor(jobs, mp_context=_context(), initializer=_init,
+                               initargs=(build, args(), os.getpid()))
     _POOLS[id(part)] = (part, jobs, pool)
     return pool
+
+
+def _context():
+    """Workers forked from a clean server process that has the library imported (a fork
+    of this process could inherit a lock held by another thread and hang); spawned
+    where there is no fork."""
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    ctx = multiprocessing.get_context("forkserver")
+    ctx.set_forkserver_preload(PRELOAD)
+    return ctx
 
 
 def _shutdown(key: int, kill: bool = False) -> None:

@@ -31,6 +31,10 @@ def add_operation_options(p, allowance_help: str) -> None:
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
                    help=OUTPUT_HELP)
     add_max_cycles(p)
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="processes: pencil's corners, finishing's planes and the gouge "
+                        "gate's cuts run on N cores (default: all; 1: one process); the "
+                        "outputs are the same whatever N")
 
 
 def add_max_cycles(p) -> None:
@@ -51,6 +55,17 @@ def add_max_cycles(p) -> None:
 
 def operation_command(args, what: str, job_of, *, progress=None,
                       times: dict | None = None) -> int:
+    """Run one operation from the command line (module doc), its worker processes
+    (``--jobs``) ended when it returns."""
+    from cadcnc import workers
+
+    try:
+        return _operation(args, what, job_of, progress=progress, times=times)
+    finally:
+        workers.close()
+
+
+def _operation(args, what: str, job_of, *, progress=None, times: dict | None = None) -> int:
     """Run one operation from the command line (module doc). ``job_of(args, source)``
     builds its Job; ``progress``: the operation's progress callback; ``times``: per-stage
     seconds (pencil)."""
@@ -61,6 +76,7 @@ def operation_command(args, what: str, job_of, *, progress=None,
     from cadcnc.ops.common import safe_height
     from cadcnc.ops.run import cut_back_gap
     from cadcnc.verification.judgement import judge, settle
+    from cadcnc.workers import check_jobs
 
     from .feedback import say_error, stage_progress
     from .options import gcode_keywords, wants_gcode
@@ -76,6 +92,7 @@ def operation_command(args, what: str, job_of, *, progress=None,
             check_destination(out, STREAM_SUFFIXES, [args.step])
         machine = machine_of(args)
     job = job_of(args, args.step)
+    jobs = check_jobs(args.jobs)
     t0 = time.monotonic()
     part = cadcnc.load_step(args.step, flip_material=job.flip_material)
     for n in getattr(job.operation, "faces", None) or ():
@@ -84,19 +101,20 @@ def operation_command(args, what: str, job_of, *, progress=None,
     if args.max_cycles < 1:
         raise InputError(f"--max-cycles must be at least 1, got {args.max_cycles}")
     program = cadcnc.run(part, job, progress=progress, times=times,
-                         max_cycles=args.max_cycles)
+                         max_cycles=args.max_cycles, jobs=jobs)
     t_cut = time.monotonic() - t0
     name = Path(args.step).name
     join = cut_back_gap(job)
     if join is not None:
         program = settle(program, part, safe_height(part, job), join, f"{args.step}: {what}",
-                         args.allow_gouge)
+                         args.allow_gouge, jobs=jobs)
     elif not program.cuts:
         raise NothingToCutError(f"{args.step}: {what}: nothing to cut")
     gcode = gcode_keywords(args) if wants_gcode(args.output) else None
     verdict = judge(program, part, f"cadcnc: {what}", gcode=gcode,
                     allow_partial=args.allow_partial, allow_gouge=args.allow_gouge,
-                    progress=stage_progress(args, f"{what}: gouge check", after_s=1.0))
+                    progress=stage_progress(args, f"{what}: gouge check", after_s=1.0),
+                    jobs=jobs)
     for line in verdict.messages:
         say_error(line)
     if not args.quiet:

@@ -32,6 +32,7 @@ class GateCache:
         self.faces = PartFaces(part, {}, tol, memo=self.memo)
         self.material = Material(self.faces, tol)
         self.surfaces: dict[str, list] = {}
+        self.shares: dict[str, tuple] = {}  # by toolpath: what workers found (gate_jobs)
 
     def share(self, key: str, since: int) -> tuple:
         """(key, the pair's checks, the distances added since the memo held ``since``):
