@@ -16,8 +16,9 @@ from cadcnc.errors import InputError
 
 from .options import BUILDERS, settings_of
 
-CLI_ONLY = ("output", "stream", "machine", "jerk", "quiet", "debug", "help", "step")
-"""Options a job file does not take: the outputs are the job file's own ``outputs``."""
+CLI_ONLY = ("output", "stream", "machine", "jerk", "quiet", "debug", "help", "step", "jobs")
+"""Options a job file does not take: the outputs are the job file's own ``outputs``, and
+each part runs in one process (``--jobs 1``)."""
 
 
 def batch_parts(job, parser) -> list:
@@ -59,7 +60,7 @@ def operation_of(job, parser, op, path: str, options: dict, outputs: tuple):
         if not hasattr(args, key.replace("-", "_")):   # an abbreviation argparse accepted
             raise job.error(where, f"unknown option of `cadcnc {op.command}`")
     try:
-        return BUILDERS[op.command](args, path), settings_of(args)
+        return BUILDERS[op.command](args, path), settings_of(args, jobs=1)  # one process a part
     except InputError as e:
         raise job.error(_where_named(str(e), options, op.where), str(e)) from None
 

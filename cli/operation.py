@@ -30,6 +30,10 @@ def add_operation_options(p, allowance_help: str) -> None:
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
                    help=OUTPUT_HELP)
     add_max_cycles(p)
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="processes: pencil's corners, finishing's planes and the gouge "
+                        "gate's cuts run on N cores (default: all; 1: one process); the "
+                        "outputs are the same whatever N")
     add_axis_options(p)
 
 
@@ -63,6 +67,17 @@ def add_max_cycles(p) -> None:
 
 def operation_command(args, what: str, job_of, *, progress=None,
                       times: dict | None = None) -> int:
+    """Run one operation from the command line (module doc), its worker processes
+    (``--jobs``) ended when it returns."""
+    from cadcnc import workers
+
+    try:
+        return _operation(args, what, job_of, progress=progress, times=times)
+    finally:
+        workers.close()
+
+
+def _operation(args, what: str, job_of, *, progress=None, times: dict | None = None) -> int:
     """Run one operation from the command line (module doc). ``job_of(args, source)``
     builds its Job; ``progress``: the operation's progress callback; ``times``: per-stage
     seconds (pencil)."""

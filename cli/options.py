@@ -13,6 +13,7 @@ from cadcnc.io.gcode import blend_for
 from cadcnc.job import Finish, Job, PairPath, Pencil, Tool, check_number
 from cadcnc.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT, Tolerances
 from cadcnc.units import parse_duration, parse_feed, parse_length, parse_point
+from cadcnc.workers import check_jobs
 
 JOB_OPTIONS = ("faces", "radius")  # feed and period have defaults (cli/operation.py)
 
@@ -100,11 +101,13 @@ BUILDERS = {"path": path_job, "pencil": pencil_job, "finish": finish_job}
 operations through it)."""
 
 
-def settings_of(args) -> Settings:
+def settings_of(args, jobs: int | None = None) -> Settings:
     """How an operation command's program is judged and written: ``--max-cycles``, the
-    G-code keywords when a .ngc is among the outputs, ``--allow-partial/gouge``."""
+    G-code keywords when a .ngc is among the outputs, ``--allow-partial/gouge``, and the
+    processes: ``jobs``, else ``--jobs`` (default every core)."""
     return Settings(args.max_cycles, gcode_keywords(args) if wants_gcode(args.output)
-                    else None, args.allow_partial, args.allow_gouge)
+                    else None, args.allow_partial, args.allow_gouge,
+                    check_jobs(args.jobs) if jobs is None else jobs)
 
 
 def clearance(args) -> float | None:

@@ -28,12 +28,15 @@ class Settings:
     """How a program is judged and written besides its Job: ``max_cycles`` (the work
     limit), ``gcode`` (keywords of :func:`~cadcnc.io.program_gcode.program_ngc` when a
     .ngc is written, else None: the gate then checks the program's own points),
-    ``allow_partial`` / ``allow_gouge`` (write a partial or gouging program anyway)."""
+    ``allow_partial`` / ``allow_gouge`` (write a partial or gouging program anyway),
+    ``jobs``: processes computing and gating (:mod:`cadcnc.workers`; a batch task runs
+    one)."""
 
     max_cycles: int = MAX_CYCLES
     gcode: dict | None = field(default=None, hash=False)
     allow_partial: bool = False
     allow_gouge: bool = False
+    jobs: int = 1
 
 
 @dataclass
@@ -67,7 +70,7 @@ def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progr
             part.face(n)   # face numbers checked before anything is computed
     try:
         program = run(part, job, progress=progress, times=times,
-                      max_cycles=settings.max_cycles)
+                      max_cycles=settings.max_cycles, jobs=settings.jobs)
     except NothingToCutError as e:   # a setup that reaches nothing says which it is
         if setup_in(part) is None:
             raise
@@ -76,12 +79,12 @@ def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progr
     join = cut_back_gap(job)
     if join is not None:
         program = settle(program, part, safe_height(part, job), join, f"{step}: {what}",
-                         settings.allow_gouge)
+                         settings.allow_gouge, jobs=settings.jobs)
     elif not program.cuts:
         raise NothingToCutError(f"{step}: {what}: nothing to cut")
     verdict = judge(program, part, f"cadcnc: {what}", gcode=settings.gcode,
                     allow_partial=settings.allow_partial, allow_gouge=settings.allow_gouge,
-                    progress=gate_progress)
+                    progress=gate_progress, jobs=settings.jobs)
     return Outcome(part, program, verdict, t_cut, time.monotonic() - t0 - t_cut, what)
 
 

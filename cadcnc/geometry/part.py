@@ -109,7 +109,7 @@ class Part:
     def __init__(self, shape, source: str = "<shape>", tol: Tolerances = DEFAULT,
                  flip_material: bool = False):
         self.shape = _shape_of(shape)
-        self.given_shape = self.shape   # as given, before sewing (a setup turns this one)
+        self.given_shape = self.shape   # as given, before sewing (a setup turns this one; a worker rebuilds from it)
         self.source = source
         self.tol = tol
         self.flip_material = bool(flip_material)

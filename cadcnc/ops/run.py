@@ -14,7 +14,7 @@ from .pencil.pencil import CHAIN_GAP, pencil_program
 
 
 def run(part, job: Job, *, progress=None, times: dict | None = None,
-        max_cycles: int = MAX_CYCLES) -> Program:
+        max_cycles: int = MAX_CYCLES, jobs: int | None = 1) -> Program:
     """The :class:`~cadcnc.program.program.Program` of ``job`` on ``part`` (a
     :class:`~cadcnc.geometry.part.Part`, or a CadQuery Workplane or Shape): the pair's
     corner for :class:`~cadcnc.job.PairPath` (every feasible stretch, cut and linked),
@@ -23,7 +23,9 @@ def run(part, job: Job, *, progress=None, times: dict | None = None,
     (:func:`program_for_job`: ``(cycles, mm)``; pencil and finish: ``(done, total,
     what)``); ``times``: pencil's seconds per stage
     (:func:`pencil_program`); ``max_cycles``: the interpolation cycles the path or pencil
-    program may need, estimated and refused up front over it. The program is not gated: see :func:`cadcnc.verification.gate_program`."""
+    program may need, estimated and refused up front over it. The program is not gated: see :func:`cadcnc.verification.gate_program`.
+    ``jobs``: processes running pencil's corners and finishing's planes (None: every
+    core; default 1, this process); the program is the same whatever it is."""
     if not isinstance(job, Job):
         raise InputError(f"job must be a cadcnc.Job, got {type(job).__name__}")
     if not isinstance(part, Part):
@@ -35,9 +37,9 @@ def run(part, job: Job, *, progress=None, times: dict | None = None,
         return program_for_job(part, job, progress=progress, max_cycles=max_cycles)
     if isinstance(op, Pencil):
         return pencil_program(part, job, progress=progress, times=times,
-                              max_cycles=max_cycles)
+                              max_cycles=max_cycles, jobs=jobs)
     if isinstance(op, Finish):
-        return finish_program(part, job, progress=progress)
+        return finish_program(part, job, progress=progress, jobs=jobs)
     raise InputError(f"unknown operation {type(op).__name__}")
 
 

@@ -16,6 +16,7 @@ from ..ops.entries import entered_program_segments
 from ..program.program import CutSegment, Program, Skipped
 from ..program.toolpath import toolpath_head
 from .gate import gouge_gate
+from .gate_jobs import gate_cuts
 
 GOUGE = "gouge"
 CUT_BACK = "cut back"  # the stop reason of a cut cut back to its last verified point
@@ -30,13 +31,16 @@ def _first_failure(gate, limit: float) -> int | None:
     return min(firsts) if firsts else None
 
 
-def cut_back(program: Program, part, z_safe: float, join: float = 0.0) -> Program:
-    """``program`` with every gouging cut cut back (see the module doc)."""
+def cut_back(program: Program, part, z_safe: float, join: float = 0.0, *,
+             jobs: int | None = 1, reference: bool = False, progress=None) -> Program:
+    """``program`` with every gouging cut cut back (see the module doc). ``jobs``,
+    ``reference``, ``progress``: as for :func:`~.program_gate.gate_program`."""
     tol = program.job.tolerances
     cuts, skipped = [], list(program.skipped)
     changed = False
-    for seg in program.cuts:
-        gate = gouge_gate(seg.path, part, tol)
+    gates = gate_cuts(part, [(seg.path, None, 0.0) for seg in program.cuts], tol,
+                      jobs=jobs, reference=reference, progress=progress)
+    for seg, gate in zip(program.cuts, gates):
         if gate.ok:
             cuts.append(seg)
             continue
@@ -45,7 +49,7 @@ def cut_back(program: Program, part, z_safe: float, join: float = 0.0) -> Progra
         keep = None
         if n is not None and n >= 2:
             head = toolpath_head(seg.path, n, CUT_BACK, gate.message)
-            if gouge_gate(head, part, tol).ok:
+            if gouge_gate(head, part, tol, reference=reference).ok:
                 keep = CutSegment(head, seg.edge, seg.stretch, at_limit=True)
         if keep is not None:
             cuts.append(keep)

@@ -20,7 +20,8 @@ from dataclasses import dataclass, field
 
 from ..tolerances import Tolerances
 from .records import SweepCheck, WholePartHit, strict_max
-from .surface_checks import SAMPLE_UNSEEDED, check_pair, prepare
+from .gate_cache import cache_for, toolpath_key
+from .surface_checks import SAMPLE_UNSEEDED, check_pair, prepare, resolve_part
 from .whole_part import check_whole_part
 
 
@@ -51,7 +52,7 @@ class GateResult:
 
 
 def gouge_gate(toolpath, part=None, tol: Tolerances | None = None, *, moves=None,
-               blend_mm: float = 0.0, progress=None) -> GateResult:
+               blend_mm: float = 0.0, progress=None, reference: bool = False) -> GateResult:
     """Whether ``toolpath`` clears every face of ``part`` within ``tol.gouge`` (fails closed).
 
     ``part`` defaults to the STEP file the toolpath's job names; ``tol`` to the job's
@@ -60,7 +61,9 @@ def gouge_gate(toolpath, part=None, tol: Tolerances | None = None, *, moves=None
     links); default the toolpath's points. ``blend_mm``: how far the machine may leave the
     programmed polyline (G64 P), counted against the limit: every move must keep the ball
     within ``tol.gouge - blend_mm`` of the part. ``progress(stage, done, total)`` is called
-    as the checks advance ("surfaces", "whole part", "moves").
+    as the checks advance ("surfaces", "whole part", "moves"). ``reference``: the gate
+    as it was before its work was shared (:mod:`.gate_cache`) and bounded (a sampled
+    cycle's exact distance always measured): the same answers, kept to test that.
     """
     require("toolpath", toolpath, Toolpath, "a cadcnc Toolpath")
     limit = math.nan
@@ -72,11 +75,24 @@ def gouge_gate(toolpath, part=None, tol: Tolerances | None = None, *, moves=None
         if not (math.isfinite(blend) and blend >= 0):
             raise ValueError(f"the blending tolerance must be a finite length >= 0 mm, got "
                              f"{blend_mm!r}")
-        part, probes = prepare(toolpath, part, tol)
-        surfaces = check_pair(toolpath, probes, tol, SAMPLE_UNSEEDED, progress)
+        if reference:
+            part, probes = prepare(toolpath, part, tol)
+            surfaces = check_pair(toolpath, probes, tol, SAMPLE_UNSEEDED, progress)
+            shared = {}
+        else:
+            part = resolve_part(toolpath, part)
+            cache = cache_for(part, tol)
+            part, probes = prepare(toolpath, part, tol, cache.faces.probe)
+            key = toolpath_key(toolpath)
+            surfaces = cache.surfaces.get(key)
+            if surfaces is None:
+                surfaces = check_pair(toolpath, probes, tol, SAMPLE_UNSEEDED, progress,
+                                      bounded=True)
+                cache.surfaces[key] = surfaces
+            shared = dict(faces=cache.faces, material=cache.material)
         whole, sweep = check_whole_part(part, probes, toolpath, surfaces,
                                         toolpath.job.tool.offset, tol, progress, moves=moves,
-                                        limit=limit, blend=blend)
+                                        limit=limit, blend=blend, **shared)
         depth = strict_max([whole.max_depth_mm, sweep.depth_mm])
     except Exception as e:  # noqa: BLE001 - any failure refuses the path
         return GateResult(False, math.nan, [], limit,

@@ -32,11 +32,12 @@ class Verdict:
 
 
 def settle(program: Program, part, z_safe: float, join: float, what: str,
-           allow_gouge: bool = False) -> Program:
+           allow_gouge: bool = False, *, jobs: int | None = 1) -> Program:
     """The program with each gouging cut cut back to its last verified point and the rest
-    listed as skipped (unless ``allow_gouge``); NothingToCutError when no cut is left."""
+    listed as skipped (unless ``allow_gouge``); NothingToCutError when no cut is left.
+    ``jobs``: processes gating the cuts (None: every core)."""
     if not allow_gouge:
-        program = cut_back(program, part, z_safe, join)
+        program = cut_back(program, part, z_safe, join, jobs=jobs)
     if not program.cuts:
         raise NothingToCutError(f"{what}: no cut left: "
                                 f"{skipped_counts(program) or 'nothing to cut'}")
@@ -44,12 +45,14 @@ def settle(program: Program, part, z_safe: float, join: float, what: str,
 
 
 def judge(program: Program, part, what: str, *, gcode: dict | None = None,
-          allow_partial: bool = False, allow_gouge: bool = False, progress=None) -> Verdict:
+          allow_partial: bool = False, allow_gouge: bool = False, progress=None,
+          jobs: int | None = 1) -> Verdict:
     """The :class:`Verdict` on ``program``. With G-code options ``gcode`` (keywords of
     :func:`~cadcnc.io.program_gcode.program_ngc`) the gate checks the moves as written
     (points dropped, rounded, tool-tip offset taken back, links); else the program's own
     points. A partial program exits 6 and is written only with ``allow_partial``; a
-    gouging one exits 5 and is written only with ``allow_gouge``."""
+    gouging one exits 5 and is written only with ``allow_gouge``. ``jobs``: processes
+    gating the cuts (None: every core); the verdict does not depend on it."""
     verdict = Verdict(True, EXIT_OK)
     if not program.complete:
         verdict.write, verdict.code = allow_partial, EXIT_PARTIAL
@@ -63,7 +66,8 @@ def judge(program: Program, part, what: str, *, gcode: dict | None = None,
         return verdict
     moves = None if gcode is None else program_written_moves(program, **gcode)
     gate = gate_program(program, part, program.job.tolerances, moves=moves,
-                        blend_mm=0.0 if gcode is None else gcode["blend"], progress=progress)
+                        blend_mm=0.0 if gcode is None else gcode["blend"], progress=progress,
+                        jobs=jobs)
     verdict.gate = gate
     if gate.ok:
         return verdict

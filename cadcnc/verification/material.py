@@ -27,7 +27,7 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
 from ..tolerances import Tolerances
-from .bounds import box_box_distance, point_box_distance
+from .bounds import point_box_distance
 from .probe import FaceProbe
 
 IN, OUT, ON = "in", "out", "on"
@@ -53,12 +53,16 @@ def _box(shape, optimal: bool) -> tuple[np.ndarray, np.ndarray]:
 class PartFaces:
     """Every face of a part: OCCT probes (made when first needed) and bounding boxes.
 
-    ``probes``: probes already made (the pair's), by face number.
+    ``probes``: probes already made (the pair's), by face number. ``memo``: a dict that
+    keeps every exact point-to-face distance of :meth:`distance` by face and point, so
+    that gates on the same part share them (None: none kept, the reference gate).
     """
 
-    def __init__(self, part, probes: dict[int, FaceProbe], tol: Tolerances):
+    def __init__(self, part, probes: dict[int, FaceProbe], tol: Tolerances,
+                 memo: dict | None = None):
         self.part, self.tol = part, tol
         self.probes = dict(probes)
+        self.memo = memo
         n = len(part)
         self.loose = np.empty((n + 1, 2, 3))
         self.loose[0, 0], self.loose[0, 1] = np.inf, -np.inf
@@ -74,6 +78,21 @@ class PartFaces:
             self.probes[n] = FaceProbe(self.part.face(n).topods, self.tol)
         return self.probes[n]
 
+    def distance(self, n: int, point) -> tuple[float, float]:
+        """(signed, unsigned) distance from ``point`` to face ``n``
+        (:meth:`FaceProbe.face_distance`; on a plane its closed form,
+        :meth:`FaceProbe.plane_distance`), from the memo when the same point was asked
+        before (OCCT's answer for the same input: the same numbers)."""
+        if self.memo is None:
+            return self.probe(n).face_distance(point)
+        key = (n, np.asarray(point, float).tobytes())
+        found = self.memo.get(key)
+        if found is None:
+            probe = self.probe(n)
+            found = probe.plane_distance(point) or probe.face_distance(point)
+            self.memo[key] = found
+        return found
+
     def box(self, n: int) -> tuple[np.ndarray, np.ndarray]:
         """The face's optimal box grown by :data:`BOX_MARGIN` (computed once)."""
         if n not in self._tight:
@@ -83,8 +102,9 @@ class PartFaces:
 
     def near(self, lo: np.ndarray, hi: np.ndarray, margin: float) -> list[int]:
         """Faces whose loose box comes within ``margin`` of the box [lo, hi]."""
-        return [k for k in range(1, len(self) + 1)
-                if box_box_distance(lo, hi, *self.loose[k]) <= margin]
+        gap = np.maximum(np.maximum(np.asarray(lo) - self.loose[1:, 1],
+                                    self.loose[1:, 0] - np.asarray(hi)), 0.0)
+        return (np.nonzero(np.sqrt((gap * gap).sum(axis=1)) <= margin)[0] + 1).tolist()
 
     def nearest(self, point) -> tuple[int, float, float]:
         """(face, signed, unsigned distance) of the face nearest to ``point``.

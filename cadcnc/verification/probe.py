@@ -12,7 +12,9 @@ import math
 import time
 
 import numpy as np
+from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
+from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
 from OCP.BRepClass import BRepClass_FaceClassifier
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_IsInFace
@@ -20,10 +22,14 @@ from OCP.BRepTools import BRepTools
 from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.Extrema import Extrema_GenLocateExtPS
 from OCP.Geom import Geom_OffsetSurface
-from OCP.GeomAdaptor import GeomAdaptor_Surface
+from OCP.GeomAdaptor import GeomAdaptor_Curve, GeomAdaptor_Surface
 from OCP.GeomAPI import GeomAPI_IntSS, GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
+from OCP.ElSLib import ElSLib
+from OCP.GeomAbs import GeomAbs_Line, GeomAbs_Plane
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
-from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
 
 from ..geometry.part import optimal_box
 from ..tolerances import DEFAULT, Tolerances
@@ -63,6 +69,7 @@ class FaceProbe:
         self._bbox = None
         self._fclass = None
         self._project = None
+        self._edges = None
 
     # -- surface -----------------------------------------------------------------------
     def normal(self, u: float, w: float) -> np.ndarray:
@@ -181,6 +188,61 @@ class FaceProbe:
             return math.nan
         return self._dss.Value()
 
+    def edge_gap(self, point, enough: float = math.inf) -> float:
+        """The distance from ``point`` to the face's boundary, or a lower bound of it
+        that is at least ``enough``: edges in order of their box's distance
+        (``BRepBndLib::Add``); an edge nearer than ``enough`` and the best so far counts
+        by OCCT's projection on its curve over its range and the distances to its ends
+        (inf without edges)."""
+        if self._edges is None:
+            self._edges = _edges_of(self.face)
+        boxes, curves, _ = self._edges
+        p = np.asarray(point, float)
+        gap = np.maximum(np.maximum(boxes[:, :3] - p, p - boxes[:, 3:]), 0.0)
+        lower = np.sqrt((gap * gap).sum(axis=1))
+        best = math.inf
+        for i in np.argsort(lower, kind="stable"):
+            if lower[i] >= best:
+                break
+            curve, t0, t1 = curves[i]
+            if lower[i] >= enough or curve is None:  # far enough, or no 3-D curve: its box
+                best = min(best, float(lower[i]))
+                if lower[i] >= enough:
+                    break
+                continue
+            found = project_on_curve(curve, p, t0, t1)
+            best = min(best, found[1] if found is not None else math.inf,
+                       *(float(np.linalg.norm(p - curve.Value(t).Coord())) for t in (t0, t1)))
+        return best
+
+    def plane_distance(self, point) -> tuple[float, float] | None:
+        """:meth:`face_distance` by closed form on a planar face, or None (not a plane, or
+        the foot on the face's boundary: OCCT's DistShapeShape then decides).
+
+        The foot of the perpendicular inside the face (OCCT's classifier): the plane's
+        distance, signed. Outside: the nearest point of a plane region to a point off it
+        lies on its boundary, so the distance to the nearest edge (:meth:`edge_gap`,
+        OCCT's projections on the edges' curves), unsigned as DistShapeShape gives it.
+        """
+        if self.adaptor.GetType() != GeomAbs_Plane:
+            return None
+        pnt = gp_Pnt(*map(float, point))
+        u, w = ElSLib.Parameters_s(self.adaptor.Plane(), pnt)
+        state = self.state(u, w)
+        if state == BOUNDARY:
+            return None
+        n = self.normal(u, w)  # leaves the foot in self._p
+        height = float((np.asarray(point, float) - self._p.Coord()) @ n)
+        if state == INSIDE:
+            d = abs(height)
+            return (d, d) if d < self.tol.noise or height >= 0 else (-d, d)
+        if self._edges is None:
+            self._edges = _edges_of(self.face)
+        if self._edges[2]:  # straight edges only: DistShapeShape is as fast
+            return None
+        d = self.edge_gap(point)
+        return (d, d) if math.isfinite(d) else None
+
     def bbox(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) corners of the face's optimal bounding box, mm (computed once)."""
         if self._bbox is None:
@@ -244,3 +306,21 @@ def shape_distances(shape, points) -> np.ndarray:
         if dss.IsDone():
             out[k] = dss.Value()
     return out
+
+
+def _edges_of(face) -> tuple[np.ndarray, list, bool]:
+    """((E, 6) boxes, [(3-D curve or None, first, last)], all straight) of the face's
+    edges, degenerate ones left out; curves located in the part's frame."""
+    boxes, curves = [], []
+    explorer = TopExp_Explorer(face, TopAbs_EDGE)
+    while explorer.More():
+        edge, box = TopoDS.Edge_s(explorer.Current()), Bnd_Box()
+        BRepBndLib.Add_s(edge, box, False)
+        if not box.IsVoid() and not BRep_Tool.Degenerated_s(edge):
+            t0, t1 = BRep_Tool.Range_s(edge)
+            boxes.append(box.Get())
+            curves.append((BRep_Tool.Curve_s(edge, t0, t1), t0, t1))
+        explorer.Next()
+    straight = all(c is not None and GeomAdaptor_Curve(c).GetType() == GeomAbs_Line
+                   for c, _, _ in curves)
+    return np.array(boxes, float).reshape(-1, 6), curves, straight

@@ -21,6 +21,8 @@ import numpy as np
 
 from ..tolerances import Tolerances
 from .gate import GateResult, gouge_gate
+from .gate_jobs import gate_cuts
+from .surface_checks import resolve_part
 
 
 @dataclass(frozen=True)
@@ -113,23 +115,32 @@ def cut_label(k: int, seg) -> str:
 
 
 def gate_program(program, part=None, tol: Tolerances | None = None, *, moves=None,
-                 blend_mm: float = 0.0, progress=None) -> ProgramGate:
+                 blend_mm: float = 0.0, progress=None, jobs: int | None = 1,
+                 reference: bool = False) -> ProgramGate:
     """The gate of every cut of ``program`` on ``part`` (see the module doc).
 
     ``moves``: per segment of the program, the (M_k, 3) ball-centre positions written
     (:func:`cadcnc.io.program_gcode.program_written_moves`); default the segments' own
     points (cuts and links as computed). ``tol`` default: the program's job's tolerances.
-    ``blend_mm`` and ``progress`` as for :func:`gouge_gate`.
+    ``blend_mm`` and ``progress`` as for :func:`gouge_gate` (with ``jobs`` other than 1,
+    progress counts the cuts gated: stage "cuts"). ``jobs``: processes gating cuts at
+    once (None: every core); the answer does not depend on it. ``reference``: the
+    reference gate (:func:`gouge_gate`).
     """
     require("program", program, Program, "a cadcnc Program")
     tol = program.job.tolerances if tol is None else tol
     if moves is None:
         moves = [s.points for s in program.segments]
     per_cut = cut_moves(program, list(moves))
-    results, labels, links = [], [], []
-    for k, (seg, (m, own)) in enumerate(zip(program.cuts, per_cut), 1):
-        labels.append(cut_label(k, seg))
-        results.append(gouge_gate(seg.path, part, tol, moves=m, blend_mm=blend_mm,
-                                  progress=progress))
-        links.append(not results[-1].ok and _in_links(results[-1], own))
+    labels = [cut_label(k, seg) for k, seg in enumerate(program.cuts, 1)]
+    if jobs == 1:
+        results = [gouge_gate(seg.path, part, tol, moves=m, blend_mm=blend_mm,
+                              progress=progress, reference=reference)
+                   for seg, (m, _) in zip(program.cuts, per_cut)]
+    else:
+        part = resolve_part(program.cuts[0].path, part) if program.cuts else part
+        results = gate_cuts(part, [(seg.path, m, blend_mm)
+                                   for seg, (m, _) in zip(program.cuts, per_cut)],
+                            tol, jobs=jobs, reference=reference, progress=progress)
+    links = [not r.ok and _in_links(r, own) for r, (_, own) in zip(results, per_cut)]
     return ProgramGate(results, labels, links)

@@ -149,7 +149,6 @@ class Polyline:
 
     def _points(self, k, d, sd, have, lb, need) -> None:
         """Exact distances where the bounds cannot prove ``need``; Lipschitz skipping."""
-        probe = self.faces.probe(k)
         cand = np.nonzero(lb < need)[0]
         if not len(cand):
             return
@@ -162,7 +161,7 @@ class Polyline:
             if lb[j] >= need[j]:
                 i += 1
                 continue
-            sd[j], d[j] = probe.face_distance(pts[j])
+            sd[j], d[j] = self.faces.distance(k, pts[j])
             have[j], lb[j] = True, d[j]
             self.evaluated += 1
             i += 1
@@ -186,7 +185,7 @@ class Polyline:
         for s in np.nonzero(near_seg & ~(seg_lb >= c))[0]:
             for j in (s, s + 1):
                 if not have[j]:
-                    sd[j], d[j] = probe.face_distance(pts[j])
+                    sd[j], d[j] = self.faces.distance(k, pts[j])
                     have[j] = True
                     self.evaluated += 1
             da, db = d[s], d[s + 1]
@@ -194,7 +193,7 @@ class Polyline:
             meas[s] = min(da, db) if not (math.isnan(da) or math.isnan(db)) else math.nan
             if seg_lb[s] >= c or not meas[s] >= c:
                 continue  # proven by its ends, or already too close at an end
-            seg_lb[s], meas[s], exact[s] = self._refine(probe, pts[s], pts[s + 1], da, db)
+            seg_lb[s], meas[s], exact[s] = self._refine(k, probe, pts[s], pts[s + 1], da, db)
         failed = np.nonzero(~(seg_lb >= c))[0]
         if len(failed):  # the worst failing move gets the exact step, for the report
             finite = np.where(np.isnan(meas[failed]), -np.inf, meas[failed])
@@ -211,7 +210,7 @@ class Polyline:
         self.seg_meas[nan], self.seg_face[nan] = np.nan, k
         self.seg_lb = np.minimum(self.seg_lb, seg_lb)
 
-    def _refine(self, probe, a, b, da, db) -> tuple[float, float, bool]:
+    def _refine(self, k, probe, a, b, da, db) -> tuple[float, float, bool]:
         """(lower bound, smallest distance found, exact?) for the move a-b (ends >= c)."""
         c = self.clearance
         length, m = float(np.linalg.norm(b - a)), min(da, db)
@@ -222,7 +221,7 @@ class Polyline:
             split = []                                # way to find a failing move
             for p, q, dp, dq in pieces:
                 mid = 0.5 * (p + q)
-                dm = probe.face_distance(mid)[1]
+                dm = self.faces.distance(k, mid)[1]
                 self.evaluated += 1
                 if not dm >= c:
                     bound = float(segment_lower_bound(dp, dq, np.linalg.norm(q - p)))

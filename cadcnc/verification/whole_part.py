@@ -28,17 +28,19 @@ MATCH_WINDOW = 64      # matched against every centre (a link); else within 64 c
 def check_whole_part(part, probes: dict[int, FaceProbe], toolpath,
                      surfaces: list[SurfaceCheck], ball: float, tol: Tolerances,
                      progress=None, *, moves=None, limit: float | None = None,
-                     blend: float = 0.0) -> tuple[WholePartCheck, SweepCheck]:
+                     blend: float = 0.0, faces: PartFaces | None = None,
+                     material: Material | None = None) -> tuple[WholePartCheck, SweepCheck]:
     """Every face of ``part`` against the ball of radius ``ball`` (R'): at every centre
     (a face is hit where the ball reaches deeper than ``tol.hit``), and swept along every
     straight move of ``moves`` ((M, 3) ball centres; default the toolpath's points), which
     must stay within ``limit`` (default ``tol.gouge``) less ``blend``.
 
     ``probes``: the pair's probes (others are made here); ``surfaces``: the pair's checks.
+    ``faces``, ``material``: the part's, shared with other gates (default: made here).
     """
     limit = tol.gouge if limit is None else limit
-    faces = PartFaces(part, probes, tol)
-    material = Material(faces, tol)
+    faces = PartFaces(part, probes, tol) if faces is None else faces
+    material = Material(faces, tol) if material is None else material
     pts = toolpath.points
     known = {s.face: (np.abs(s.face_deviation + s.offset), s.face_deviation + s.offset)
              for s in surfaces}

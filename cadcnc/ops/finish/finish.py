@@ -29,13 +29,14 @@ from ...job import Finish, Job, Tool
 from ...program.program import CutSegment, Program, Skipped
 from ...tolerances import DEFAULT, Tolerances
 from ...work import MAX_PLANES, Heartbeat
-from .passes import GuidePlane, pass_cuts
+from .passes import GuidePlane, PassResult, pass_cuts
 from .steep_shallow import strategy_program
 from .waterline import stay_down_links
 from .plan import MAX_SAMPLES, centre_chord, plan_planes, sample_faces
 from .uncut import uncut_report
 from ..common import safe_height
 from ..entries import entered_program_segments
+from ..parallel import on_workers
 from ...job import DEFAULT_FEED, DEFAULT_PERIOD
 
 JOIN = 1e-6
@@ -77,14 +78,17 @@ def finish(part, faces, *, radius: float, allowance: float = 0.0,
 
 
 def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX_PLANES,
-                   clock=time.monotonic, work: dict | None = None) -> Program:
+                   clock=time.monotonic, work: dict | None = None,
+                   jobs: int | None = 1) -> Program:
     """The finishing program of a :class:`~cadcnc.job.Finish` ``job`` on ``part``:
     ``progress(done, total, what)`` after each plane, and inside a plane at least every
     HEARTBEAT_S seconds of ``clock`` (``done`` then counting the planes finished). The
     planes are estimated before any is placed and refused over ``max_planes``
     (:class:`~cadcnc.work.WorkLimitError`, exit 2); the face samples are at most
     MAX_SAMPLES. ``work``: a dict given ``planes_estimate``, ``planes``,
-    ``samples_estimate``, ``samples`` and ``cycles`` (every stepper cycle run)."""
+    ``samples_estimate``, ``samples`` and ``cycles`` (every stepper cycle run). ``jobs``:
+    processes running the planes (None: every core); the program does not depend on it
+    (the heartbeat inside a plane is then only the planes' ends)."""
     op, pattern = job.operation, job.operation.pattern
     for n in op.faces:
         part.face(n)  # FaceNumberError names the range
@@ -98,16 +102,18 @@ def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX
     work.update(planes=total, samples=len(samples), cycles=0)
     cuts: list[CutSegment] = []
     skipped: list[Skipped] = []
-    for k, offset in enumerate(plan.offsets):
-        res = pass_cuts(part, op.faces, GuidePlane(op.angle, float(offset)), job,
-                        reverse=pattern == "zigzag" and k % 2 == 1,
-                        beat=lambda text, k=k: beat.beat(
-                            lambda: f"plane {k + 1}: " + (text() if callable(text) else text)))
+    tasks = [(job, k, float(offset), pattern == "zigzag" and k % 2 == 1)
+             for k, offset in enumerate(plan.offsets)]
+
+    def arrived(k: int, res) -> None:
+        nonlocal done
+        done += 1   # reported now, which restarts the heartbeat's interval
+        beat.beat(f"plane {done} at {plan.offsets[k]:.3f} mm", force=True)
+
+    for res in on_workers(_plane, tasks, part, jobs, arrived, "plane", beat):
         cuts += res.cuts
         skipped += res.skipped
         work["cycles"] += res.cycles
-        done = k + 1   # reported now, which restarts the heartbeat's interval
-        beat.beat(f"plane {done} at {offset:.3f} mm", force=True)
     stay_down = stay_down_links(part, job) if pattern == "zigzag" else None
     segments, unreachable, notes = entered_program_segments(
         part, job, cuts, safe_height(part, job), join=JOIN, stay_down=stay_down,
@@ -117,6 +123,15 @@ def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX
     program.skipped += report.skipped()
     program.notes += report.notes()
     return program
+
+
+def _plane(part: Part, task, beat=None) -> PassResult:
+    """One plane's pass (:func:`~cadcnc.ops.parallel.on_workers`' task)."""
+    job, k, offset, reverse = task
+    tell = None if beat is None else (lambda text: beat.beat(
+        lambda: f"plane {k + 1}: " + (text() if callable(text) else text)))
+    return pass_cuts(part, job.operation.faces, GuidePlane(job.operation.angle, offset), job,
+                     reverse=reverse, beat=tell)
 
 
 def plan_for_job(part: Part, job: Job, *, max_planes: int = MAX_PLANES,

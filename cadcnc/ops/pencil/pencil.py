@@ -37,6 +37,7 @@ from .corners import BLEND, EDGE, Corner, find_corners
 from ...guard import guard_for
 from ..common import refuse_cycles, require_ball, run_stretch, safe_height
 from ..entries import UNREACHABLE, entered_program_segments
+from ..parallel import on_workers
 from ..path.pair_program import CLIMB, stretch_cuts
 from ..path.pair_path import plan_path
 from ..path.stretches import (LIMIT_TOL, MIN_SAMPLES, SPACING, Feasibility,
@@ -81,7 +82,7 @@ def keyword_job(part, radius: float, allowance: float = 0.0, feed: float = DEFAU
 
 def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = None,
                    max_cycles: int = MAX_CYCLES, clock=time.monotonic,
-                   work: dict | None = None) -> Program:
+                   work: dict | None = None, jobs: int | None = 1) -> Program:
     """The pencil program of a :class:`~cadcnc.job.Pencil` ``job`` on ``part``.
 
     ``progress(done, total, what)`` after each corner, and within a corner at least every
@@ -94,12 +95,13 @@ def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = 
     (:func:`estimate_work`) and refused over ``max_cycles`` interpolation cycles or
     MAX_SAMPLES search samples (:class:`~cadcnc.work.WorkLimitError`, exit 2); ``work``:
     a dict given the estimates and the counts (``cycles_estimate``, ``samples_estimate``,
-    ``cycles``: every stepper cycle run, re-runs included; ``samples``).
+    ``cycles``: every stepper cycle run, re-runs included; ``samples``). ``jobs``:
+    processes cutting the corners, one pair's corners a task (None: every core); the
+    program does not depend on it; ``times`` then adds the workers' seconds.
     """
     require_ball(job)
     stage = _Clock(times)
     op, tool = job.operation, job.tool
-    side = op.side
     faces = None if op.faces is None else set(op.faces)
     radius, allowance = tool.radius, tool.allowance
     with stage("edges"):
@@ -111,30 +113,75 @@ def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = 
     todo = [c for c in corners if c.cut]
     work = {} if work is None else work
     work.update(estimate_work(todo, job, max_cycles), cycles=0, samples=0)
-    stretches: dict = {}
-    guards: dict = {}
     beat = Heartbeat(progress and (lambda text: progress(done, len(todo), text)), clock=clock)
     done = 0
-    for k, corner in enumerate(todo, 1):
+    groups: dict = {}   # corners of one pair share its guard and stretch search: one task
+    for k, corner in enumerate(todo):
+        groups.setdefault(corner.faces, []).append(k)
+    per_corner: list = [None] * len(todo)
+
+    def arrived(_: int, res) -> None:
+        nonlocal done
+        for k, cut_skip in res[0]:
+            per_corner[k] = cut_skip
+            done += 1
+            if progress is not None:
+                progress(done, len(todo), "faces {} {}".format(*todo[k].faces))
+                beat.last = beat.clock()
+
+    portable = (lambda c: c) if jobs == 1 else (lambda c: _rail_refs(part, c))
+    tasks = [(job, [(k, portable(todo[k])) for k in ks], max_cycles)
+             for ks in groups.values()]
+    for _, seconds, counts in on_workers(_pair_corners, tasks, part, jobs, arrived,
+                                         "the corners of pair", beat):
+        for name, t in seconds.items():
+            stage.add(name, t)
+        for name, n in counts.items():
+            work[name] += n
+    for new, why in per_corner:
+        cuts += new
+        skipped += why
+    with stage("linking"):   # entries (ops/entries.py), ordering and links
+        segments, unreachable, notes = entered_program_segments(
+            part, job, cuts, safe_height(part, job), join=CHAIN_GAP,
+            order=lambda items: order_cuts(items, CHAIN_GAP),
+            tick=lambda k, n: beat.beat(f"linking: {k} of {n} cuts entered"))
+    return Program(job, segments, skipped + unreachable, notes)
+
+
+def _pair_corners(part: Part, task, beat=None) -> tuple[list, dict, dict]:
+    """The cuts and skips of the corners of one pair (they share its guard and stretch
+    search): ``([(corner index, (cuts, skipped))], seconds per stage, work counts)``;
+    :func:`~cadcnc.ops.parallel.on_workers`' task."""
+    job, corners, max_cycles = task
+    times: dict = {}
+    stage = _Clock(times)
+    work = {"cycles": 0, "samples": 0}
+    side = job.operation.side
+    beat = beat if beat is not None else Heartbeat(None)
+    guard, found_pair, out = None, None, []
+    for k, corner in corners:
+        corner = _rails_back(part, corner)
         i, j = corner.faces
         cjob = replace(job, operation=PairPath(faces=(i, j), edge=corner.edge))
         at = f"faces {i} {j}"
         feas = None
         steps = (lambda cycles, mm: beat.beat(f"{at}: interpolating, {cycles} cycles"))
+        cuts: list[CutSegment] = []
+        skipped: list[Skipped] = []
         try:
             s1, s2 = part.face(i), part.face(j)
             with stage("guards"):   # one per pair (its cache serves all its corners)
-                guard = guards.get((i, j)) or guards.setdefault(
-                    (i, j), guard_for(part, (i, j), cjob))
+                guard = guard or guard_for(part, (i, j), cjob)
             beat.beat(f"{at}: guard built")
             feas = Feasibility(s1, s2, cjob, guard)
             feas.beat = lambda: beat.beat(lambda: f"{at}: stretch search, {feas.samples} "
                                           "ball positions")
             if corner.kind == EDGE:
                 with stage("stretches"):
-                    if (i, j) not in stretches:
-                        stretches[(i, j)] = pair_stretches(s1, s2, cjob, guard, feas=feas)
-                found = [stretches[(i, j)][corner.edge]]
+                    if found_pair is None:
+                        found_pair = pair_stretches(s1, s2, cjob, guard, feas=feas)
+                found = [found_pair[corner.edge]]
                 with stage("interpolation"):
                     new, why = stretch_cuts(s1, s2, cjob, found, guard, max_cycles, steps,
                                             side=side, work=work)
@@ -165,16 +212,26 @@ def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = 
             skipped.append(Skipped((i, j), "failed", f"{corner.kind} corner: {e}",
                                    None if corner.edge is None else corner.edge + 1))
         work["samples"] += 0 if feas is None else feas.samples
-        done = k
-        if progress is not None:
-            progress(k, len(todo), at)
-            beat.last = beat.clock()
-    with stage("linking"):   # entries (ops/entries.py), ordering and links
-        segments, unreachable, notes = entered_program_segments(
-            part, job, cuts, safe_height(part, job), join=CHAIN_GAP,
-            order=lambda items: order_cuts(items, CHAIN_GAP),
-            tick=lambda k, n: beat.beat(f"linking: {k} of {n} cuts entered"))
-    return Program(job, segments, skipped + unreachable, notes)
+        out.append((k, (cuts, skipped)))
+    return out, times, work
+
+
+def _rail_refs(part: Part, corner: Corner) -> Corner:
+    """``corner`` with its rails (OCCT edges, which do not pickle) as (faces, index) in
+    the part's adjacency, for a worker to find again (:func:`_rails_back`)."""
+    refs = []
+    for rail in corner.rails:
+        edges = part.shared_edges(*rail.faces)
+        refs.append((rail.faces, next(k for k, e in enumerate(edges) if e is rail)))
+    return replace(corner, rails=tuple(refs))
+
+
+def _rails_back(part: Part, corner: Corner) -> Corner:
+    """``corner`` with rails given by :func:`_rail_refs` found again in ``part``."""
+    if not corner.rails or not isinstance(corner.rails[0], tuple):
+        return corner
+    return replace(corner, rails=tuple(part.shared_edges(*faces)[k]
+                                       for faces, k in corner.rails))
 
 
 MAX_SAMPLES = 400_000
@@ -221,6 +278,11 @@ class _Clock:
         self.times = times
         self.stage = ""
         self.t0 = 0.0
+
+    def add(self, stage: str, seconds: float) -> None:
+        """Add ``seconds`` measured elsewhere (a worker) to ``stage``."""
+        if self.times is not None:
+            self.times[stage] = self.times.get(stage, 0.0) + seconds
 
     def __call__(self, stage: str) -> "_Clock":
         self.stage = stage

@@ -1,0 +1,166 @@
+"""Independent tasks on every core: a standard-library process pool, results in order.
+
+Operations (pencil corners, finishing planes) and the gouge gate (one task per cut) hand
+:func:`map_ordered` a function and a list of tasks. With ``jobs`` 1 (or one task) the
+tasks run here, in order, on the caller's part; else in a
+``concurrent.futures.ProcessPoolExecutor`` whose workers rebuild the part once each
+(the ``build`` function and its arguments, e.g. BRep bytes: OCCT shapes do not pickle),
+so start-up (imports, compiled kernels, the part's faces) is paid once per worker, not
+per task. The pool is kept for the part and reused by the next call with the same
+part (the gate after the computation) until :func:`close` or exit.
+
+Results come back in task order whatever the number of workers, so outputs do not
+depend on it. ``on_result(k, result)`` is called in the caller's process as each
+result arrives (progress). Ctrl-C cancels the pending tasks, terminates every worker
+and re-raises KeyboardInterrupt; a worker that dies raises :class:`WorkerError` (exit 1)
+naming the task, never a hang. No OCCT here: the part is opaque.
+"""
+
+from __future__ import annotations
+
+import atexit
+import multiprocessing
+import os
+import signal
+import threading
+import time
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from typing import Any, Callable, Sequence
+
+from .errors import CadcncError, InputError
+
+PRELOAD = ["cadcnc.ops.run", "cadcnc.verification.gate_jobs"]
+"""Modules the workers' server imports once (every worker starts with them loaded)."""
+WATCH_S = 0.5
+"""How often (s) a worker checks that its parent process is still there."""
+_STATE: dict[str, Any] = {}   # in a worker: the part it rebuilt
+_POOLS: dict[int, tuple[Any, int, ProcessPoolExecutor]] = {}  # id(part) -> (part, jobs, pool)
+
+
+class WorkerError(CadcncError):
+    """A worker process died (killed, out of memory, crashed in native code): exit 1."""
+
+
+def default_jobs() -> int:
+    """All cores this process may use."""
+    try:
+        return max(len(os.sched_getaffinity(0)), 1)
+    except AttributeError:  # not on Linux
+        return max(os.cpu_count() or 1, 1)
+
+
+def check_jobs(jobs: int | None) -> int:
+    """``jobs`` as a worker count (None: every core); InputError below 1."""
+    if jobs is None:
+        return default_jobs()
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise InputError(f"jobs must be a whole number of processes >= 1, got {jobs!r}")
+    return jobs
+
+
+def _init(build: Callable, args: tuple, parent: int) -> None:
+    """In a worker: rebuild the part once (imports and compiled kernels come with it).
+    Ctrl-C is the parent's to handle: it terminates the workers; a worker whose parent
+    is gone (killed, or ended by ``os._exit``) ends too."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_watch, args=(parent,), daemon=True).start()
+    _STATE["part"] = build(*args)
+
+
+def _watch(parent: int) -> None:
+    while True:
+        time.sleep(WATCH_S)
+        try:
+            os.kill(parent, 0)
+        except OSError:
+            os._exit(1)
+
+
+def _call(fn: Callable, task) -> Any:
+    return fn(_STATE["part"], task)
+
+
+def _pool(part, jobs: int, build: Callable, args: Callable[[], tuple]) -> ProcessPoolExecutor:
+    held = _POOLS.get(id(part))
+    if held is not None and held[0] is part and held[1] == jobs:
+        return held[2]
+    if held is not None:
+        _shutdown(id(part))
+    pool = ProcessPoolExecutor(jobs, mp_context=_context(), initializer=_init,
+                               initargs=(build, args(), os.getpid()))
+    _POOLS[id(part)] = (part, jobs, pool)
+    return pool
+
+
+def _context():
+    """Workers forked from a clean server process that has the library imported (a fork
+    of this process could inherit a lock held by another thread and hang); spawned
+    where there is no fork."""
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    ctx = multiprocessing.get_context("forkserver")
+    ctx.set_forkserver_preload(PRELOAD)
+    return ctx
+
+
+def _shutdown(key: int, kill: bool = False) -> None:
+    _, _, pool = _POOLS.pop(key)
+    if kill:  # Ctrl-C or a dead worker: stop every worker now, not after its task
+        for proc in list(getattr(pool, "_processes", {}).values()):
+            if proc.is_alive():
+                proc.terminate()
+    pool.shutdown(wait=True, cancel_futures=True)
+
+
+def close() -> None:
+    """Shut every kept pool down (its workers exit)."""
+    for key in list(_POOLS):
+        _shutdown(key)
+
+
+atexit.register(close)
+
+
+def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: int | None,
+                build: Callable, build_args: Callable[[], tuple],
+                on_result: Callable[[int, Any], None] | None = None,
+                what: str = "task") -> list:
+    """``[fn(part, t) for t in tasks]``, on ``jobs`` processes (module doc).
+
+    ``fn`` must be a module-level function (it is pickled by name); ``build(*build_args())``
+    rebuilds ``part`` in a worker (``build_args`` is called only when a pool starts).
+    ``what(k)``-style naming: ``what`` names a task in the dead-worker error.
+    """
+    tasks = list(tasks)
+    jobs = min(check_jobs(jobs), max(len(tasks), 1))
+    if jobs == 1:
+        out = []
+        for k, t in enumerate(tasks):
+            out.append(fn(part, t))
+            if on_result is not None:
+                on_result(k, out[-1])
+        return out
+    pool = _pool(part, jobs, build, build_args)
+    futures = {}
+    try:
+        futures = {pool.submit(_call, fn, t): k for k, t in enumerate(tasks)}
+        out: list = [None] * len(tasks)
+        pending = set(futures)
+        while pending:
+            done, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for f in sorted(done, key=futures.get):
+                out[futures[f]] = f.result()
+                if on_result is not None:
+                    on_result(futures[f], out[futures[f]])
+        return out
+    except BrokenProcessPool as e:
+        bad = sorted(k for f, k in futures.items() if not f.done() or f.exception())
+        _shutdown(id(part), kill=True)
+        raise WorkerError(f"a worker process died during {what} {bad[0] + 1 if bad else '?'} "
+                          f"of {len(tasks)} (killed, out of memory, or a crash in native "
+                          "code); nothing written. --jobs 1 runs in one process") from e
+    except BaseException:  # Ctrl-C, or an error in a task: stop every worker
+        if id(part) in _POOLS:
+            _shutdown(id(part), kill=True)
+        raise
