@@ -107,7 +107,7 @@ def settings_of(args, jobs: int | None = None) -> Settings:
     processes: ``jobs``, else ``--jobs`` (default every core)."""
     return Settings(args.max_cycles, gcode_keywords(args) if wants_gcode(args.output)
                     else None, args.allow_partial, args.allow_gouge,
-                    check_jobs(args.jobs) if jobs is None else jobs)
+                    check_jobs(getattr(args, "jobs", None)) if jobs is None else jobs)
 
 
 def clearance(args) -> float | None:
