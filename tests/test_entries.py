@@ -16,8 +16,14 @@ import pytest
 
 from benchmarks.coverage.coverage_oracle import Oracle, read_shape
 from benchmarks.entries.sweeps import TOL, entries_at, entry_exists, links_check
-from cadcnc.errors import EXIT_NOTHING, EXIT_OK
+import cadcnc
+from cadcnc.errors import EXIT_GOUGE, EXIT_NOTHING, EXIT_OK
+from cadcnc.job import Job, PairPath, Tool
+from cadcnc.ops.common import safe_height
+from cadcnc.program.linking import linked
+from cadcnc.program.program import Program
 from cadcnc.program.toolpath import toolpath_piece
+from cadcnc.verification.judgement import judge
 from conftest import FIXTURES, cadcnc_cli, fixture_path
 
 pytestmark = [pytest.mark.slow, pytest.mark.cli]
@@ -187,3 +193,20 @@ def test_a_reversed_piece_is_the_same_chords_backwards():
     ahead = toolpath_piece(tp, lo, hi)
     assert np.array_equal(ahead.points, tp.points[lo:hi + 1])
     assert np.array_equal(ahead.steps[1:], tp.steps[lo + 1:hi + 1])
+
+
+def test_a_blocked_plunge_is_refused_without_a_useless_hint():
+    """The same cut of entry_side linked the old way (a plunge through the overhang) is
+    refused by the gate (exit 5, which entries avoid), and the message suggests no option
+    that cannot help: no --clearance, --radius or --tolerance, only --allow-gouge."""
+    f = FACTS["entry_side"]
+    part = cadcnc.load_step(FIXTURES / f["file"])
+    job = Job(Tool(R), 1500.0, 0.02, PairPath(faces=(f["floor"], f["wall"])))
+    entered = cadcnc.run(part, job)
+    old = Program(job, linked(entered.cuts, safe_height(part, job)))
+    verdict = judge(old, part, "path")
+    assert verdict.code == EXIT_GOUGE and any(verdict.gate.link_failed)
+    text = " ".join(verdict.messages)
+    assert "--allow-gouge" in text
+    assert not any(opt in text for opt in ("--clearance", "--radius", "--tolerance"))
+    assert judge(entered, part, "path").code == EXIT_OK

@@ -8,8 +8,8 @@ first message line); the judge's ball positions (``coverage_judge.judge_pair``, 
 ``feasible`` and ``unreachable``: with or without a clear plunge from above); how many the
 written cuts cover (within 5 µm); for the uncovered ones (at most SAMPLE, evenly spread),
 whether any entry reaches them by the independent OCCT check (``sweeps.entries_at``: a
-plunge, or a horizontal approach along +-X, +-Y), and for the skipped stretches the
-same at the named point; and every link move of the written program swept with the ball
+plunge, or a horizontal approach along +-X, +-Y), and the same at the point a skipped
+stretch names (with the face OCCT finds in the plunge's way); and every link move of the written program swept with the ball
 and a 10 R shank (``sweeps.links_check``). Set COVERAGE_JUDGE_CACHE to a folder to judge a
 part once. Lengths mm.
 """
@@ -83,6 +83,15 @@ def measure(step: Path, faces, radius: float, sample: int = SAMPLE) -> dict:
     rec["uncovered_checked"] = len(reach)
     rec["uncovered_with_entry"] = sum(entry_exists(r, offset) for r in reach)
     rec["uncovered_blocked_by"] = sorted({n for r in reach for _, n in r.values() if n})
+    named = re.search(r"unreachable: .*?\(([-\d.]+), ([-\d.]+), ([-\d.]+)\): (?:ball|shank) "
+                      r"touches face (\d+)", rec["message"])
+    if named:   # the point and face the skip names, checked independently
+        p = np.array([float(x) for x in named.groups()[:3]])
+        ways = entries_at(o, p, offset, shank, z_safe)
+        rec["named"] = {"point": p.tolist(), "face": int(named.group(4)),
+                        "entry_exists": entry_exists(ways, offset),
+                        "plunge_face": ways["plunge"][1],
+                        "plunge_mm_nearer": offset - ways["plunge"][0]}
     if program is not None:
         rec["links"] = links_check(o, program, offset, shank)
         rec["skipped"] = [f"{s['reason']}: {s['detail']}"[:300] for s in program["skipped"]]

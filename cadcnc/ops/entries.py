@@ -6,7 +6,8 @@ there, then cut along its whole length. :func:`visit_for` tries, in this order:
 
 1. a straight plunge from the clearance height onto its start (cut as computed);
 2. the same onto its end (the cut run the other way);
-3. a plunge onto a point between (INTERIOR points tried, from the start on), cutting
+3. a plunge onto a point between (one every R' along the cut, INTERIOR to MAX_INTERIOR
+   points, tried from the start on), cutting
    both ways from there: to the end, back along the cut to that point, then to the start;
 4. a straight horizontal approach at the cut's own height from outside the part's
    bounding box, along +X, -X, +Y or -Y (SIDES), onto its start, its end, or a point
@@ -41,8 +42,9 @@ SIDES = ((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, -1.0, 0.0))
 """Horizontal unit directions (in the setup's frame) from a cut out to where a side
 approach starts: the tool comes in from the +X, -X, +Y, -Y side of the part."""
 SIDE_NAMES = ("+X", "-X", "+Y", "-Y")
-INTERIOR = 32
-"""Points between a cut's ends tried for a plunge (evenly spaced by index)."""
+INTERIOR, MAX_INTERIOR = 32, 200
+"""Points between a cut's ends tried for a plunge: one every R' along it, at least
+INTERIOR and at most MAX_INTERIOR (evenly spaced by index)."""
 SIDE_POINTS = 4
 """Points between a cut's ends tried for a horizontal approach (each costs 4 OCCT
 distances of a swept tool)."""
@@ -136,7 +138,9 @@ def _entry(cut: CutSegment, access: Access) -> tuple[int, np.ndarray | None, str
         return 0, None, ""
     if n and access.plunge(faces, pts[n])[0]:
         return n, None, ""
-    for k in _indices(n, INTERIOR):
+    between = _indices(n, int(np.clip(cut.length / access.job.tool.offset, INTERIOR,
+                                      MAX_INTERIOR)))
+    for k in between:
         if access.plunge(faces, pts[k])[0]:
             return k, None, ""
     for k in [0, n][:1 + bool(n)] + _indices(n, SIDE_POINTS):
@@ -144,7 +148,7 @@ def _entry(cut: CutSegment, access: Access) -> tuple[int, np.ndarray | None, str
         if q is not None:
             return k, q, ""
     return -1, None, (f"no clear entry: the plunge onto its start {why}; onto its end and "
-                      f"{len(_indices(n, INTERIOR))} points between, and from the side "
+                      f"{len(between)} points between, and from the side "
                       f"({', '.join(SIDE_NAMES)}) at its height: blocked too")
 
 
