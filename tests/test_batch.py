@@ -220,6 +220,8 @@ BAD_TOML = [
      'command = "pencil"\n', 4, "options.radius"),
     ("unknown command", 'parts = ["*.step"]\n[[operations]]\ncommand = "polish"\n', 3,
      "operations[1].command"),
+    ("bad output", 'parts = ["*.step"]\noutputs = [".json",\n ".txt"]\n[[operations]]\n'
+     'command = "pencil"\nradius = 3\n', 3, "outputs[2]"),
     ("an output option", 'parts = ["*.step"]\n[[operations]]\ncommand = "pencil"\n'
      'radius = 3\noutput = "x.ngc"\n', 5, "operations[1].output"),
 ]
