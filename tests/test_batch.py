@@ -89,9 +89,9 @@ def _summary(jobs: Path) -> dict:
 
 @pytest.fixture(scope="module")
 def embedded(tmp_path_factory):
-    """(job file, run): the batch on the embedded cluster of two workers."""
+    """(job file, run): the batch on the embedded cluster (one worker: the cheapest)."""
     jobs = _folder(tmp_path_factory.mktemp("embedded"))
-    return jobs, cadcnc_cli("batch", jobs, "--workers", "2")
+    return jobs, cadcnc_cli("batch", jobs, "--workers", "1")
 
 
 def test_every_part_listed_and_a_failing_part_survives(embedded):
