@@ -130,7 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="feed of the links' plunge moves, mm/min (default: the feed)")
     add_max_cycles(p)
 
-    from . import batch, finish, pencil, stream  # light: commands import the library when run
+    from . import batch, finish, pencil, stream  # light: their commands import the library when run
     pencil.add_parser(add, _flip_option, _gouge_options, _gcode_options)
     finish.add_parser(add, _flip_option, _gouge_options, _gcode_options)
     stream.add_parser(add, _flip_option, _gouge_options)

@@ -19,7 +19,7 @@ from .options import BUILDERS, settings_of
 
 CLI_ONLY = ("output", "stream", "machine", "jerk", "quiet", "debug", "help", "step", "jobs")
 """Options a job file does not take: the outputs are the job file's own ``outputs``, and
-each part runs in one process (``--jobs 1``): the batch's workers are the parallelism."""
+each part runs in one process (``--jobs 1``)."""
 
 
 def batch_parts(job, parser) -> list:
@@ -62,7 +62,7 @@ def operation_of(job, parser, op, path: str, options: dict, outputs: tuple):
     for key, (value, where) in options.items():
         if key in CLI_ONLY:
             raise job.error(where, "not an option of a job file (outputs: the job file's "
-                                   "`outputs`; workers: `--workers` or the cluster's)")
+                                   "`outputs`)")
         argv += _words(job, key, value, where)
     for name in outputs:
         argv += ["-o", name]
