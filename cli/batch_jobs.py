@@ -13,6 +13,7 @@ from pathlib import Path
 
 from cadcnc.batch.task import BatchOperation, BatchPart
 from cadcnc.errors import InputError
+from cadcnc.io.outputs import SUFFIXES
 
 from .options import BUILDERS, settings_of
 
@@ -25,6 +26,16 @@ def batch_parts(job, parser) -> list:
     """Every part's :class:`~cadcnc.batch.task.BatchPart`: its operations' options (shared,
     the operation's, the part's) parsed by the command's parser (``parser``: the
     ``cadcnc`` parser) into Jobs."""
+    for k, suffix in enumerate(job.outputs):
+        if suffix not in SUFFIXES:
+            raise job.error(("outputs", k), f"{suffix!r}: the outputs are "
+                                            f"{', '.join(SUFFIXES)}")
+    stems: dict[str, str] = {}
+    for path in job.parts:   # each part's folder is its file's stem
+        other = stems.setdefault(Path(path).stem, path)
+        if other != path:
+            raise job.error(("parts",), f"{other} and {path} would share the output folder "
+                                        f"{Path(path).stem!r}: rename one")
     parts = []
     for path in job.parts:
         ops = []

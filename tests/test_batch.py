@@ -89,9 +89,9 @@ def _summary(jobs: Path) -> dict:
 
 @pytest.fixture(scope="module")
 def embedded(tmp_path_factory):
-    """(job file, run): the batch on the embedded cluster of two workers."""
+    """(job file, run): the batch on the embedded cluster (one worker: the cheapest)."""
     jobs = _folder(tmp_path_factory.mktemp("embedded"))
-    return jobs, cadcnc_cli("batch", jobs, "--workers", "2")
+    return jobs, cadcnc_cli("batch", jobs, "--workers", "1")
 
 
 def test_every_part_listed_and_a_failing_part_survives(embedded):
@@ -220,6 +220,8 @@ BAD_TOML = [
      'command = "pencil"\n', 4, "options.radius"),
     ("unknown command", 'parts = ["*.step"]\n[[operations]]\ncommand = "polish"\n', 3,
      "operations[1].command"),
+    ("bad output", 'parts = ["*.step"]\noutputs = [".json",\n ".txt"]\n[[operations]]\n'
+     'command = "pencil"\nradius = 3\n', 3, "outputs[2]"),
     ("an output option", 'parts = ["*.step"]\n[[operations]]\ncommand = "pencil"\n'
      'radius = 3\noutput = "x.ngc"\n', 5, "operations[1].output"),
 ]

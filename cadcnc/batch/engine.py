@@ -107,12 +107,14 @@ def _plan(parts: list[BatchPart], out: Path) -> list[_Planned]:
             raise InputError(f"{p.path} and {seen[p.label]} would share the output folder "
                              f"{p.label!r}: give one of them a name")
         seen[p.label] = p.path
-        if not p.operations:
-            raise InputError(f"{p.path}: no operation")
+        names = [name for op in p.operations for name in op.outputs]
+        if not p.operations or len(set(names)) < len(names):
+            raise InputError(f"{p.path}: no operation, or two that write one file: "
+                             f"{', '.join(names)}")
+    digests = [job_hash(p) for p in parts]   # every part read before any folder is made
     plans = []
-    for p in parts:
+    for p, digest in zip(parts, digests):
         folder = out / p.label
-        digest = job_hash(p)
         folder.mkdir(parents=True, exist_ok=True)
         sets = [OutputSet([folder / name for name in op.outputs], SUFFIXES, inputs=[p.path])
                 for op in p.operations]

@@ -88,8 +88,8 @@ def _announce(part: str, batch: str) -> None:
         worker = get_worker()
     except ValueError:   # not in a Dask worker
         return
-    worker.log_event(EVENT_TOPIC, {"batch": batch, "part": part, "worker": worker.address, "pid": os.getpid(),
-                                   "host": socket.gethostname()})
+    worker.log_event(EVENT_TOPIC, {"batch": batch, "part": part, "worker": worker.address,
+                                   "pid": os.getpid(), "host": socket.gethostname()})
 
 
 def run_operation(path: str, op: BatchOperation) -> OperationResult:
