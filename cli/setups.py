@@ -37,6 +37,8 @@ def setups_command(args) -> int:
 
     if getattr(args, "axis", None) is not None:
         raise InputError("give --axis or --setups, not both")
+    if getattr(args, "stream", None):
+        raise InputError("--stream takes one program: stream a setup's with --axis")
     asked = parse_setups(args.setups)
     for out in args.output:   # every name a setup may take, checked before computing
         for tag in PRINCIPAL_AXES if asked == AUTO else ["+Z"]:

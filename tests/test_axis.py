@@ -122,6 +122,12 @@ def test_axis_reaches_its_own_side(part, tmp_path, side):
     cuts = np.vstack([s["points"] for s in data["segments"] if s["kind"] == "cut"])
     assert np.allclose(cuts @ d, 15 + R, atol=1e-9) and np.allclose(cuts @ e, -8 + R,
                                                                      atol=1e-9)
+    from cadcnc.io.program_json import read_program
+
+    back = read_program(out[1])   # read back into its work coordinates, as the G-code
+    feeds = np.array([p for kind, p in moves if kind == "STRAIGHT_FEED"])
+    assert np.abs(feeds[:, None, :] - back.cuts[0].points[None, ::40, :]).max(
+        axis=2).min(axis=0).max() <= DIGITS
     import trimesh
 
     scene = trimesh.load(out[2])
