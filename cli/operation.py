@@ -75,6 +75,7 @@ def _operation(args, what: str, job_of, *, progress=None, times: dict | None = N
     from cadcnc.io.outputs import SUFFIXES, render
     from cadcnc.ops.common import safe_height
     from cadcnc.ops.run import cut_back_gap
+    from cadcnc.verification.gate_cache import open_shared
     from cadcnc.verification.judgement import judge, settle
     from cadcnc.workers import check_jobs
 
@@ -105,6 +106,7 @@ def _operation(args, what: str, job_of, *, progress=None, times: dict | None = N
     t_cut = time.monotonic() - t0
     name = Path(args.step).name
     join = cut_back_gap(job)
+    open_shared(part)  # the cut-back step and the program gate share their work
     if join is not None:
         program = settle(program, part, safe_height(part, job), join, f"{args.step}: {what}",
                          args.allow_gouge, jobs=jobs)
