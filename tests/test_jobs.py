@@ -32,20 +32,19 @@ def cli(args, **kw) -> subprocess.Popen:
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
 
 
+def _parent_of(pid: str) -> int | None:
+    try:
+        return int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
+    except (OSError, IndexError, ValueError):  # gone meanwhile
+        return None
+
+
 def descendants(pid: int) -> set[int]:
     """Every live process under ``pid`` (workers are grandchildren: a fork server's)."""
-    parent = {}
-    for d in Path("/proc").iterdir():
-        if d.name.isdigit():
-            try:
-                stat = (d / "stat").read_text()
-            except OSError:
-                continue
-            parent[int(d.name)] = int(stat.rsplit(")", 1)[1].split()[1])
+    parent = {int(p): _parent_of(p) for p in os.listdir("/proc") if p.isdigit()}
     out, todo = set(), [pid]
     while todo:
-        p = todo.pop()
-        kids = {c for c, pp in parent.items() if pp == p}
+        kids = {c for c, pp in parent.items() if pp == todo.pop()}
         out |= kids
         todo += kids
     return out
