@@ -31,17 +31,18 @@ def add_operation_options(p, allowance_help: str) -> None:
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
                    help=OUTPUT_HELP)
     add_max_cycles(p)
+
+
+def add_max_cycles(p) -> None:
+    """--max-cycles (the work limit, docs/reliability.md), --jobs and the --stream
+    options."""
+    p.add_argument("--max-cycles", type=int, default=MAX_CYCLES, metavar="N",
+                   help=f"interpolation cycles the program may need, estimated before "
+                        f"computing and refused over it (default {MAX_CYCLES})")
     p.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="processes: pencil's corners, finishing's planes and the gouge "
                         "gate's cuts run on N cores (default: all; 1: one process); the "
                         "outputs are the same whatever N")
-
-
-def add_max_cycles(p) -> None:
-    """--max-cycles (the work limit, docs/reliability.md) and the --stream options."""
-    p.add_argument("--max-cycles", type=int, default=MAX_CYCLES, metavar="N",
-                   help=f"interpolation cycles the program may need, estimated before "
-                        f"computing and refused over it (default {MAX_CYCLES})")
     g = p.add_argument_group("stream (docs/controller.md)")
     g.add_argument("--stream", action="append", metavar="OUT",
                    help="also write the program as one position per servo period, its feed "
@@ -93,7 +94,7 @@ def _operation(args, what: str, job_of, *, progress=None, times: dict | None = N
             check_destination(out, STREAM_SUFFIXES, [args.step])
         machine = machine_of(args)
     job = job_of(args, args.step)
-    jobs = check_jobs(args.jobs)
+    jobs = check_jobs(getattr(args, "jobs", None))
     t0 = time.monotonic()
     part = cadcnc.load_step(args.step, flip_material=job.flip_material)
     for n in getattr(job.operation, "faces", None) or ():
