@@ -32,6 +32,8 @@ from .errors import CadcncError, InputError
 
 PRELOAD = ["cadcnc.ops.run", "cadcnc.verification.gate_jobs"]
 """Modules the workers' server imports once (every worker starts with them loaded)."""
+ENV = "CADCNC_JOBS"
+"""The default number of processes when none is given (unset: every core)."""
 WATCH_S = 0.5
 """How often (s) a worker checks that its parent process is still there."""
 _STATE: dict[str, Any] = {}   # in a worker: the part it rebuilt
@@ -43,7 +45,12 @@ class WorkerError(CadcncError):
 
 
 def default_jobs() -> int:
-    """All cores this process may use."""
+    """The environment's ``CADCNC_JOBS`` when set, else all cores this process may use."""
+    env = os.environ.get(ENV, "").strip()
+    if env:
+        if not env.isdigit() or int(env) < 1:
+            raise InputError(f"{ENV}={env!r}: a whole number of processes >= 1")
+        return int(env)
     try:
         return max(len(os.sched_getaffinity(0)), 1)
     except AttributeError:  # not on Linux

@@ -30,10 +30,6 @@ def add_operation_options(p, allowance_help: str) -> None:
     p.add_argument("-o", "--output", action="append", required=True, metavar="OUT",
                    help=OUTPUT_HELP)
     add_max_cycles(p)
-    p.add_argument("--jobs", type=int, default=None, metavar="N",
-                   help="processes: pencil's corners, finishing's planes and the gouge "
-                        "gate's cuts run on N cores (default: all; 1: one process); the "
-                        "outputs are the same whatever N")
     add_axis_options(p)
 
 
@@ -54,6 +50,10 @@ def add_max_cycles(p) -> None:
     p.add_argument("--max-cycles", type=int, default=MAX_CYCLES, metavar="N",
                    help=f"interpolation cycles the program may need, estimated before "
                         f"computing and refused over it (default {MAX_CYCLES})")
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="processes: pencil's corners, finishing's planes and the gouge "
+                        "gate's cuts run on N cores (default: all; 1: one process); the "
+                        "outputs are the same whatever N")
     g = p.add_argument_group("stream (docs/controller.md)")
     g.add_argument("--stream", action="append", metavar="OUT",
                    help="also write the program as one position per servo period, its feed "

@@ -20,10 +20,11 @@ CONCAVE_PAIRS = [(name, *p["faces"]) for name in FIXTURE_NAMES
                  for p in SIDECAR[name]["pairs"] if p["class"] == "concave"]
 
 _parts: dict = {}
+os.environ.setdefault("CADCNC_JOBS", "1")  # commands in one process: pytest-xdist has the cores
 
 SLOW_MODULES = {"test_finish.py", "test_fuzz.py", "test_fuzz_operations.py",
                 "test_hal_loop.py", "test_controller_stream.py", "test_trim_grid.py",
-                "test_gate.py", "test_finish_bounds.py", "test_batch.py"}
+                "test_gate.py", "test_finish_bounds.py", "test_batch.py", "test_jobs.py"}
 CLI_MODULES = {"test_cli.py", "test_cli_program.py", "test_cli_smoke.py", "test_cli_units.py",
                "test_pencil_cli.py", "test_finish_cli.py", "test_controller_cli.py",
                "test_outputs.py", "test_bad_input.py", "test_bounds_and_inputs.py",

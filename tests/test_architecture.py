@@ -22,7 +22,7 @@ PKG = Path(__file__).resolve().parents[1] / "cadcnc"
 CLI = PKG.parent / "cli"
 KERNEL_FREE_TOP = {"cadcnc.errors", "cadcnc.tolerances", "cadcnc.job", "cadcnc.units", "cadcnc.work", "cadcnc.trim_states",
                    "cadcnc.trim", "cadcnc.jsonable",
-                   "cadcnc.interrupts"}
+                   "cadcnc.interrupts", "cadcnc.workers"}
 THIRD_PARTY_OK_IN_CORE = {"numpy", "numba"}
 
 
@@ -144,6 +144,13 @@ NO_OCCT_STAGES = ("cadcnc.ops", "cadcnc.program", "cadcnc.controller")
 def test_operations_program_and_controller_import_no_occt(name):
     for mod in imports(name):
         assert mod.split(".")[0] not in ("OCP", "cadquery"), (name, mod)
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES
+                                        if n.startswith("cadcnc.verification")))
+def test_verification_imports_nothing_from_the_guard(name):
+    """The gate is a second opinion: it shares no code with the guard it checks."""
+    assert not [m for m in internal(name) if m.startswith("cadcnc.guard")], name
 
 
 def test_no_private_name_imported_across_modules():

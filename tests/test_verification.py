@@ -371,6 +371,8 @@ def test_gate_fails_closed_when_the_check_raises(cylinders, monkeypatch):
         raise RuntimeError("OCCT said no")
 
     monkeypatch.setattr(FaceProbe, "face_distance", broken)
+    # the bounded gate needs no DistShapeShape on this path: its global projections fail too
+    monkeypatch.setattr(FaceProbe, "project_global", lambda self, p, *a: broken(self, p))
     gate = gouge_gate(tp, part)
     assert not gate.ok and math.isnan(gate.depth_mm)
     assert "could not be completed" in gate.message and "OCCT said no" in gate.message
@@ -394,6 +396,8 @@ def test_gate_fails_closed_on_a_nan_distance_to_another_face(monkeypatch):
     part, tp = path("narrow_slot", 3, 4)  # R 1.5: clean, the end faces are near the ball
     assert gouge_gate(tp, part).ok
     monkeypatch.setattr(FaceProbe, "face_distance", lambda self, p: (math.nan, math.nan))
+    # the closed form on planes asks no DistShapeShape: the nan must come from OCCT's
+    monkeypatch.setattr(FaceProbe, "plane_distance", lambda self, p: None)
     gate = gouge_gate(tp, part)
     assert not gate.ok and any(not h.followed and math.isnan(h.depth_mm) for h in gate.hits)
     assert "could not be measured" in gate.message

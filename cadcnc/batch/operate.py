@@ -19,6 +19,7 @@ from ..job import Job
 from ..ops.common import safe_height
 from ..ops.run import cut_back_gap, run
 from ..program.program import Program
+from ..verification.gate_cache import open_shared
 from ..verification.judgement import Verdict, judge, settle
 from ..work import MAX_CYCLES
 
@@ -77,6 +78,7 @@ def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progr
         raise NothingToCutError(f"{what}: {e}") from None
     t_cut = time.monotonic() - t0
     join = cut_back_gap(job)
+    open_shared(part)  # the cut-back step and the program gate share their work
     if join is not None:
         program = settle(program, part, safe_height(part, job), join, f"{step}: {what}",
                          settings.allow_gouge, jobs=settings.jobs)

@@ -8,6 +8,10 @@ every exact point-to-face distance by face and point (:meth:`PartFaces.distance`
 the pair's checks by toolpath (keyed by content, so a worker process can be handed
 them). Every value kept is OCCT's answer for the same input, so a gate answers as it
 would from scratch; the reference gate (``reference=True``) keeps nothing.
+
+The work is kept only inside ``with shared_gates(part):`` (a command's cut-back step
+and program gate; a worker process for its pool's life); elsewhere each gate starts
+afresh, so nothing outlives the command that computed it.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import weakref
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -52,12 +57,31 @@ class GateCache:
 
 
 def cache_for(part, tol: Tolerances) -> GateCache:
-    """The :class:`GateCache` of ``part`` and ``tol`` (made on first use, dropped with
-    the part)."""
-    per_part = _CACHES.setdefault(part, {})
+    """The :class:`GateCache` of ``part`` and ``tol`` inside :func:`shared_gates` (made
+    on first use), else a new one."""
+    per_part = _CACHES.get(part)
+    if per_part is None:
+        return GateCache(part, tol)
     if tol not in per_part:
         per_part[tol] = GateCache(part, tol)
     return per_part[tol]
+
+
+def open_shared(part) -> None:
+    """Keep the gates' work on ``part`` from now on (a worker's part: its pool's life)."""
+    _CACHES.setdefault(part, {})
+
+
+@contextmanager
+def shared_gates(part):
+    """Gates on ``part`` inside the block share their work (module doc)."""
+    fresh = part not in _CACHES
+    open_shared(part)
+    try:
+        yield
+    finally:
+        if fresh:
+            _CACHES.pop(part, None)
 
 
 def toolpath_key(toolpath) -> str:

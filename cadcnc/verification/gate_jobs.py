@@ -15,7 +15,7 @@ from ..geometry.part_bytes import part_blob, part_from_blob
 from ..tolerances import Tolerances
 from ..workers import map_ordered
 from .gate import GateResult, gouge_gate
-from .gate_cache import cache_for, toolpath_key
+from .gate_cache import cache_for, open_shared, toolpath_key
 from .surface_checks import resolve_part
 
 
@@ -23,6 +23,8 @@ def _gate_task(part, task) -> tuple[GateResult, tuple | None]:
     """One cut's gate (in a worker or here) and, when asked, what it found to share."""
     toolpath, moves, blend, tol, reference, share, want = task
     since = 0
+    if want:  # a worker: its gates share their work while its pool lives
+        open_shared(part)
     if not reference:
         cache = cache_for(part, tol)
         cache.take(share)

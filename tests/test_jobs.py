@@ -1,0 +1,108 @@
+"""``--jobs N`` (issue 24): the same bytes whatever N, Ctrl-C and dead workers handled.
+
+The commands run as a user runs them (a subprocess), so that the worker processes, the
+signals and the exit codes are the real ones.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+import cadcnc
+from cadcnc.errors import EXIT_INTERNAL, EXIT_INTERRUPTED
+from cadcnc.geometry.part_bytes import part_blob, part_from_blob
+from cadcnc.workers import WorkerError, close, map_ordered
+from conftest import FIXTURES
+
+BOSS = str(FIXTURES / "finish_boss.step")
+FINISH = ["finish", BOSS, "--faces", "6", "--radius", "3", "--stepover", "4"]
+PENCIL = ["pencil", str(FIXTURES / "step_slot.step"), "--radius", "3"]
+
+
+def cli(args, **kw) -> subprocess.Popen:
+    env = {**os.environ, "CADCNC_JOBS": ""}  # the command's own default: every core
+    return subprocess.Popen([sys.executable, "-m", "cadcnc.cli", *map(str, args)], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
+
+
+def _parent_of(pid: str) -> int | None:
+    try:
+        return int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
+    except (OSError, IndexError, ValueError):  # gone meanwhile
+        return None
+
+
+def descendants(pid: int) -> set[int]:
+    """Every live process under ``pid`` (workers are grandchildren: a fork server's)."""
+    parent = {int(p): _parent_of(p) for p in os.listdir("/proc") if p.isdigit()}
+    out, todo = set(), [pid]
+    while todo:
+        kids = {c for c, pp in parent.items() if pp == todo.pop()}
+        out |= kids
+        todo += kids
+    return out
+
+
+@pytest.mark.parametrize("command", [FINISH, PENCIL], ids=["finish", "pencil"])
+def test_the_outputs_are_the_same_bytes_whatever_the_jobs(command, tmp_path):
+    files = {}
+    for n in (1, 2):
+        outs = [tmp_path / f"p{n}.json", tmp_path / f"p{n}.ngc"]
+        run = cli([*command, "--jobs", n, *[a for o in outs for a in ("-o", o)]])
+        out, err = run.communicate(timeout=600)
+        assert run.returncode == 0, err
+        files[n] = [o.read_bytes() for o in outs]
+    assert files[1] == files[2]
+
+
+def test_ctrl_c_stops_every_worker_and_writes_nothing(tmp_path):
+    out = tmp_path / "p.json"
+    run = cli([*FINISH[:-1], "1", "--jobs", "2", "-o", out])
+    deadline = time.monotonic() + 120
+    while len(descendants(run.pid)) < 3 and time.monotonic() < deadline:  # server, 2 workers
+        time.sleep(0.1)
+    workers = descendants(run.pid)
+    assert len(workers) >= 3 and run.poll() is None
+    run.send_signal(signal.SIGINT)
+    _, err = run.communicate(timeout=60)
+    assert run.returncode == EXIT_INTERRUPTED, err
+    alive, deadline = workers, time.monotonic() + 30  # the fork server's own teardown
+    while alive and time.monotonic() < deadline:      # (OCCT, numba) takes about a second
+        time.sleep(0.2)
+        alive = {p for p in workers if Path(f"/proc/{p}").exists()}
+    assert not alive and not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def _die(part, task):
+    if task == 1:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return len(part)
+
+
+def test_a_dead_worker_is_an_error_not_a_hang():
+    part = cadcnc.load_step(FIXTURES / "step_block.step")
+    t0 = time.monotonic()
+    with pytest.raises(WorkerError, match="a worker process died during task") as err:
+        map_ordered(_die, [0, 1, 2, 3], part=part, jobs=2, build=part_from_blob,
+                    build_args=lambda: part_blob(part))
+    assert err.value.exit_code == EXIT_INTERNAL and time.monotonic() - t0 < 120
+    close()
+
+
+def test_tasks_come_back_in_order_from_a_part_rebuilt_in_each_worker():
+    part = cadcnc.load_step(FIXTURES / "step_slot.step")
+    got = map_ordered(_kind, list(range(1, len(part) + 1)), part=part, jobs=2,
+                      build=part_from_blob, build_args=lambda: part_blob(part))
+    close()
+    assert got == [part.face(n).kind for n in range(1, len(part) + 1)]
+
+
+def _kind(part, n):
+    return part.face(n).kind
