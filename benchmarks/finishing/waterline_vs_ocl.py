@@ -185,21 +185,25 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     load = os.getloadavg()
     rows = []
-    for name in args.fixtures:
-        row = compare(name, args.tol, args.stepdown)
-        rows.append(row)
-        print(table([row]), flush=True)
+    for name in args.fixtures:   # written as each fixture is done (long runs)
+        rows.append(compare(name, args.tol, args.stepdown))
+        print(table(rows[-1:]), flush=True)
+        if args.png and len(rows) == 1:
+            picture(rows[0], args.png)
+        if args.json:
+            Path(args.json).write_text(json.dumps(dict(
+                load=[load, os.getloadavg()], rows=[_plain(r) for r in rows]), indent=1))
     print(f"\nload average at start {load[0]:.2f}, at end {os.getloadavg()[0]:.2f}")
     print(table(rows))
-    if args.png:
-        picture(rows[0], args.png)
-    if args.json:
-        strip = [{k: v for k, v in r.items() if k != "cad_level"} for r in rows]
-        for r in strip:
-            for o in r["ocl"].values():
-                o.pop("level_loops", None)
-        Path(args.json).write_text(json.dumps(dict(load=load, rows=strip), indent=1))
     return 0
+
+
+def _plain(row: dict) -> dict:
+    """The row without its polylines (JSON)."""
+    out = {k: v for k, v in row.items() if k != "cad_level"}
+    out["ocl"] = {k: {a: b for a, b in o.items() if a != "level_loops"}
+                  for k, o in row["ocl"].items()}
+    return out
 
 
 if __name__ == "__main__":
