@@ -16,6 +16,7 @@ import numbers
 from dataclasses import dataclass, field
 
 from .errors import InputError
+from .finish_fields import check_strategy
 from .tolerances import DEFAULT, Tolerances
 from .units import PRINCIPAL_AXES, axis_name, check_axis  # noqa: F401 - the Job's axis
 from .units import Point, check_faces, check_number, check_point, shown  # noqa: F401 - checks of every record
@@ -173,39 +174,6 @@ class Pencil:
 
 
 FINISH_PATTERNS = ("zigzag", "oneway")
-FINISH_STRATEGIES = ("raster", "waterline", "steep-shallow")
-LOOP_SIDES = ("climb", "conventional")
-
-
-def check_strategy(op) -> None:
-    """Validate a :class:`Finish`'s strategy and its waterline fields, in place: which of
-    stepover, stepdown and scallop it needs, threshold (deg, 0 < A < 90), side, overlap."""
-    if op.strategy not in FINISH_STRATEGIES:
-        raise InputError(f"strategy must be one of {', '.join(FINISH_STRATEGIES)}, got "
-                         f"{shown(op.strategy)}")
-    if op.side not in LOOP_SIDES:
-        raise InputError(f"side must be one of {', '.join(LOOP_SIDES)}, got {shown(op.side)}")
-    if op.stepdown is not None:
-        object.__setattr__(op, "stepdown", check_number("stepdown", op.stepdown, "mm"))
-    object.__setattr__(op, "overlap", check_number("overlap", op.overlap, "mm",
-                                                   allow_zero=True))
-    a = op.threshold
-    if isinstance(a, bool) or not isinstance(a, numbers.Real) or not 0.0 < a < 90.0:
-        raise InputError(f"threshold must be a slope in degrees between 0 and 90 "
-                         f"(exclusive), got {shown(a)}")
-    object.__setattr__(op, "threshold", float(a))
-    given = {k for k in ("stepover", "stepdown", "scallop") if getattr(op, k) is not None}
-    if op.strategy == "raster":
-        ok, need = "stepdown" not in given, "stepover or scallop (stepdown is for waterline)"
-    elif op.strategy == "waterline":
-        ok, need = given in ({"stepdown"}, {"scallop"}), "exactly one of stepdown and scallop"
-    else:
-        ok, need = given in ({"scallop"}, {"stepover", "stepdown"}), \
-            "scallop alone, or both stepover (raster) and stepdown (waterline)"
-    if not ok:
-        raise InputError(f"finishing with strategy {op.strategy} needs {need}, got "
-                         + (", ".join(f"{k} {shown(getattr(op, k))}" for k in sorted(given))
-                            or "none"))
 
 
 @dataclass(frozen=True)
@@ -224,16 +192,11 @@ class Finish:
     scallop: float | None = None
     angle: float = 0.0
     pattern: str = "zigzag"
-    stepdown: float | None = None
-    """mm: the waterline levels' fixed spacing (strategy waterline or steep-shallow)."""
+    stepdown: float | None = None   # mm, waterline levels' spacing (check_strategy)
     strategy: str = "raster"
-    """raster (vertical guide planes), waterline (horizontal levels) or steep-shallow."""
-    threshold: float = 45.0
-    """deg: steep-shallow cuts waterline where the slope exceeds it, raster elsewhere."""
+    threshold: float = 45.0         # deg
     side: str = "climb"
-    """waterline loops: climb or conventional."""
-    overlap: float = 0.0
-    """mm: steep-shallow's two regions overlap this much at their boundary."""
+    overlap: float = 0.0            # mm
 
     def __post_init__(self):
         if isinstance(self.faces, (tuple, list)) and not self.faces:

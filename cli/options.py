@@ -85,6 +85,9 @@ def finish_job(args, source: str) -> Job:
     spacing = {name: None if getattr(args, name) is None else
                parse_length(getattr(args, name), name, allow_zero=False)
                for name in ("stepover", "scallop", "stepdown")}
+    if all(v is None for v in spacing.values()):
+        raise InputError("give --stepover S or --scallop H (raster), --stepdown D or "
+                         "--scallop H (waterline): the passes' spacing")
     try:
         angle, threshold = float(args.angle), float(args.threshold)
     except ValueError:

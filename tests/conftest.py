@@ -24,12 +24,13 @@ os.environ.setdefault("CADCNC_JOBS", "1")  # commands in one process: pytest-xdi
 
 SLOW_MODULES = {"test_finish.py", "test_fuzz.py", "test_fuzz_operations.py",
                 "test_hal_loop.py", "test_controller_stream.py", "test_trim_grid.py",
-                "test_gate.py", "test_finish_bounds.py", "test_batch.py", "test_jobs.py"}
+                "test_gate.py", "test_finish_bounds.py", "test_batch.py", "test_jobs.py",
+                "test_waterline_cli.py"}
 CLI_MODULES = {"test_cli.py", "test_cli_program.py", "test_cli_smoke.py", "test_cli_units.py",
                "test_pencil_cli.py", "test_finish_cli.py", "test_controller_cli.py",
                "test_outputs.py", "test_bad_input.py", "test_bounds_and_inputs.py",
                "test_fuzz_operations.py", "test_one_job.py", "test_surface_models.py",
-               "test_batch.py"}
+               "test_batch.py", "test_waterline_cli.py"}
 
 
 def pytest_collection_modifyitems(config, items):

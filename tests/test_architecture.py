@@ -20,7 +20,7 @@ import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "cadcnc"
 CLI = PKG.parent / "cli"
-KERNEL_FREE_TOP = {"cadcnc.errors", "cadcnc.tolerances", "cadcnc.job", "cadcnc.units", "cadcnc.work", "cadcnc.trim_states",
+KERNEL_FREE_TOP = {"cadcnc.errors", "cadcnc.tolerances", "cadcnc.job", "cadcnc.finish_fields", "cadcnc.units", "cadcnc.work", "cadcnc.trim_states",
                    "cadcnc.trim", "cadcnc.jsonable",
                    "cadcnc.interrupts", "cadcnc.workers"}
 THIRD_PARTY_OK_IN_CORE = {"numpy", "numba"}

@@ -26,7 +26,7 @@ FACTS = json.loads((FIXTURES / "waterline_fixtures.json").read_text())
 RADIUS = {"dome": 3.0, "wall": 3.0, "boss": 2.0}
 # levels (centre z, mm) per fixture: closed loops (dome high), open pieces (dome low, the
 # wall), circles across the seam of the boss wall and its fillet (torus)
-LEVELS = {"dome": (19.5, 16.0, 13.1), "wall": (15.0, 10.0, 7.5), "boss": (12.0, 7.8)}
+LEVELS = {"dome": (19.5, 13.1), "wall": (10.0,), "boss": (12.0, 7.8)}
 _cache: dict = {}
 
 

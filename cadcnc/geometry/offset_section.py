@@ -18,7 +18,6 @@ import numpy as np
 from OCP.BRepAdaptor import BRepAdaptor_CompCurve
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
 from OCP.BRepOffset import BRepOffset_MakeSimpleOffset
-from OCP.GCPnts import GCPnts_AbscissaPoint, GCPnts_QuasiUniformAbscissa
 from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
 from OCP.ShapeAnalysis import ShapeAnalysis_FreeBounds
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
@@ -31,13 +30,16 @@ from ..errors import GeometryError
 JOIN_TOL = 1e-6
 """mm: section edges whose ends are this near are joined into one wire."""
 SAMPLE_MM = 0.5
-"""mm: the spacing of the points sampled along each section wire."""
+"""mm: the spacing of the points sampled along each section wire (uniform in the wire's
+parameter, counted from its length over COARSE points: about this spacing)."""
+COARSE = 17
 
 
 @dataclass
 class SectionWire:
     """One wire of a section: ``points`` (K, 3) along it about SAMPLE_MM apart (its ends
-    included; a closed wire's last point is its first), ``closed``, ``length`` mm."""
+    included; a closed wire's last point is its first), ``closed``, ``length`` mm (of a
+    COARSE-point polyline: a lower bound)."""
 
     points: np.ndarray
     closed: bool
@@ -61,7 +63,8 @@ def _section_edges(faces, z: float) -> TopTools_HSequenceOfShape:
     seq = TopTools_HSequenceOfShape()
     plane = gp_Pln(gp_Pnt(0.0, 0.0, float(z)), gp_Dir(0.0, 0.0, 1.0))
     for face in faces:
-        sec = BRepAlgoAPI_Section(face, plane)
+        sec = BRepAlgoAPI_Section(face, plane, False)   # built once, below
+        sec.Approximation(False)
         sec.Build()
         if not sec.IsDone():
             raise GeometryError(f"OCCT's section of an offset face at z {z:g} mm failed")
@@ -86,14 +89,11 @@ def section_wires(faces, z: float, join: float = JOIN_TOL,
     for i in range(1, wires.Length() + 1):
         curve = BRepAdaptor_CompCurve(TopoDS.Wire_s(wires.Value(i)))
         t0, t1 = curve.FirstParameter(), curve.LastParameter()
-        ends = [np.array(curve.Value(t).Coord()) for t in (t0, t1)]
-        closed = bool(np.linalg.norm(ends[1] - ends[0]) <= join)
-        length = GCPnts_AbscissaPoint.Length_s(curve)
-        count = max(8, int(np.ceil(length / spacing)) + 1)
-        quasi = GCPnts_QuasiUniformAbscissa(curve, count)
-        ts = [quasi.Parameter(k) for k in range(1, quasi.NbPoints() + 1)] if quasi.IsDone() \
-            else list(np.linspace(t0, t1, count))
-        pts = np.array([curve.Value(t).Coord() for t in ts])
+        coarse = np.array([curve.Value(t).Coord() for t in np.linspace(t0, t1, COARSE)])
+        closed = bool(np.linalg.norm(coarse[-1] - coarse[0]) <= join)
+        length = float(np.linalg.norm(np.diff(coarse, axis=0), axis=1).sum())
+        count = max(COARSE, int(np.ceil(length / spacing)) + 1)
+        pts = np.array([curve.Value(t).Coord() for t in np.linspace(t0, t1, count)])
         out.append(SectionWire(pts, closed, float(length)))
     return out
 
