@@ -104,6 +104,7 @@ def test_every_part_listed_and_a_failing_part_survives(embedded):
         r = by_part[name]
         assert (r["status"], r["exit"], r["attempts"]) == ("done", 0, 1), r
         assert r["cuts"] >= 1 and 0 < r["coverage"] <= 1 and r["seconds"] > 0
+        assert 0 < r["cpu_seconds"]
         assert r["outputs"] == [f"{name}/pencil.json", f"{name}/pencil.ngc"]
     csv_rows = (jobs.parent / "jobs-out" / "summary.csv").read_text().splitlines()
     assert len(csv_rows) == 4 and csv_rows[0].startswith("part,operation,status,exit")

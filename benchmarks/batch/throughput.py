@@ -82,8 +82,8 @@ def one_batch(parts: list[BatchPart], workers: int) -> dict:
         wall = time.perf_counter() - t0
     return {"workers": workers, "wall_s": wall, "load_before": load0,
             "load_after": os.getloadavg(),
-            "parts": {r.part: {"seconds": r.seconds, "exit": r.exit, "cuts": r.cuts}
-                      for r in records}}
+            "parts": {r.part: {"seconds": r.seconds, "cpu_seconds": r.cpu_seconds,
+                               "exit": r.exit, "cuts": r.cuts} for r in records}}
 
 
 def main(argv=None) -> dict:
@@ -104,7 +104,9 @@ def main(argv=None) -> dict:
         run = one_batch(parts, n)
         report["runs"].append(run)
         busy = sum(p["seconds"] for p in run["parts"].values())
-        print(f"{n} worker(s): {run['wall_s']:.1f} s wall, parts' seconds {busy:.1f}, "
+        cpu = sum(p["cpu_seconds"] for p in run["parts"].values())
+        print(f"{n} worker(s): {run['wall_s']:.1f} s wall, parts' seconds {busy:.1f} "
+              f"(CPU {cpu:.1f}), "
               f"{len(parts) / run['wall_s'] * 3600:.0f} parts/h; load "
               f"{run['load_before']} -> {run['load_after']}", flush=True)
     base = report["runs"][0]
@@ -113,15 +115,21 @@ def main(argv=None) -> dict:
         print(f"speedup {run['workers']} vs {base['workers']} worker(s): "
               f"{run['speedup']:.2f}x", flush=True)
     seconds = [p["seconds"] for p in base["parts"].values()]
+    cpu = [p["cpu_seconds"] for p in base["parts"].values()]
     for name, p in sorted(base["parts"].items(), key=lambda kv: -kv[1]["seconds"]):
-        print(f"  {name}: {p['seconds']:.1f} s, exit {p['exit']}, {p['cuts']} cuts")
+        print(f"  {name}: {p['seconds']:.1f} s ({p['cpu_seconds']:.1f} s CPU), exit "
+              f"{p['exit']}, {p['cuts']} cuts")
     report["overhead_per_task_s"] = (base["wall_s"] * base["workers"] - sum(seconds)) \
         / len(seconds)
     report["predicted_s"] = {str(w): longest_first(seconds, w) for w in (1, 2, 32, 128)}
+    report["predicted_cpu_s"] = {str(w): longest_first(cpu, w) for w in (1, 2, 32, 128)}
+    report["mean_part_cpu_s"] = sum(cpu) / len(cpu)
     report["mean_part_s"] = sum(seconds) / len(seconds)
     print(f"overhead per task (wall x workers - parts' seconds, per part, cluster start "
           f"included): {report['overhead_per_task_s']:.2f} s; longest-first makespan: "
-          + ", ".join(f"{w} workers {s:.1f} s" for w, s in report["predicted_s"].items()),
+          + ", ".join(f"{w} workers {s:.1f} s" for w, s in report["predicted_s"].items())
+          + "; on the parts' CPU seconds (an idle core each): "
+          + ", ".join(f"{w} workers {s:.1f} s" for w, s in report["predicted_cpu_s"].items()),
           flush=True)
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=1))

@@ -37,7 +37,8 @@ class Record:
     passes the operation found that it cut; ``seconds``: computing and gating;
     ``attempts``: how many times a worker started the part (2 or more: a worker died
     while running it and Dask ran it again); ``worker``: host:pid of the run that counts;
-    ``outputs``: the files written, relative to the batch's output folder."""
+    ``outputs``: the files written, relative to the batch's output folder;
+    ``cpu_seconds``: the worker's CPU time over ``seconds`` (less when it shared a core)."""
 
     part: str
     operation: str
@@ -50,13 +51,14 @@ class Record:
     attempts: int = 1
     worker: str = ""
     outputs: list[str] = field(default_factory=list)
+    cpu_seconds: float = 0.0
 
     @classmethod
     def of(cls, part: str, result: OperationResult, worker: str, attempts: int,
            outputs: list[str]) -> "Record":
         return cls(part, result.operation, DONE if result.exit == EXIT_OK else FAILED,
                    result.exit, result.cuts, result.coverage, result.seconds,
-                   result.message, attempts, worker, outputs)
+                   result.message, attempts, worker, outputs, result.cpu_seconds)
 
 
 COLUMNS = [f.name for f in fields(Record)]

@@ -58,8 +58,9 @@ class BatchPart:
 class OperationResult:
     """One operation's result from a worker: exit code, cuts, coverage (the share of what
     the operation found, corners, stretches or passes, that it cut; nan when nothing was
-    found), seconds (computing and gating), message, and ``contents`` ({file name: bytes
-    or str}, empty when the verdict writes nothing)."""
+    found), seconds (computing and gating; ``cpu_seconds`` the process's CPU time over
+    them), message, and ``contents`` ({file name: bytes or str}, empty when the verdict
+    writes nothing)."""
 
     operation: str
     exit: int
@@ -68,6 +69,7 @@ class OperationResult:
     seconds: float = 0.0
     message: str = ""
     contents: dict = field(default_factory=dict)
+    cpu_seconds: float = 0.0
 
 
 @dataclass
@@ -96,15 +98,17 @@ def run_operation(path: str, op: BatchOperation) -> OperationResult:
     """One operation on ``path``; the library's errors become the result's exit code and
     message, any other exception exit 1 (an internal error), so that one failing part
     never stops the batch."""
-    t0 = time.monotonic()
+    t0, cpu0 = time.monotonic(), time.process_time()
     try:
         done = operate(path, op.job, op.command, op.settings)
     except CadcncError as e:
         return OperationResult(op.label, e.exit_code, seconds=time.monotonic() - t0,
-                               message=str(e))
+                               message=str(e), cpu_seconds=time.process_time() - cpu0)
     except Exception as e:  # noqa: BLE001 - a bug in one part must not end the batch
         return OperationResult(op.label, EXIT_INTERNAL, seconds=time.monotonic() - t0,
-                               message=f"internal error: {type(e).__name__}: {e}")
+                               message=f"internal error: {type(e).__name__}: {e}",
+                               cpu_seconds=time.process_time() - cpu0)
+    cpu = time.process_time() - cpu0
     program, verdict = done.program, done.verdict
     found = len(program.cuts) + len(program.skipped)
     message = "; ".join(verdict.messages) or ("" if verdict.code == EXIT_OK else
@@ -112,7 +116,8 @@ def run_operation(path: str, op: BatchOperation) -> OperationResult:
     contents = rendered(done, op.outputs, op.command, op.settings) if verdict.write else {}
     return OperationResult(op.label, verdict.code, len(program.cuts),
                            len(program.cuts) / found if found else float("nan"),
-                           done.seconds_computed + done.seconds_gated, message, contents)
+                           done.seconds_computed + done.seconds_gated, message, contents,
+                           cpu)
 
 
 def run_part(part: BatchPart, batch: str = "") -> PartResult:
