@@ -33,6 +33,13 @@ CLI_MODULES = {"test_cli.py", "test_cli_program.py", "test_cli_smoke.py", "test_
                "test_batch.py", "test_waterline_cli.py"}
 
 
+def pytest_xdist_auto_num_workers(config):
+    """``-n auto``: a worker per core and one more. The HAL loop's module waits ~20 s on
+    real 1 ms periods with its core idle; the extra worker runs other modules meanwhile
+    (it costs one more collection, ~10 s of CPU)."""
+    return (os.cpu_count() or 1) + 1
+
+
 def pytest_collection_modifyitems(config, items):
     """The markers of pyproject.toml, by module: ``slow`` and ``cli``."""
     for item in items:

@@ -315,9 +315,16 @@ def test_path_refuses_a_pair_with_no_feasible_position(tmp_path):
 
 
 def test_verify_old_tolerance_spelling_still_gates(boss_outputs):
+    """``--tolerance`` parses into the very options ``--gouge-tolerance`` gives, and
+    ``main`` acts on nothing else: the strict gate that test_verify_saved_path_and_gate
+    runs (exit 5, "limit 1e-09") is this spelling's too, without a second 5 s gate."""
+    from cadcnc.cli.app import build_parser
+
     d, _ = boss_outputs
-    strict = cadcnc_cli("verify", d / "p.json", "--tolerance", "1e-9", "--quiet")
-    assert strict.returncode == 5 and "limit 1e-09" in strict.stderr
+    old, new = (vars(build_parser().parse_args(["verify", str(d / "p.json"), flag, "1e-9",
+                                                 "--quiet"]))
+                for flag in ("--tolerance", "--gouge-tolerance"))
+    assert old == new and old["gouge_tolerance"] == "1e-9"
 
 
 def test_safe_z_is_an_alias_of_clearance(tmp_path):

@@ -41,6 +41,10 @@ class Machine:
 
 
 MACHINE = Machine()
+# periods of the smooth stream (7 s at 1 ms; the same curve was 10 s): its speed reaches
+# 0.67 of the X and Y limits and its acceleration 0.45 of Y's (the 0.9 margin and the
+# "not trivially slow" floor below are asserted), and HAL waits 3 s fewer real periods
+N_SMOOTH = 7_000
 
 
 def derivatives(p: np.ndarray, dt: float):
@@ -81,7 +85,7 @@ def live_hal_processes() -> list[str]:
 
 
 def test_synthesised_streams_are_what_the_tests_claim():
-    v, a, j = derivatives(smooth_stream(10_000, MACHINE), MACHINE.period)
+    v, a, j = derivatives(smooth_stream(N_SMOOTH, MACHINE), MACHINE.period)
     assert (np.abs(v).max(0) < 0.9 * np.array(MACHINE.max_velocity)).all()
     assert (np.abs(a).max(0) < 0.9 * np.array(MACHINE.max_acceleration)).all()
     assert (np.abs(j).max(0) < 0.9 * np.array(MACHINE.max_jerk)).all()
@@ -92,13 +96,13 @@ def test_synthesised_streams_are_what_the_tests_claim():
 
 @pytest.fixture(scope="module")
 def smooth_run():
-    stream = smooth_stream(10_000, MACHINE)
+    stream = smooth_stream(N_SMOOTH, MACHINE)
     return stream, run_hal_loop(stream, MACHINE, limits="machine")
 
 
 def test_stream_within_limits_runs_unclipped_at_the_machine_limits(smooth_run):
     stream, r = smooth_run
-    assert r.streamed == 10_000 and r.read >= 10_000
+    assert r.streamed == N_SMOOTH and r.read >= N_SMOOTH
     assert r.underruns == 0 and r.overruns == 0
     assert r.command_error <= 1e-6
     assert r.clipped == 0, f"{r.clipped} samples clipped by limit3"
