@@ -144,7 +144,7 @@ def table(rows) -> str:
             out.append(f"| | OCL {key} | {o['deviation']['max']:.1e} | "
                        f"{sum(o['loops'])} loops, {sum(o['pieces_over'])} over the faces / "
                        f"{sum(r['expected'])} | {o['per_level_s']:.2f} | "
-                       f"{o['per_point_us']:.0f} ({o['per_point_us'] / c['per_point_us']:.0f}x) |")
+                       f"{o['per_point_us']:.0f} ({o['per_point_us'] / c['per_point_us']:.2g}x) |")
     return "\n".join(out)
 
 
