@@ -62,7 +62,7 @@ def check_jobs(jobs: int | None) -> int:
     if jobs is None:
         return default_jobs()
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
-        raise InputError(f"jobs must be a whole number of processes >= 1, got {jobs!r}")
+        raise InputError(f"jobs (--jobs) must be a whole number of processes >= 1, got {jobs!r}")
     return jobs
 
 

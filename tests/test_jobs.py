@@ -44,8 +44,8 @@ def descendants(pid: int) -> set[int]:
     parent = {int(p): _parent_of(p) for p in os.listdir("/proc") if p.isdigit()}
     out, todo = set(), [pid]
     while todo:
-        here = todo.pop()
-        kids = {c for c, pp in parent.items() if pp == here}
+        mine = todo.pop()
+        kids = {c for c, pp in parent.items() if pp == mine}
         out |= kids
         todo += kids
     return out
