@@ -36,6 +36,8 @@ ENV = "CADCNC_JOBS"
 """The default number of processes when none is given (unset: every core)."""
 WATCH_S = 0.5
 """How often (s) a worker checks that its parent process is still there."""
+KILL_AFTER_S = 2.0
+"""How long (s) a terminated worker has to end before it is killed outright."""
 _STATE: dict[str, Any] = {}   # in a worker: the part it rebuilt
 _POOLS: dict[int, tuple[Any, int, ProcessPoolExecutor]] = {}  # id(part) -> (part, jobs, pool)
 
@@ -78,10 +80,24 @@ def _init(build: Callable, args: tuple, parent: int) -> None:
 def _watch(parent: int) -> None:
     while True:
         time.sleep(WATCH_S)
-        try:
-            os.kill(parent, 0)
-        except OSError:
+        if not process_alive(parent):
             os._exit(1)
+
+
+def process_alive(pid: int) -> bool:
+    """Whether process ``pid`` runs: not gone, and not a zombie (a parent that has exited
+    but is not yet reaped still answers ``kill(pid, 0)``; a worker it started without
+    registering, e.g. at a Ctrl-C, would then wait for it, holding its output pipes)."""
+    try:
+        os.kill(pid, 0)
+    except OSError:
+        return False
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            state = f.read().rsplit(b")", 1)[1].split()[0]
+    except (OSError, IndexError):  # no /proc (not Linux), or gone meanwhile
+        return True
+    return state not in (b"Z", b"X")
 
 
 def _call(fn: Callable, task) -> Any:
@@ -113,11 +129,21 @@ def _context():
 
 def _shutdown(key: int, kill: bool = False) -> None:
     _, _, pool = _POOLS.pop(key)
-    if kill:  # Ctrl-C or a dead worker: stop every worker now, not after its task
-        for proc in list(getattr(pool, "_processes", {}).values()):
-            if proc.is_alive():
-                proc.terminate()
-    pool.shutdown(wait=True, cancel_futures=True)
+    if not kill:
+        pool.shutdown(wait=True, cancel_futures=True)
+        return
+    # Ctrl-C or a dead worker: stop every worker now, not after its task, and never wait
+    # on the pool's own teardown (its queue threads can block on a pipe no one reads).
+    procs = [p for p in list(getattr(pool, "_processes", {}).values()) if p.is_alive()]
+    for proc in procs:
+        proc.terminate()
+    deadline = time.monotonic() + KILL_AFTER_S
+    for proc in procs:
+        proc.join(max(deadline - time.monotonic(), 0.0))
+        if proc.is_alive():
+            proc.kill()
+            proc.join(KILL_AFTER_S)
+    pool.shutdown(wait=False, cancel_futures=True)
 
 
 def close() -> None:
