@@ -1,4 +1,4 @@
-"""Entries through free space (cadcnc/ops/entries.py, docs/entries.md), on the entry
+"""Entries through free space (cadcnc/ops/entries.py, docs/program.md "Entries"), on the entry
 fixtures (fixtures/build_entry_fixtures.py): a corner under overhangs higher than the
 shank is entered at its clear end, at a clear point between (cut both ways), or from the
 side; a corner in a sealed void is skipped as `unreachable`; finishing passes under an

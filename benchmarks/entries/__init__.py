@@ -1,3 +1,3 @@
-"""Entries through free space (docs/entries.md): the independent check of links and of
+"""Entries through free space (docs/program.md "Entries"): the independent check of links and of
 `unreachable` skips (``sweeps.py``), and the measurement on the pairs of issue 23
 (``pairs.py``)."""

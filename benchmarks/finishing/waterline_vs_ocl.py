@@ -132,7 +132,7 @@ def compare(name: str, tols, stepdown: float = STEPDOWN) -> dict:
 
 
 def table(rows) -> str:
-    """The markdown table of docs/finish.md."""
+    """The markdown table of docs/waterline.md "Current figures"."""
     out = ["| fixture | who | worst deviation mm | loops found / expected | s per level "
            "| µs per point |", "|---|---|---|---|---|---|"]
     for r in rows:
