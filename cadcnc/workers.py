@@ -132,8 +132,7 @@ def _shutdown(key: int, kill: bool = False) -> None:
     if not kill:
         pool.shutdown(wait=True, cancel_futures=True)
         return
-    # Ctrl-C or a dead worker: stop every worker now, not after its task, and never wait
-    # on the pool's own teardown (its queue threads can block on a pipe no one reads).
+    # Ctrl-C or a dead worker: stop every worker now, not after its task.
     procs = [p for p in list(getattr(pool, "_processes", {}).values()) if p.is_alive()]
     for proc in procs:
         proc.terminate()
@@ -143,7 +142,11 @@ def _shutdown(key: int, kill: bool = False) -> None:
         if proc.is_alive():
             proc.kill()
             proc.join(KILL_AFTER_S)
-    pool.shutdown(wait=False, cancel_futures=True)
+    # The pool's own teardown frees its queues (else Python warns of leaked semaphores),
+    # but is given a bounded time: its queue threads can block on a pipe no one reads.
+    ender = threading.Thread(target=pool.shutdown, kwargs={"cancel_futures": True}, daemon=True)
+    ender.start()
+    ender.join(KILL_AFTER_S)
 
 
 def close() -> None:

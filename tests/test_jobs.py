@@ -74,6 +74,7 @@ def test_ctrl_c_stops_every_worker_and_writes_nothing(tmp_path):
     run.send_signal(signal.SIGINT)
     _, err = run.communicate(timeout=60)
     assert run.returncode == EXIT_INTERRUPTED, err
+    assert err.strip().splitlines()[-1] == "cadcnc: interrupted", err  # no teardown noise
     alive, deadline = workers, time.monotonic() + 30  # the fork server's own teardown
     while alive and time.monotonic() < deadline:      # (OCCT, numba) takes about a second
         time.sleep(0.2)
