@@ -138,7 +138,7 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_parser(add, parser)
 
     p = add("run", "execute an APT-like part program (PATH = P/[...])",
-            "Execute an APT-like part program (grammar: docs/cli.md). Prints a summary per "
+            "Execute an APT-like part program (grammar: docs/notes/apt.md). Prints a summary per "
             "path, streams the per-period increments, or writes outputs.")
     p.add_argument("program", metavar="PROGRAM.apt")
     p.add_argument("--stream", action="store_true",

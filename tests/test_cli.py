@@ -1,8 +1,8 @@
 """Every command as a user runs it, in-process through ``main(argv)``.
 
 Outputs are parsed and compared with the Python API; error cases check the documented
-one-line messages and exit codes (docs/cli.md "Errors"). Expensive runs are module-scoped.
-The console script itself is exercised by the subprocess smoke tests in
+one-line messages and exit codes (docs/reliability.md "Exit codes"). Expensive runs are
+module-scoped. The console script itself is exercised by the subprocess smoke tests in
 test_cli_smoke.py.
 """
 

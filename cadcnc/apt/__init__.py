@@ -1,6 +1,6 @@
 """The APT-like part program: parse, check, and execute ``PATH = P/[S1, S2, IS, IE]``.
 
-The format (grammar in docs/cli.md) is ours, in the spirit of the paper's one-statement
+The format (grammar in docs/notes/apt.md) is ours, in the spirit of the paper's one-statement
 part program::
 
     $$ pencil path around the boss

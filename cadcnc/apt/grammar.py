@@ -1,4 +1,4 @@
-"""The APT-like language's syntax: tokens, statements, parser (grammar in docs/cli.md).
+"""The APT-like language's syntax: tokens, statements, parser (grammar in docs/notes/apt.md).
 
 Pure syntax: no file system, no geometry, no ranges. A statement carries its values in
 user units (mm, mm/min, s) and, in ``where``, the (line, column) of each value, so that
