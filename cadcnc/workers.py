@@ -24,9 +24,10 @@ import os
 import signal
 import threading
 import time
+from contextlib import contextmanager
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Iterator, Sequence
 
 from .errors import CadcncError, InputError
 
@@ -149,6 +150,22 @@ def _shutdown(key: int, kill: bool = False) -> None:
     ender.join(KILL_AFTER_S)
 
 
+@contextmanager
+def _ctrl_c_deferred() -> Iterator[None]:
+    """Hold a Ctrl-C (SIGINT) until the block ends. Submitting starts the pool's workers;
+    a Ctrl-C between a worker's start and its registration would leave it running,
+    unknown to the pool, and printing a traceback when it finds its queues gone."""
+    if threading.current_thread() is not threading.main_thread() or \
+            not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+
+
 def close() -> None:
     """Shut every kept pool down (its workers exit)."""
     for key in list(_POOLS):
@@ -180,7 +197,8 @@ def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: i
     pool = _pool(part, jobs, build, build_args)
     futures = {}
     try:
-        futures = {pool.submit(_call, fn, t): k for k, t in enumerate(tasks)}
+        with _ctrl_c_deferred():  # the pool starts its workers here: all or none registered
+            futures = {pool.submit(_call, fn, t): k for k, t in enumerate(tasks)}
         out: list = [None] * len(tasks)
         pending = set(futures)
         while pending:
