@@ -171,7 +171,8 @@ def _run(client: Client, todo: list[_Planned], state: Progress, progress) -> dic
 
     client.subscribe_topic(EVENT_TOPIC, on_start)
     futures = {client.submit(run_part, p.part, token, key=f"cadcnc-{p.part.label}-{token}",
-                             pure=False): p for p in todo}
+                             pure=False, priority=-rank): p
+               for rank, p in enumerate(sorted(todo, key=lambda p: -queue_size(p.part)))}
     records: dict[str, list[Record]] = {}
     for future in as_completed(futures):
         plan = futures[future]
@@ -192,6 +193,18 @@ def _run(client: Client, todo: list[_Planned], state: Progress, progress) -> dic
     client.unsubscribe_topic(EVENT_TOPIC)
     final = _attempts(client, token)
     return {name: _with_attempts(recs, final) for name, recs in records.items()}
+
+
+def queue_size(part: BatchPart) -> int:
+    """A part's place in the queue, largest first: its STEP file's bytes times its
+    operations, a proxy for its time, so that no long part starts last and leaves the
+    other workers idle (Dask runs higher priorities first). 0 for a missing file (its
+    task fails with its own message)."""
+    try:
+        n = os.path.getsize(part.path)
+    except OSError:
+        n = 0
+    return n * max(len(part.operations), 1)
 
 
 def _attempts(client: Client, token: str) -> dict[str, list[dict]]:
