@@ -40,14 +40,31 @@ def pytest_xdist_auto_num_workers(config):
     return (os.cpu_count() or 1) + 1
 
 
+# The modules that take longest (CPU, or real time waiting on HAL, a cluster, a signal),
+# longest first: xdist (``--dist loadscope --no-loadscope-reorder``) hands modules out in
+# this order, so that none of them starts last while the other workers sit idle
+# (docs/notes/suite-time.md). Modules not listed follow, the most tests first.
+LONGEST_FIRST = ["test_jobs.py", "test_hal_loop.py", "test_batch.py", "test_trim_grid.py",
+                 "test_finish.py", "test_gate.py", "test_cli.py", "test_verification.py",
+                 "test_outputs.py", "test_fuzz.py", "test_waterline_cli.py", "test_axis.py",
+                 "test_axis_finish.py", "test_fuzz_operations.py", "test_finish_reverse.py"]
+
+
 def pytest_collection_modifyitems(config, items):
-    """The markers of pyproject.toml, by module: ``slow`` and ``cli``."""
+    """The markers of pyproject.toml, by module: ``slow`` and ``cli``; the modules in
+    LONGEST_FIRST order (a module's tests stay together, in their order)."""
     for item in items:
         name = item.path.name
         if name in SLOW_MODULES:
             item.add_marker(pytest.mark.slow)
         if name in CLI_MODULES:
             item.add_marker(pytest.mark.cli)
+    count: dict = {}
+    for item in items:
+        count[item.path] = count.get(item.path, 0) + 1
+    rank = {name: k for k, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: (rank.get(item.path.name, len(rank)), -count[item.path],
+                                 str(item.path)))
 
 
 def load_fixture(name: str):
