@@ -95,7 +95,6 @@ class ClearanceGuard:
         self.closed_calls = 0    # closed-form distances
         self.broad_calls = 0
         self.bounded_calls = 0   # segment distances bounded from point distances
-        self._last_point: tuple = (None, None, None)   # (face, p, OCCT distance) last asked
 
     # -- the guard ------------------------------------------------------------------------
     def margin(self, p) -> tuple[float, str]:
@@ -195,10 +194,8 @@ class ClearanceGuard:
         if d is not None:
             return d, False
         if k not in self.pair and length > 0.0:
-            def point(s: float) -> float:   # s = 0: p itself (_exact may ask it again)
-                return self._point_distance(k, (p[0], p[1], p[2] + s) if s else p)
-
-            d = segment_lower_bound(point, length, self.threshold)
+            d = segment_lower_bound(lambda s: self._point_distance(k, (p[0], p[1], p[2] + s)),
+                                    length, self.threshold)
             if d is not None:   # clears R' - tol: a lower bound will do (the margin >= 0)
                 self.bounded_calls += 1
                 return d, False
@@ -290,14 +287,10 @@ class ClearanceGuard:
         if d is not None:
             self.closed_calls += 1
             return d
-        if self._last_point[:2] == (k, p):   # the segment bound's first sample, asked again
-            return self._last_point[2]
         self.exact_calls += 1
         face = self._faces[k - 1].topods
         ext = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(), face)
-        d = ext.Value() if ext.IsDone() and ext.NbSolution() else -math.inf
-        self._last_point = (k, p, d)
-        return d
+        return ext.Value() if ext.IsDone() and ext.NbSolution() else -math.inf
 
 
 _PART_DATA: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()

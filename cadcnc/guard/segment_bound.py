@@ -57,8 +57,7 @@ def segment_lower_bound(point_distance: Callable[[float], float], length: float,
     is the face's distance (mm) from the segment's point at s (any non-finite value:
     None, the caller measures exactly)."""
     need = need + SAFETY
-    d0 = point_distance(0.0)
-    d1 = point_distance(length) if math.isfinite(d0) and d0 >= need else -math.inf
+    d0, d1 = point_distance(0.0), point_distance(length)
     if not math.isfinite(d0 + d1) or min(d0, d1) < need:
         return None   # an end point itself is too near: the exact answer is wanted
     heap = [(interval_bound(0.0, length, d0, d1), 0.0, length, d0, d1)]
