@@ -45,7 +45,6 @@ from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.gp import gp_Pnt
 
 from .analytic import AnalyticFace
-from .segment_bound import segment_lower_bound
 from ..geometry.part import optimal_box
 from ..tolerances import DEFAULT
 
@@ -94,7 +93,6 @@ class ClearanceGuard:
         self.exact_calls = 0     # OCCT distances
         self.closed_calls = 0    # closed-form distances
         self.broad_calls = 0
-        self.bounded_calls = 0   # segment distances bounded from point distances
 
     # -- the guard ------------------------------------------------------------------------
     def margin(self, p) -> tuple[float, str]:
@@ -187,18 +185,11 @@ class ClearanceGuard:
         every nearest point of the face lies on an edge or vertex of face i or j): in
         closed form for an analytic face whose foot is inside it (then not on an edge);
         for a third face whose distance to its whole surface already clears R' - tol, that
-        distance (a lower bound: the margin stays >= 0); for a third face, a lower bound from
-        a few point distances where it clears R' - tol (:mod:`.segment_bound`); else OCCT's."""
+        distance (a lower bound: the margin stays >= 0); else OCCT's."""
         length = self.shank if length is None else length
         d = self._closed_segment_distance(k, p, length)
         if d is not None:
             return d, False
-        if k not in self.pair and length > 0.0:
-            d = segment_lower_bound(lambda s: self._point_distance(k, (p[0], p[1], p[2] + s)),
-                                    length, self.threshold)
-            if d is not None:   # clears R' - tol: a lower bound will do (the margin >= 0)
-                self.bounded_calls += 1
-                return d, False
         self.exact_calls += 1
         face = self._faces[k - 1].topods
         if self._analytic[k - 1].kind == "plane" and k not in self.pair:
