@@ -11,7 +11,9 @@ With a start point it runs one path as :func:`~cadcnc.ops.path.pair_path.path_fo
 except that a start outside every stretch moves to the nearest stretch limit, and the
 program's ``notes`` say so. Edges with no feasible position are listed in ``skipped``
 with the reason; a cut that stops before its stretch's end is kept and the rest of the
-stretch listed as ``stopped short`` (the program is then partial). Lengths mm.
+stretch listed as ``stopped short`` (the program is then partial), unless the stretch
+search's judge confirms a gap there that its samples missed: then the stretch ends at the
+stop and its rest is cut from the far side of the gap (:mod:`.stretch_split`). Lengths mm.
 """
 
 from __future__ import annotations

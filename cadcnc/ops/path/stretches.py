@@ -21,7 +21,9 @@ stretch (or a gap between stretches) can be missed only if it is shorter than th
 curve between two samples: under 0.5 mm wherever the curve turns less than ~50 deg
 over 0.45 mm. Intervals where a sample has no tangency, or could not be refined to
 MAX_CHORD, are counted in ``EdgeStretches.missed`` (a stretch of any length may hide
-there); they are never reported as feasible.
+there); they are never reported as feasible. A gap the samples miss is found by the
+stepper (every 0.1 mm step) and, when this judge confirms it, ends the stretch there
+(:mod:`.stretch_split`): an expected end, not a stop short.
 """
 
 from __future__ import annotations
