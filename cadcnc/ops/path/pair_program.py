@@ -11,7 +11,9 @@ With a start point it runs one path as :func:`~cadcnc.ops.path.pair_path.path_fo
 except that a start outside every stretch moves to the nearest stretch limit, and the
 program's ``notes`` say so. Edges with no feasible position are listed in ``skipped``
 with the reason; a cut that stops before its stretch's end is kept and the rest of the
-stretch listed as ``stopped short`` (the program is then partial). Lengths mm.
+stretch listed as ``stopped short`` (the program is then partial), unless the stretch
+search's judge confirms a gap there that its samples missed: then the stretch ends at the
+stop and its rest is cut from the far side of the gap (:mod:`.stretch_split`). Lengths mm.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from ..entries import entered_program_segments
 from ...guard import guard_for
 from .pair_path import PathPlan, plan_path, shared_edge_for, stepper_for
 from .stretch_paths import nearest_start, plan_for_stretch, refuse_without_stretch
+from .stretch_split import split_at_stop
 from .stretches import FEASIBLE, Feasibility, Stretch, pair_stretches
 
 LIMIT_SLACK = 1e-3
@@ -155,9 +158,10 @@ def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
         if not e.stretches:
             skipped.append(Skipped((i, j), NO_STRETCH, e.refusal, e.edge + 1))
             continue
-        for k, st in enumerate(e.stretches, 1):
-            if job.operation.stretch is not None and k != job.operation.stretch:
-                continue
+        todo = [(k, st) for k, st in enumerate(e.stretches, 1)
+                if job.operation.stretch is None or k == job.operation.stretch]
+        while todo:
+            k, st = todo.pop(0)
             cjob = _short_period(_cut_job(job, st, k), st)
             plan = replace(plan_for_stretch(s1, s2, cjob, st), job=cjob)
             if st.length <= POINT_STRETCH:
@@ -167,12 +171,17 @@ def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
             tp = run_stretch(plan, guard, max_cycles, progress)
             work["cycles"] += len(tp) - 1
             at_limit = _reached_limit(tp, st)
+            split = None if at_limit else split_at_stop(e, st, tp.points[-1])
+            if split is not None:   # a gap the search stepped over: the stretch ends here
+                st = split[0]
+                todo[:0] = [(k, rest) for rest in split[1]]
+                at_limit = _reached_limit(tp, st)
             if side is not None and at_limit and len(tp) > 2:
                 measure = climb_measure(tp)
                 if abs(measure) >= SIDE_MIN and (measure > 0) != (side == CLIMB):
                     back = run_stretch(_reversed(tp, plan), guard, max_cycles, progress)
                     work["cycles"] += len(back) - 1
-                    if back.complete or back.stop_reason in (BOUNDARY, COLLISION):
+                    if _reached_limit(back, replace(st, start=st.end, end=st.start)):
                         tp = back
             cuts.append(CutSegment(tp, edge=e.edge + 1, stretch=k, at_limit=at_limit))
             if not cuts[-1].at_limit:

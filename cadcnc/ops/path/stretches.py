@@ -21,7 +21,9 @@ stretch (or a gap between stretches) can be missed only if it is shorter than th
 curve between two samples: under 0.5 mm wherever the curve turns less than ~50 deg
 over 0.45 mm. Intervals where a sample has no tangency, or could not be refined to
 MAX_CHORD, are counted in ``EdgeStretches.missed`` (a stretch of any length may hide
-there); they are never reported as feasible.
+there); they are never reported as feasible. A gap the samples miss is found by the
+stepper (every 0.1 mm step) and, when this judge confirms it, ends the stretch there
+(:mod:`.stretch_split`): an expected end, not a stop short.
 """
 
 from __future__ import annotations
@@ -120,6 +122,8 @@ class EdgeStretches:
     samples: list[Sample] = field(default_factory=list)
     missed: int = 0
     why: str = ""         # why the edge was not searched (a degenerate edge)
+    curve: EdgeCurve | None = None      # the curve the samples are anchored on
+    judge: "Feasibility | None" = None  # the judge of its positions (stretch_split reuses it)
 
     @property
     def refusal(self) -> str | None:
@@ -241,18 +245,18 @@ def edge_stretches(feas: Feasibility, shared_edge, edge: int,
     k_lo, k_hi = (k_ext if go else 0 for go in extend)
     grid = np.concatenate([-step * np.arange(k_lo, 0, -1), grid,
                            curve.length + step * np.arange(1, k_hi + 1)])
-    out = EdgeStretches(edge, curve.length)
+    out = EdgeStretches(edge, curve.length, curve=curve, judge=feas)
     samples: list[Sample] = []
     for s in grid:   # each seeded from the last solved sample: stays on one branch
         last = next((x for x in reversed(samples[-1:]) if x.tangency is not None), None)
-        samples.append(_at(feas, curve, float(s), last))
+        samples.append(sample_at(feas, curve, float(s), last))
     samples = _refine(feas, curve, samples, out)
     out.samples = samples
     out.stretches = _stretches(feas, curve, samples, edge)
     return out
 
 
-def _at(feas: Feasibility, curve: EdgeCurve, s: float, seed: Sample | None) -> Sample:
+def sample_at(feas: Feasibility, curve: EdgeCurve, s: float, seed: Sample | None) -> Sample:
     anchor, tangent = curve.point_tangent(s)
     tan = seed.tangency if seed is not None else None
     got = feas.sample(s, anchor, tangent, tan)
@@ -280,14 +284,14 @@ def _refine(feas, curve, samples: list[Sample], out: EdgeStretches) -> list[Samp
                     # seeded from a's tangency, feasible or not, as the grid is: from the
                     # anchor alone Newton may land on another branch of the curve (millimetres
                     # away), and every halving would land there again
-                    stack.append(_at(feas, curve, 0.5 * (a.s + b.s), a))
+                    stack.append(sample_at(feas, curve, 0.5 * (a.s + b.s), a))
                     continue
                 out.missed += 1
             result.append(stack.pop())
     return result
 
 
-def _locate(feas, curve, good: Sample, bad: Sample) -> tuple[Sample, Sample]:
+def locate_limit(feas, curve, good: Sample, bad: Sample) -> tuple[Sample, Sample]:
     """Bisection on arc length between a feasible and an infeasible sample, until their
     centres are LIMIT_TOL apart (or the anchors 1e-12 mm): (last feasible, first failing)."""
     for _ in range(80):
@@ -296,7 +300,7 @@ def _locate(feas, curve, good: Sample, bad: Sample) -> tuple[Sample, Sample]:
             break
         if abs(bad.s - good.s) < 1e-12:
             break
-        mid = _at(feas, curve, 0.5 * (good.s + bad.s), good)
+        mid = sample_at(feas, curve, 0.5 * (good.s + bad.s), good)
         if mid.ok:
             good = mid
         else:
@@ -313,7 +317,7 @@ def _limit(feas, curve, good: Sample, bad: Sample | None) -> Limit:
                      "extension of the edge", good.s)
     if curve.closed and abs(bad.s - good.s) > 0.5 * curve.length:
         bad = replace(bad, s=bad.s + math.copysign(curve.length, good.s - bad.s))
-    good, bad = _locate(feas, curve, good, bad)
+    good, bad = locate_limit(feas, curve, good, bad)
     return Limit(good.tangency, bad.rule, bad.detail, good.s)
 
 
@@ -324,7 +328,7 @@ def _stretches(feas, curve, samples: list[Sample], edge: int) -> list[Stretch]:
         first = samples[0]
         lim = Limit(first.tangency, CLOSED, "feasible all around the closed edge", first.s)
         pts = [x.tangency for x in samples + [first]]
-        return [Stretch(edge, lim, lim, first.tangent, _polyline(pts), True)]
+        return [Stretch(edge, lim, lim, first.tangent, polyline_length(pts), True)]
     order = list(range(len(samples)))
     if curve.closed:   # start the walk at an infeasible sample, wrapping around
         k = ok.index(False)
@@ -348,11 +352,11 @@ def _stretches(feas, curve, samples: list[Sample], edge: int) -> list[Stretch]:
                        samples[before])
         end = _limit(feas, curve, samples[last], None if after is None else samples[after])
         pts = [start.tangency] + [samples[i].tangency for i in run] + [end.tangency]
-        out.append(Stretch(edge, start, end, samples[first].tangent, _polyline(pts)))
+        out.append(Stretch(edge, start, end, samples[first].tangent, polyline_length(pts)))
     return out
 
 
-def _polyline(tangencies: list[Tangency]) -> float:
+def polyline_length(tangencies: list[Tangency]) -> float:
     """Length of the polyline through the tangencies' centres, mm."""
     pts = np.array([t.p for t in tangencies])
     return float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
