@@ -26,6 +26,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ...errors import InputError
 from ...trim import OUTSIDE
@@ -39,6 +40,9 @@ DOWN_NZ = -1e-9
 MAX_SAMPLES = 60_000
 """Samples over all the selected faces at most (the grid is made coarser above)."""
 MIN_PER_SIDE = 4
+EDGE_ALONG = 0.5
+"""mm/mm: a boundary along which the centre coordinate changes slower than this runs along
+the planes (:func:`along_edges`)."""
 ESTIMATE_BINS = 2048
 """Bins of the plane coordinate over which the adaptive spacing's plane count is estimated."""
 
@@ -59,6 +63,9 @@ class FaceSamples:
     faces: np.ndarray
     areas: np.ndarray
     spacing: float
+    edge: np.ndarray | None = None
+    """(N,) whether the node lies on its face's boundary: a border of the grid that is not
+    a seam, or beside a node outside the trims (None: not known)."""
 
     def __len__(self) -> int:
         return len(self.points)
@@ -72,23 +79,23 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
     total = sum(lu * lw for lu, lw in extents) / spacing ** 2
     if total > max_samples:
         spacing *= math.sqrt(total / max_samples)
-    numbers, weights, derivs = [], [], []
+    numbers, weights, derivs, edge = [], [], [], []
     for s, (lu, lw) in zip(surfs, extents):
         nu = max(MIN_PER_SIDE, math.ceil(lu / spacing))
         nw = max(MIN_PER_SIDE, math.ceil(lw / spacing))
         (u0, u1), (w0, w1) = s.u_range, s.w_range
         us, wu = _nodes(u0, u1, nu)
         ws, ww = _nodes(w0, w1, nw)
-        uv = []
-        for u, du in zip(us, wu):
-            for w, dw in zip(ws, ww):
-                if s.classify(u, w) == OUTSIDE:
-                    continue
-                uv.append((u, w))
-                numbers.append(s.number)
-                weights.append(du * dw)
-        if uv:   # D2 at every node at once (compiled where the face allows)
-            derivs.extend(face_derivatives(s, np.array(uv)))
+        inside = np.array([[s.classify(u, w) != OUTSIDE for w in ws] for u in us])
+        numbers.extend([s.number] * int(inside.sum()))
+        weights.extend((wu[:, None] * ww[None, :])[inside].tolist())
+        wrap = [per is not None and abs(hi - lo - per) <= 1e-9 * max(1.0, per)
+                for per, (lo, hi) in ((s.u_period, s.u_range), (s.w_period, s.w_range))]
+        edge.extend(_edge_nodes(inside, *wrap)[inside].tolist())
+        uv = np.stack(np.meshgrid(us, ws, indexing="ij"), axis=-1).reshape(-1, 2)
+        uv = uv[inside.ravel()]
+        if len(uv):   # D2 at every node at once (compiled where the face allows)
+            derivs.extend(face_derivatives(s, uv))
     if not derivs:
         raise InputError(f"faces {', '.join(map(str, faces))}: no sample inside their trims")
     d = np.array(derivs)                                   # (N, 6, 3)
@@ -106,7 +113,20 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
     d, c, area, numbers = d[keep], c[keep], area[keep], numbers[keep]
     normals = np.array([sign[n] for n in numbers])[:, None] * c / area[:, None]
     return FaceSamples(d[:, 0], normals, d[:, 1], d[:, 2], d[:, 3], d[:, 4], d[:, 5],
-                       numbers, area * np.array(weights)[keep], spacing)
+                       numbers, area * np.array(weights)[keep], spacing,
+                       np.array(edge, bool)[keep])
+
+
+def _edge_nodes(inside: np.ndarray, wrap_u: bool, wrap_w: bool) -> np.ndarray:
+    """(nu + 1, nw + 1) whether each grid node is on the face's boundary: on a border of
+    the grid not joined to the opposite one (``wrap_u``, ``wrap_w``: a closed seam), or
+    beside a node outside the trims (4-neighbours)."""
+    pad = np.pad(inside, 1, constant_values=False)
+    if wrap_u:
+        pad[0, 1:-1], pad[-1, 1:-1] = inside[-2], inside[1]
+    if wrap_w:
+        pad[1:-1, 0], pad[1:-1, -1] = inside[:, -2], inside[:, 1]
+    return inside & ~(pad[:-2, 1:-1] & pad[2:, 1:-1] & pad[1:-1, :-2] & pad[1:-1, 2:])
 
 
 def _nodes(t0: float, t1: float, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -216,12 +236,34 @@ def plan_planes(samples: FaceSamples, radius: float, allowance: float, angle: fl
         first = 0.5 * (lo + hi) - 0.5 * (count - 1) * stepover
         return PlanePlan(angle, n, first + stepover * np.arange(count), f, reason)
     spacing = np.where(reason == "", centre_chord(scallop, k, radius, allowance) * g, np.inf)
+    spacing = np.where(along_edges(samples, f), 0.5 * spacing, spacing)
     estimate = work["planes_estimate"] = planes_estimate(lo, hi, f=f, spacing=spacing)
     refuse_over(f"finishing {hi - lo:.4g} mm across the planes (R' {r1:g} mm) for a "
                 f"scallop of {scallop:g} mm", estimate, max_planes, "guide planes",
                 "give a larger --scallop, or a smaller --radius")
     offsets = adaptive_offsets(f, spacing, lo, hi, limit=int(1.5 * estimate) + 2)
     return PlanePlan(angle, n, offsets, f, reason, spacing)
+
+
+def along_edges(samples: FaceSamples, f: np.ndarray) -> np.ndarray:
+    """(N,) the boundary samples (``samples.edge``) where the face's boundary runs along
+    the planes: the centre coordinate ``f`` (N,) changes by less than ``EDGE_ALONG`` mm per
+    mm to the two nearest boundary samples of the same face. There a pass whose contact
+    leaves the face is missing over a long stretch of the edge, and the edge is cut only
+    from the next plane inside: for its cusp to stay within H that plane must lie within
+    half a chord, so these samples allow half the spacing (docs/finish.md, "Spacing")."""
+    out = np.zeros(len(samples), bool)
+    if samples.edge is None:
+        return out
+    for face in np.unique(samples.faces):
+        idx = np.flatnonzero((samples.faces == face) & samples.edge)
+        if len(idx) < 3:
+            continue
+        p = samples.points[idx]
+        dist, near = cKDTree(p).query(p, k=3)
+        slope = np.abs(f[idx][near[:, 1:]] - f[idx][:, None]) / np.maximum(dist[:, 1:], 1e-12)
+        out[idx] = slope.max(axis=1) < EDGE_ALONG
+    return out
 
 
 def planes_estimate(lo: float, hi: float, *, stepover: float | None = None, f=None,
