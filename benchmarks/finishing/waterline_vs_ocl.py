@@ -69,23 +69,23 @@ def runs(over: np.ndarray, closed: bool = True) -> int:
 
 
 def cadcnc_run(name: str, stepdown: float):
-    """(part, program, seconds, loops_seconds, levels, per-level polylines) of cadcnc's
-    waterline. ``loops_seconds``: from reading the part to the last level's loops (samples,
-    critical heights, levels, OCCT's sections, loops; OCL's span: tessellation, STLSurf,
-    runs); ``seconds``: the whole program (also links and the uncut report)."""
+    """(part, program, times, levels, per-level polylines) of cadcnc's waterline; times:
+    (program s, loops s, program CPU s, loops CPU s). Loops: from reading the part to the
+    last level's loops (samples, critical heights, levels, OCCT's sections, loops; OCL's
+    span: tessellation, STLSurf, runs); program: also links and the uncut report."""
     marks = []
 
     def progress(done, total, what):
         if done == total and not marks:
-            marks.append(clock())
-    t0 = clock()
+            marks.append((clock(), time.process_time()))
+    t0, c0 = clock(), time.process_time()
     part = cadcnc.load_step(ROOT / "fixtures" / FIXTURES[name]["file"])
     prog = finish(part, FIXTURES[name]["faces"], radius=RADIUS[name],
               strategy="waterline", stepdown=stepdown, progress=progress)
-    seconds = clock() - t0
+    seconds, cpu = clock() - t0, time.process_time() - c0
     levels = sorted({round(float(c.points[0, 2]), 9) for c in prog.cuts}, reverse=True)
     per = {z: [c.points for c in prog.cuts if abs(c.points[0, 2] - z) < 1e-6] for z in levels}
-    return part, prog, seconds, marks[0] - t0, levels, per
+    return part, prog, (seconds, marks[0][0] - t0, cpu, marks[0][1] - c0), levels, per
 
 
 def ocl_run(triangles, levels, radius, adaptive: bool) -> dict:
@@ -101,12 +101,12 @@ def ocl_run(triangles, levels, radius, adaptive: bool) -> dict:
         cuts = np.cumsum([0, *sizes])
         loops = [pts[a:b] for a, b in zip(cuts[:-1], cuts[1:])]
         return dict(loops=loops, level_of=level_of, seconds=out["seconds"].tolist(),
-                    stl=float(out["stl"]))
+                    stl=float(out["stl"]), cpu=float(out["cpu"]))
 
 
 def compare(name: str, tols, stepdown: float = STEPDOWN) -> dict:
     """Every figure of one fixture (module doc)."""
-    part, prog, seconds, loops_s, levels, per = cadcnc_run(name, stepdown)
+    part, prog, (seconds, loops_s, cpu, loops_cpu), levels, per = cadcnc_run(name, stepdown)
     t0 = clock()
     gate = gate_program(prog, part)
     gate_s = clock() - t0
@@ -123,6 +123,7 @@ def compare(name: str, tols, stepdown: float = STEPDOWN) -> dict:
                            loops_s=loops_s, per_level_s=loops_s / len(levels),
                            per_point_us=1e6 * loops_s / points,
                            program_per_point_us=1e6 * seconds / points,
+                           cpu_s=cpu, loops_cpu_s=loops_cpu,
                            gate_ok=bool(gate.ok), gate_s=gate_s),
                ocl={}, cad_level=per[levels[0]])
     for tol in tols:
@@ -131,13 +132,14 @@ def compare(name: str, tols, stepdown: float = STEPDOWN) -> dict:
             o = ocl_run(tris, levels, rp, adaptive)
             dev = dist.measure(o["loops"])
             total = mesh_s + o["stl"] + sum(o["seconds"])
+            cpu = mesh_s + o["cpu"]   # (the mesh's in this process, unloaded as a rule)
             n = sum(len(p) for p in o["loops"])
             pieces = [0] * len(levels)
             for (signed, over), k in zip(dev.per_line(), o["level_of"]):
                 pieces[k] += runs(over) if len(over) else 0
             key = f"{'Adaptive' if adaptive else ''}Waterline {tol:g}"
             row["ocl"][key] = dict(
-                triangles=len(tris), seconds=total, mesh_s=mesh_s, points=n,
+                triangles=len(tris), seconds=total, mesh_s=mesh_s, points=n, cpu_s=cpu,
                 loops=[int(np.sum(o["level_of"] == k)) for k in range(len(levels))],
                 pieces_over=pieces, deviation=dev.summary(),
                 per_level_s=total / len(levels), per_point_us=1e6 * total / max(n, 1),
