@@ -6,6 +6,7 @@ uncut report of the free-form wall stays at or below the limit."""
 
 from __future__ import annotations
 
+import functools
 import json
 
 import numpy as np
@@ -17,13 +18,12 @@ from cadcnc.ops.finish.plan import across, along_edges, centre_chord, plan_plane
 from conftest import FIXTURES
 
 FACTS = json.loads((FIXTURES / "waterline_fixtures.json").read_text())
-_parts: dict = {}
 
 
+@functools.cache
 def part(name: str):
-    if name not in _parts:
-        _parts[name] = cadcnc.load_step(FIXTURES / FACTS[name]["file"])
-    return _parts[name]
+    """A waterline fixture's part, read once."""
+    return cadcnc.load_step(FIXTURES / FACTS[name]["file"])
 
 
 def test_edge_samples_are_the_fillets_two_circles_not_its_seam():
