@@ -46,6 +46,8 @@ MIN_PER_SIDE = 4
 EDGE_ALONG = 0.5
 """mm/mm: a boundary along which the centre coordinate changes slower than this runs along
 the planes (:func:`along_edges`)."""
+EDGE_STEEP_DEG = 60.0
+"""deg: boundary samples steeper than this get no edge interval."""
 EDGE_INSET = 0.125
 """The plane serving such a boundary lies at least this many spacings inside the face."""
 ESTIMATE_BINS = 2048
@@ -270,7 +272,10 @@ def along_edges(samples: FaceSamples, f: np.ndarray) -> np.ndarray:
         p = samples.points[idx]
         dist, near = cKDTree(p).query(p, k=3)
         slope = np.abs(f[idx][near[:, 1:]] - f[idx][:, None]) / np.maximum(dist[:, 1:], 1e-12)
-        along = slope.max(axis=1) < EDGE_ALONG
+        # on a steep edge (over EDGE_STEEP_DEG) the planes are close already (g small);
+        # in steep-shallow it is waterline's
+        steep = samples.normals[idx, 2] < math.cos(math.radians(EDGE_STEEP_DEG))
+        along = (slope.max(axis=1) < EDGE_ALONG) & ~steep
         inner = cKDTree(samples.points[mine]).query(p[along], k=min(9, len(mine)))[1]
         out[idx[along]] = np.sign((f[mine][inner] - f[idx[along]][:, None]).mean(axis=1))
     return out
