@@ -11,7 +11,7 @@ mm), ``length`` (cutter length), ``sampling`` (fibre spacing, mm), ``min_samplin
 (AdaptiveWaterline's finest), ``adaptive`` (0/1), ``threads``. OUT.npz: ``points`` (N, 3)
 ball centres of every loop (OCL's tool tips + R z), ``sizes`` (M,) points per loop,
 ``level_of`` (M,) the level index of each loop, ``seconds`` (L,) per level (setZ, run,
-getLoops), ``stl`` s building the STLSurf.
+getLoops), ``stl`` s building the STLSurf, ``cpu`` the process's CPU seconds of both.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import opencamlib as ocl
 
 
 def waterline(triangles, levels, radius, length, sampling, min_sampling, adaptive, threads):
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     surf = ocl.STLSurf()
     for a, b, c in triangles.tolist():
         surf.addTriangle(ocl.Triangle(ocl.Point(*a), ocl.Point(*b), ocl.Point(*c)))
@@ -45,12 +45,13 @@ def waterline(triangles, levels, radius, length, sampling, min_sampling, adaptiv
         loops = wl.getLoops()
         got = [[(p.x, p.y, p.z + radius) for p in loop] for loop in loops]
         seconds.append(time.perf_counter() - t0)
+        cpu = time.process_time() - c0
         for loop in got:
             points.extend(loop)
             sizes.append(len(loop))
             level_of.append(k)
     return (np.array(points, float).reshape(-1, 3), np.array(sizes, int),
-            np.array(level_of, int), np.array(seconds), stl)
+            np.array(level_of, int), np.array(seconds), stl, cpu)
 
 
 def main(argv: list[str]) -> int:
@@ -58,12 +59,12 @@ def main(argv: list[str]) -> int:
         print(__doc__, file=sys.stderr)
         return 2
     d = np.load(argv[0])
-    points, sizes, level_of, seconds, stl = waterline(
+    points, sizes, level_of, seconds, stl, cpu = waterline(
         d["triangles"], d["levels"], float(d["radius"]), float(d["length"]),
         float(d["sampling"]), float(d["min_sampling"]), bool(d["adaptive"]),
         int(d["threads"]))
     np.savez(argv[1], points=points, sizes=sizes, level_of=level_of, seconds=seconds,
-             stl=stl)
+             stl=stl, cpu=cpu)
     return 0
 
 

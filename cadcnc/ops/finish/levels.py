@@ -33,6 +33,7 @@ import numpy as np
 
 from ...errors import InputError
 from ...work import MAX_PLANES, refuse_over
+from .polish import face_derivatives
 from .plan import FaceSamples, across, adaptive_offsets, centre_chord, planes_estimate
 
 FLAT_DEG = 5.0
@@ -70,23 +71,48 @@ def sample_reasons(samples: FaceSamples, k, g, offset: float) -> np.ndarray:
     return reason
 
 
-def _tangency(surface, uv, iterations: int = 12):
-    """(u, w) near ``uv`` where the face's normal is vertical (Gauss-Newton on N_x, N_y,
-    finite-difference Jacobian), or None when it does not converge inside the face."""
-    u, w = map(float, uv)
-    for _ in range(iterations):
-        n = surface.normal(u, w)
-        if math.hypot(n[0], n[1]) < 1e-13:
-            return u, w
-        h = 1e-6 * max(1.0, abs(u), abs(w))
-        ju = (surface.normal(u + h, w) - n)[:2] / h
-        jw = (surface.normal(u, w + h) - n)[:2] / h
-        step = np.linalg.lstsq(np.stack([ju, jw], axis=1), -n[:2], rcond=None)[0]
-        u, w = u + float(step[0]), w + float(step[1])
-        if not surface.contains(u, w):
-            return None
-    n = surface.normal(u, w)
-    return (u, w) if math.hypot(n[0], n[1]) < 1e-10 else None
+def _tangencies(surface, uv: np.ndarray, iterations: int = 12) -> list[tuple[float, float]]:
+    """(u, w) of the points where the face's normal is vertical, found from the starts
+    ``uv`` (M, 2): Newton on N_x = N_y = 0 for all starts at once, the Jacobian of N from
+    the compiled second derivatives (Weingarten); a start that leaves the parameter box
+    is dropped, one that converges outside the trims too."""
+    uv = np.array(uv, dtype=float).reshape(-1, 2)
+    (u0, u1), (w0, w1) = surface.u_range, surface.w_range
+    live = np.ones(len(uv), bool)
+    done = np.zeros(len(uv), bool)
+    for it in range(iterations + 1):
+        act = np.flatnonzero(live & ~done)
+        if not len(act):
+            break
+        d = face_derivatives(surface, uv[act])
+        ru, rw, ruu, ruw, rww = (d[:, k] for k in range(1, 6))
+        m = np.cross(ru, rw)
+        mn = np.linalg.norm(m, axis=1)[:, None]
+        mh = m / mn
+        nxy = surface.normal_sign * mh[:, :2]
+        small = np.hypot(nxy[:, 0], nxy[:, 1])
+        done[act[small < 1e-13]] = True
+        if it == iterations:
+            done[act[small < 1e-10]] = True
+            break
+        cols = []
+        for dm in (np.cross(ruu, rw) + np.cross(ru, ruw), np.cross(ruw, rw) + np.cross(ru, rww)):
+            cols.append(surface.normal_sign * (dm - mh * np.einsum("ij,ij->i", mh, dm)[:, None])
+                        / mn)
+        a, b, c, e = cols[0][:, 0], cols[1][:, 0], cols[0][:, 1], cols[1][:, 1]
+        det = a * e - b * c
+        ok = np.abs(det) > 1e-300
+        det = np.where(ok, det, 1.0)
+        du = -(e * nxy[:, 0] - b * nxy[:, 1]) / det
+        dw = -(a * nxy[:, 1] - c * nxy[:, 0]) / det
+        step = ~done[act] & ok
+        uv[act[step], 0] += du[step]
+        uv[act[step], 1] += dw[step]
+        live[act[~ok]] = False
+        out_u = ((uv[:, 0] < u0) | (uv[:, 0] > u1)) & (surface.u_period is None)
+        out_w = ((uv[:, 1] < w0) | (uv[:, 1] > w1)) & (surface.w_period is None)
+        live &= ~(out_u | out_w)
+    return [(float(u), float(w)) for u, w in uv[live & done] if surface.contains(u, w)]
 
 
 def critical_heights(part, faces, samples: FaceSamples, offset: float) -> list[tuple[float, str]]:
@@ -106,14 +132,13 @@ def critical_heights(part, faces, samples: FaceSamples, offset: float) -> list[t
         near = near[np.argsort(-samples.normals[near, 2])]   # the flattest first
         cells = np.floor(samples.points[near, :2] / START_MM).astype(np.int64)
         _, first = np.unique(cells, axis=0, return_index=True)   # the flattest per cell
-        for i in near[np.sort(first)][:MAX_STARTS]:
-            uv = s.project(samples.points[i])[:2]
-            found = _tangency(s, uv)
-            if found is not None:
-                c = s.point(*found) + offset * s.normal(*found)
-                if not any(abs(c[2] - z) < CRITICAL_MM for z, _ in out):
-                    out.append((float(c[2]), f"face {n}, horizontal tangency at "
-                                f"({c[0]:.3f}, {c[1]:.3f})"))
+        starts = near[np.sort(first)][:MAX_STARTS]
+        uv = np.array([s.project(samples.points[i])[:2] for i in starts]).reshape(-1, 2)
+        for found in _tangencies(s, uv):
+            c = s.point(*found) + offset * s.normal(*found)
+            if not any(abs(c[2] - z) < CRITICAL_MM for z, _ in out):
+                out.append((float(c[2]), f"face {n}, horizontal tangency at "
+                            f"({c[0]:.3f}, {c[1]:.3f})"))
     return out
 
 

@@ -17,7 +17,10 @@ circular cross-section; sqrt(1 - (n . N)^2) turns that distance on the offset su
 the distance between the planes (a slope across the passes brings them closer). Samples
 the ball cannot serve are set apart with their reason: normals pointing down
 (``unreachable``), concave tighter than the ball (``too tight``), within
-``PARALLEL_DEG`` of parallel to the planes (``parallel wall``). Lengths mm.
+``PARALLEL_DEG`` of parallel to the planes (``parallel wall``). Where a face's boundary
+runs along the planes, a plane whose contact leaves the face there has no pass over a long
+stretch of the edge; the edge is then cut from the next plane inside only, which must lie
+within half a chord of it (:func:`along_edges`, :func:`edge_intervals`). Lengths mm.
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ...errors import InputError
 from ...trim import OUTSIDE
@@ -39,6 +43,13 @@ DOWN_NZ = -1e-9
 MAX_SAMPLES = 60_000
 """Samples over all the selected faces at most (the grid is made coarser above)."""
 MIN_PER_SIDE = 4
+EDGE_ALONG = 0.5
+"""mm/mm: a boundary along which the centre coordinate changes slower than this runs along
+the planes (:func:`along_edges`)."""
+EDGE_STEEP_DEG = 60.0
+"""deg: boundary samples steeper than this get no edge interval."""
+EDGE_INSET = 0.125
+"""The plane serving such a boundary lies at least this many spacings inside the face."""
 ESTIMATE_BINS = 2048
 """Bins of the plane coordinate over which the adaptive spacing's plane count is estimated."""
 
@@ -59,6 +70,9 @@ class FaceSamples:
     faces: np.ndarray
     areas: np.ndarray
     spacing: float
+    edge: np.ndarray | None = None
+    """(N,) whether the node lies on its face's boundary: a border of the grid that is not
+    a seam, or beside a node outside the trims (None: not known)."""
 
     def __len__(self) -> int:
         return len(self.points)
@@ -72,23 +86,23 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
     total = sum(lu * lw for lu, lw in extents) / spacing ** 2
     if total > max_samples:
         spacing *= math.sqrt(total / max_samples)
-    numbers, weights, derivs = [], [], []
+    numbers, weights, derivs, edge = [], [], [], []
     for s, (lu, lw) in zip(surfs, extents):
         nu = max(MIN_PER_SIDE, math.ceil(lu / spacing))
         nw = max(MIN_PER_SIDE, math.ceil(lw / spacing))
         (u0, u1), (w0, w1) = s.u_range, s.w_range
         us, wu = _nodes(u0, u1, nu)
         ws, ww = _nodes(w0, w1, nw)
-        uv = []
-        for u, du in zip(us, wu):
-            for w, dw in zip(ws, ww):
-                if s.classify(u, w) == OUTSIDE:
-                    continue
-                uv.append((u, w))
-                numbers.append(s.number)
-                weights.append(du * dw)
-        if uv:   # D2 at every node at once (compiled where the face allows)
-            derivs.extend(face_derivatives(s, np.array(uv)))
+        inside = np.array([[s.classify(u, w) != OUTSIDE for w in ws] for u in us])
+        numbers.extend([s.number] * int(inside.sum()))
+        weights.extend((wu[:, None] * ww[None, :])[inside].tolist())
+        wrap = [per is not None and abs(hi - lo - per) <= 1e-9 * max(1.0, per)
+                for per, (lo, hi) in ((s.u_period, s.u_range), (s.w_period, s.w_range))]
+        edge.extend(_edge_nodes(inside, *wrap)[inside].tolist())
+        uv = np.stack(np.meshgrid(us, ws, indexing="ij"), axis=-1).reshape(-1, 2)
+        uv = uv[inside.ravel()]
+        if len(uv):   # D2 at every node at once (compiled where the face allows)
+            derivs.extend(face_derivatives(s, uv))
     if not derivs:
         raise InputError(f"faces {', '.join(map(str, faces))}: no sample inside their trims")
     d = np.array(derivs)                                   # (N, 6, 3)
@@ -106,7 +120,20 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
     d, c, area, numbers = d[keep], c[keep], area[keep], numbers[keep]
     normals = np.array([sign[n] for n in numbers])[:, None] * c / area[:, None]
     return FaceSamples(d[:, 0], normals, d[:, 1], d[:, 2], d[:, 3], d[:, 4], d[:, 5],
-                       numbers, area * np.array(weights)[keep], spacing)
+                       numbers, area * np.array(weights)[keep], spacing,
+                       np.array(edge, bool)[keep])
+
+
+def _edge_nodes(inside: np.ndarray, wrap_u: bool, wrap_w: bool) -> np.ndarray:
+    """(nu + 1, nw + 1) whether each grid node is on the face's boundary: on a border of
+    the grid not joined to the opposite one (``wrap_u``, ``wrap_w``: a closed seam), or
+    beside a node outside the trims (4-neighbours)."""
+    pad = np.pad(inside, 1, constant_values=False)
+    if wrap_u:
+        pad[0, 1:-1], pad[-1, 1:-1] = inside[-2], inside[1]
+    if wrap_w:
+        pad[1:-1, 0], pad[1:-1, -1] = inside[:, -2], inside[:, 1]
+    return inside & ~(pad[:-2, 1:-1] & pad[2:, 1:-1] & pad[1:-1, :-2] & pad[1:-1, 2:])
 
 
 def _nodes(t0: float, t1: float, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -220,8 +247,49 @@ def plan_planes(samples: FaceSamples, radius: float, allowance: float, angle: fl
     refuse_over(f"finishing {hi - lo:.4g} mm across the planes (R' {r1:g} mm) for a "
                 f"scallop of {scallop:g} mm", estimate, max_planes, "guide planes",
                 "give a larger --scallop, or a smaller --radius")
-    offsets = adaptive_offsets(f, spacing, lo, hi, limit=int(1.5 * estimate) + 2)
+    a, e = edge_intervals(along_edges(samples, f), f, spacing)
+    extra = int(np.ceil((e.max() - a.min()) / (e - a).min())) + 1 if len(a) else 0
+    offsets = adaptive_offsets(f, spacing, lo, hi, limit=int(1.5 * estimate) + 2 + extra,
+                               edges=(a, e))
     return PlanePlan(angle, n, offsets, f, reason, spacing)
+
+
+def along_edges(samples: FaceSamples, f: np.ndarray) -> np.ndarray:
+    """(N,) for each boundary sample (``samples.edge``) where the face's boundary runs
+    along the planes (the centre coordinate ``f`` (N,) changes by less than ``EDGE_ALONG``
+    mm per mm to the two nearest boundary samples of the same face) the side of f the face
+    lies on (+1 or -1: its nearest samples' mean); 0 elsewhere. There a pass whose contact
+    leaves the face is missing over a long stretch of the edge, which is then cut from the
+    next plane inside only (:func:`edge_intervals`)."""
+    out = np.zeros(len(samples))
+    if samples.edge is None:
+        return out
+    for face in np.unique(samples.faces):
+        mine = np.flatnonzero(samples.faces == face)
+        idx = mine[samples.edge[mine]]
+        if len(idx) < 3:
+            continue
+        p = samples.points[idx]
+        dist, near = cKDTree(p).query(p, k=3)
+        slope = np.abs(f[idx][near[:, 1:]] - f[idx][:, None]) / np.maximum(dist[:, 1:], 1e-12)
+        # on a steep edge (over EDGE_STEEP_DEG) the planes are close already (g small);
+        # in steep-shallow it is waterline's
+        steep = samples.normals[idx, 2] < math.cos(math.radians(EDGE_STEEP_DEG))
+        along = (slope.max(axis=1) < EDGE_ALONG) & ~steep
+        inner = cKDTree(samples.points[mine]).query(p[along], k=min(9, len(mine)))[1]
+        out[idx[along]] = np.sign((f[mine][inner] - f[idx[along]][:, None]).mean(axis=1))
+    return out
+
+
+def edge_intervals(side: np.ndarray, f: np.ndarray, spacing: np.ndarray):
+    """(a, e): for each boundary sample running along the planes (``side`` != 0, finite
+    ``spacing``), the interval of f (mm) that must hold a plane: within half its chord
+    of it on the face's side (and ``EDGE_INSET`` of a spacing inside it: a plane through
+    the edge itself would run along it), so that the edge's cusp stays within H there."""
+    sel = (side != 0) & np.isfinite(spacing)
+    half, inner = 0.5 * spacing[sel], EDGE_INSET * spacing[sel]
+    lo = np.where(side[sel] > 0, f[sel] + inner, f[sel] - half)
+    return lo, lo + half - inner
 
 
 def planes_estimate(lo: float, hi: float, *, stepover: float | None = None, f=None,
@@ -252,37 +320,49 @@ def planes_estimate(lo: float, hi: float, *, stepover: float | None = None, f=No
 
 
 def adaptive_offsets(f: np.ndarray, spacing: np.ndarray, lo: float, hi: float,
-                     limit: int = MAX_PLANES) -> np.ndarray:
+                     limit: int = MAX_PLANES, edges=None) -> np.ndarray:
     """Plane offsets from ``lo`` to ``hi`` (mm): the first within half the spacing its
     samples allow of ``lo``, each next as far from the last as the smallest ``spacing``
     (N,) of the samples whose ``f`` (N,) lies between them, the last within half a spacing
-    of ``hi``. More than ``limit`` planes is an error (the estimate was wrong)."""
+    of ``hi``. ``edges``: intervals (a, e) (M,) each of which must hold a plane: a next
+    plane comes no later than the first end e of an interval starting after the last
+    (the greedy stabbing). More than ``limit`` planes is an error (the estimate was
+    wrong)."""
     order = np.argsort(f)
     fs, sp = f[order], spacing[order]
     finite = sp[np.isfinite(sp)]
     if not len(finite):
         return np.array([0.5 * (lo + hi)])
     widest = float(finite.max())
+    a, e = (np.zeros(0), np.zeros(0)) if edges is None else map(np.asarray, edges)
+    by = np.argsort(a)
+    a = a[by]
+    ends = np.minimum.accumulate(e[by][::-1])[::-1] if len(a) else e   # min end of a[i:]
 
-    def allowed(a: float) -> float:
-        """The smallest spacing of the samples in [a, a + d], shrinking d to it."""
+    def allowed(x: float) -> float:
+        """The smallest spacing of the samples in [x, x + d], shrinking d to it."""
         d = widest
         for _ in range(60):
-            i, j = np.searchsorted(fs, a), np.searchsorted(fs, a + d, side="right")
+            i, j = np.searchsorted(fs, x, side="left"), np.searchsorted(fs, x + d, side="right")
             m = float(sp[i:j].min()) if j > i else math.inf
             if m >= d:
                 return d
             d = m
         return d
 
-    first = lo + 0.5 * allowed(lo)
-    out = [first]
+    def due(x: float, strict: bool = True) -> float:
+        """The first end of the intervals starting after x (inf when none)."""
+        i = np.searchsorted(a, x, side="right" if strict else "left")
+        return float(ends[i]) if i < len(a) else math.inf
+
+    out = [min(lo + 0.5 * allowed(lo), due(lo, strict=False))]
     while True:
         d = allowed(out[-1])
-        if out[-1] + 0.5 * d >= hi:
+        nxt = due(out[-1])
+        if out[-1] + 0.5 * d >= hi and nxt == math.inf:
             break
         if len(out) >= limit:
             raise RuntimeError(f"adaptive spacing: more than {limit} planes, over 1.5 times "
                                "the estimate")
-        out.append(out[-1] + d)
+        out.append(min(out[-1] + d, nxt))
     return np.array(out)

@@ -42,7 +42,7 @@ def subset(samples: FaceSamples, mask: np.ndarray) -> FaceSamples:
     """The samples where ``mask`` (N,) is True."""
     return FaceSamples(*(getattr(samples, k)[mask] for k in (
         "points", "normals", "ru", "rw", "ruu", "ruw", "rww", "faces", "areas")),
-        samples.spacing)
+        samples.spacing, None if samples.edge is None else samples.edge[mask])
 
 
 def steep_mask(normals: np.ndarray, threshold_deg: float) -> np.ndarray:

@@ -195,7 +195,10 @@ def _reasons(reason, left, samples, q, part, job, n) -> np.ndarray:
         idx = np.nonzero(open_ & (samples.faces == face))[0]
         guard = ClearanceGuard(part, (int(face), int(face)), job.tool.offset,
                                job.tool.shank, job.tolerances.hit)
-        probe = idx[np.linspace(0, len(idx) - 1, min(len(idx), GUARD_SAMPLES)).astype(int)]
+        # one probe per cell of side R' (the tool's scale), at most GUARD_SAMPLES
+        cells = np.floor(q[idx] / max(job.tool.offset, 1e-3)).astype(np.int64)
+        probe = idx[np.sort(np.unique(cells, axis=0, return_index=True)[1])]
+        probe = probe[np.linspace(0, len(probe) - 1, min(len(probe), GUARD_SAMPLES)).astype(int)]
         hit = np.array([guard.margin(q[i])[0] < 0.0 for i in probe])
         # every sample takes the verdict of the nearest probed one
         nearest = cKDTree(q[probe]).query(q[idx])[1]
