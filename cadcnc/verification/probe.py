@@ -38,6 +38,10 @@ from ..trim import BOUNDARY, INSIDE, OUTSIDE
 _STATES = {TopAbs_IN: INSIDE, TopAbs_ON: BOUNDARY}
 NEWTON_PARAMETER_PRECISION = 1e-12
 """Convergence of the seeded Newton search in (u, w): a solver precision, not a threshold."""
+EDGE_CLEAR = 1e-6
+"""How much farther (mm) than an interior foot every edge must be for that foot to be the
+face's nearest point (:meth:`FaceProbe.interior_distance`): DistShapeShape counts a
+boundary point within its precision (1e-7) of the nearest distance as a foot too."""
 SEGMENT_AS_POINT = 1e-7
 """A segment shorter than this (mm, OCCT's Precision::Confusion) has no edge: its
 midpoint's distance less half its length stands for it (a lower bound, within 1e-7)."""
@@ -65,7 +69,7 @@ class FaceProbe:
                                               NEWTON_PARAMETER_PRECISION)
         self._dss = BRepExtrema_DistShapeShape()
         self._dss.LoadS2(topods_face)
-        self._p, self._du, self._dw = gp_Pnt(), gp_Vec(), gp_Vec()
+        self._p, self._du, self._dw, self._q = gp_Pnt(), gp_Vec(), gp_Vec(), gp_Pnt()
         self._bbox = None
         self._fclass = None
         self._project = None
@@ -92,7 +96,8 @@ class FaceProbe:
 
     def project_seeded(self, point, u0: float, w0: float):
         """(u, w, distance) by a local Newton search started at (u0, w0), or None."""
-        self._locate.Perform(gp_Pnt(*point), float(u0), float(w0))
+        self._q.SetCoord(float(point[0]), float(point[1]), float(point[2]))
+        self._locate.Perform(self._q, float(u0), float(w0))
         if not self._locate.IsDone():
             return None
         u, w = self._locate.Point().Parameter()
@@ -121,8 +126,11 @@ class FaceProbe:
 
     def signed(self, point, u: float, w: float, dist: float) -> float:
         """``dist`` signed by the side of the surface the point is on (+ out of material)."""
-        n = self.normal(u, w)
-        side = (np.asarray(point) - self._p.Coord()) @ n  # _p: the foot point
+        self.adaptor.D1(u, w, self._p, self._du, self._dw)  # _p: the foot point
+        nx, ny, nz = self._du.Crossed(self._dw).Coord()
+        qx, qy, qz = self._p.Coord()
+        side = self.sign * ((float(point[0]) - qx) * nx + (float(point[1]) - qy) * ny
+                            + (float(point[2]) - qz) * nz)  # along the normal, unscaled
         return dist if side >= 0 else -dist
 
     # -- trimmed face ------------------------------------------------------------------
@@ -242,6 +250,24 @@ class FaceProbe:
             return None
         d = self.edge_gap(point)
         return (d, d) if math.isfinite(d) else None
+
+    def interior_distance(self, point) -> tuple[float, float] | None:
+        """:meth:`face_distance` where OCCT's global search over the face's parameter box
+        (:meth:`project_global`, the search DistShapeShape runs on the face) finds its
+        nearest surface point inside the trimmed face, and OCCT's projections on the
+        face's edges (:meth:`edge_gap`) are all farther by :data:`EDGE_CLEAR`: no point of
+        the face is nearer (an interior one would be a nearer point of the box, a boundary
+        one a nearer point of an edge), and no boundary point ties. None elsewhere
+        (DistShapeShape decides)."""
+        found = self.project_global(point)
+        if found is None:
+            return None
+        u, w, d = found
+        if not d >= self.tol.noise or self.state(u, w) != INSIDE:
+            return None
+        if not self.edge_gap(point, d + EDGE_CLEAR) >= d + EDGE_CLEAR:
+            return None
+        return self.signed(point, u, w, d), d
 
     def bbox(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) corners of the face's optimal bounding box, mm (computed once)."""
