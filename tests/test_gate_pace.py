@@ -3,8 +3,9 @@
 - Faces that are planes in all but name (the extruded sides of finish_slab and
   bspline_boss) get a twin on a true plane: its closed form equals DistShapeShape's
   distance to the face, signed and unsigned, within 1e-9 mm; curved faces get none.
-- An interior foot proven nearest by OCCT's global search and its edge projections
-  (:meth:`FaceProbe.interior_distance`) is DistShapeShape's distance within 1e-9 mm.
+- An interior foot proven nearest (OCCT's global search, or the radial foot on a
+  cylinder, sphere or torus, and OCCT's edge projections:
+  :meth:`FaceProbe.interior_distance`) is DistShapeShape's distance within 1e-9 mm.
 - Moves are matched to the same centres as the windowed rule did (k-d tree shortcut).
 - A finishing program on finish_slab (extruded sides, B-spline top), clean and seeded
   with a gouge: the same verdicts and depths as the reference gate.
@@ -18,7 +19,8 @@ import numpy as np
 import pytest
 
 import cadcnc
-from OCP.GeomAbs import GeomAbs_SurfaceOfExtrusion
+from OCP.GeomAbs import (GeomAbs_BSplineSurface, GeomAbs_Cylinder, GeomAbs_Sphere,
+                         GeomAbs_SurfaceOfExtrusion, GeomAbs_Torus)
 from cadcnc.job import Finish, Job, Tool
 from cadcnc.program.program import CutSegment, Program
 from cadcnc.verification import gate_program
@@ -60,13 +62,18 @@ def test_planar_twins_give_occts_distances(name):
     assert twins == 4 and compared > 60
 
 
-@pytest.mark.parametrize("name, faces", [("bspline_boss", [5, 6, 7]),
-                                         ("crossing_cylinders", [1, 2])])
-def test_interior_feet_give_occts_distances(name, faces):
+@pytest.mark.parametrize("name, kinds", [
+    ("bspline_boss", {GeomAbs_BSplineSurface}),        # OCCT's global search
+    ("sphere_cylinder", {GeomAbs_Sphere, GeomAbs_Cylinder}),   # radial feet
+    ("fillet_pocket", {GeomAbs_Torus}),
+])
+def test_interior_feet_give_occts_distances(name, kinds):
     part = _load(name)
     found = 0
-    for k in faces:
+    for k in range(1, len(part) + 1):
         probe = FaceProbe(part.face(k).topods, part.tol)
+        if probe.adaptor.GetType() not in kinds:
+            continue
         for p in _around(probe, 30, k):
             fast = probe.interior_distance(p)
             if fast is not None:
@@ -128,3 +135,22 @@ def test_a_slab_finish_gets_the_reference_verdicts():
     assert [r.ok for r in ref.results] == [True, False, True]
     for a, b in zip(ref.results, fast.results):
         same(a, b)
+
+
+def test_a_whole_box_face_answers_by_its_edges_beyond_them():
+    """finish_slab's B-spline top is its whole parameter box; points all around it,
+    beyond its edges too, get DistShapeShape's distance (unsigned at an edge, as it
+    gives it); a face trimmed out of its surface is not taken for its box."""
+    part = _load("finish_slab")
+    top = FaceProbe(part.face(5).topods, part.tol)
+    assert top.natural()
+    edges = 0
+    for p in _around(top, 60, 5):
+        fast, exact = top.interior_distance(p), top.face_distance(p)
+        assert fast is not None
+        np.testing.assert_allclose(fast, exact, atol=DEPTH)
+        edges += fast[0] == fast[1] and exact[0] == exact[1]
+    assert edges > 10
+    pocket = _load("fillet_pocket")
+    assert not all(FaceProbe(pocket.face(k).topods, pocket.tol).natural()
+                   for k in range(1, len(pocket) + 1))

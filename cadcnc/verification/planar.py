@@ -106,10 +106,10 @@ def _agrees(probe: FaceProbe, twin: FaceProbe) -> bool:
         return False
     lo, hi = twin.bbox()
     centre, size = 0.5 * (lo + hi), float(np.linalg.norm(hi - lo)) + 1.0
-    points = list(centre + 0.6 * size * np.random.default_rng(0).uniform(-1, 1, (8, 3)))
+    points = list(centre + 0.6 * size * np.random.default_rng(0).uniform(-1, 1, (6, 3)))
     umin, umax, wmin, wmax = probe.box
-    for u in np.linspace(umin, umax, 5):
-        for w in np.linspace(wmin, wmax, 4):
+    for u in np.linspace(umin, umax, 4):
+        for w in np.linspace(wmin, wmax, 3):
             n = probe.normal(u, w)  # leaves the surface point in probe._p
             q = np.array(probe._p.Coord())
             points += [q + n, q - n]

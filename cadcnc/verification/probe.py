@@ -25,7 +25,8 @@ from OCP.Geom import Geom_OffsetSurface
 from OCP.GeomAdaptor import GeomAdaptor_Curve, GeomAdaptor_Surface
 from OCP.GeomAPI import GeomAPI_IntSS, GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
 from OCP.ElSLib import ElSLib
-from OCP.GeomAbs import GeomAbs_Line, GeomAbs_Plane
+from OCP.GeomAbs import (GeomAbs_Cylinder, GeomAbs_Line, GeomAbs_Plane, GeomAbs_Sphere,
+                          GeomAbs_Torus)
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
 from OCP.TopExp import TopExp_Explorer
@@ -34,10 +35,18 @@ from OCP.TopoDS import TopoDS
 from ..geometry.part import optimal_box
 from ..tolerances import DEFAULT, Tolerances
 from ..trim import BOUNDARY, INSIDE, OUTSIDE
+from .box_face import whole_box
 
 _STATES = {TopAbs_IN: INSIDE, TopAbs_ON: BOUNDARY}
 NEWTON_PARAMETER_PRECISION = 1e-12
 """Convergence of the seeded Newton search in (u, w): a solver precision, not a threshold."""
+_RADIAL = {  # ElSLib's parameters of a point: those of its radial foot on the surface
+    GeomAbs_Cylinder: lambda a, p: ElSLib.Parameters_s(a.Cylinder(), p),
+    GeomAbs_Sphere: lambda a, p: ElSLib.Parameters_s(a.Sphere(), p),
+    GeomAbs_Torus: lambda a, p: ElSLib.Parameters_s(a.Torus(), p),
+}
+BOX_EDGE_TIE = 1e-10
+"""The edges' distance may exceed the global search's by this (mm) on a whole box face."""
 EDGE_CLEAR = 1e-6
 """How much farther (mm) than an interior foot every edge must be for that foot to be the
 face's nearest point (:meth:`FaceProbe.interior_distance`): DistShapeShape counts a
@@ -74,6 +83,7 @@ class FaceProbe:
         self._fclass = None
         self._project = None
         self._edges = None
+        self._natural = None
 
     # -- surface -----------------------------------------------------------------------
     def normal(self, u: float, w: float) -> np.ndarray:
@@ -252,22 +262,47 @@ class FaceProbe:
         return (d, d) if math.isfinite(d) else None
 
     def interior_distance(self, point) -> tuple[float, float] | None:
-        """:meth:`face_distance` where OCCT's global search over the face's parameter box
-        (:meth:`project_global`, the search DistShapeShape runs on the face) finds its
-        nearest surface point inside the trimmed face, and OCCT's projections on the
-        face's edges (:meth:`edge_gap`) are all farther by :data:`EDGE_CLEAR`: no point of
-        the face is nearer (an interior one would be a nearer point of the box, a boundary
-        one a nearer point of an edge), and no boundary point ties. None elsewhere
-        (DistShapeShape decides)."""
-        found = self.project_global(point)
+        """:meth:`face_distance` where the surface's nearest point lies inside the
+        trimmed face and OCCT's projections on the face's edges (:meth:`edge_gap`) are all
+        farther by :data:`EDGE_CLEAR`: no point of the face is nearer, and no boundary
+        point ties. The nearest surface point: on a cylinder, sphere or torus the radial
+        foot (ElSLib's parameters of the point, the nearest point of the whole surface);
+        elsewhere OCCT's global search over the face's parameter box
+        (:meth:`project_global`, the search DistShapeShape runs on the face). On a face
+        that is its whole parameter box (:meth:`natural`), a foot on the box's side puts
+        no point of the face nearer than the search's distance: the distance is the
+        edges', when they are no farther than that by :data:`BOX_EDGE_TIE` (unsigned, as
+        DistShapeShape gives a foot on the boundary). None elsewhere (DistShapeShape
+        decides)."""
+        found = self._analytic_foot(point) if self.adaptor.GetType() in _RADIAL \
+            else self.project_global(point)
         if found is None:
             return None
         u, w, d = found
-        if not d >= self.tol.noise or self.state(u, w) != INSIDE:
+        if not d >= self.tol.noise:
             return None
+        if self.state(u, w) != INSIDE:  # on a whole parameter box: its edges' distance
+            if self.adaptor.GetType() in _RADIAL or not self.natural():
+                return None
+            e = self.edge_gap(point)
+            return (e, e) if e <= d + BOX_EDGE_TIE else None
         if not self.edge_gap(point, d + EDGE_CLEAR) >= d + EDGE_CLEAR:
             return None
         return self.signed(point, u, w, d), d
+
+    def natural(self) -> bool:
+        """Whether the trimmed face is its whole parameter box: one wire whose edges run
+        straight along u or w on the box's sides (their pcurves), computed once."""
+        if self._natural is None:
+            self._natural = whole_box(self.face, self.box)
+        return self._natural
+
+    def _analytic_foot(self, point) -> tuple[float, float, float]:
+        """(u, w, distance) of the radial foot on a cylinder, sphere or torus: a nearest
+        point of the whole surface (on the axis, centre or core circle, one of many)."""
+        self._q.SetCoord(float(point[0]), float(point[1]), float(point[2]))
+        u, w = _RADIAL[self.adaptor.GetType()](self.adaptor, self._q)
+        return u, w, self.adaptor.Value(u, w).Distance(self._q)
 
     def bbox(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) corners of the face's optimal bounding box, mm (computed once)."""
@@ -350,3 +385,4 @@ def _edges_of(face) -> tuple[np.ndarray, list, bool]:
     straight = all(c is not None and GeomAdaptor_Curve(c).GetType() == GeomAbs_Line
                    for c, _, _ in curves)
     return np.array(boxes, float).reshape(-1, 6), curves, straight
+
