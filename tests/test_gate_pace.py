@@ -27,7 +27,7 @@ from cadcnc.verification import gate_program
 from cadcnc.verification.gate_cache import shared_gates
 from cadcnc.verification.planar import planar_twin
 from cadcnc.verification.probe import FaceProbe
-from cadcnc.verification.whole_part import FAR_MATCH_STEPS, MATCH_WINDOW, _match
+from cadcnc.verification.whole_part import _match, window_match
 from conftest import FIXTURES
 from test_gate_shared import DEPTH, same
 
@@ -42,6 +42,18 @@ def _around(probe: FaceProbe, n: int, seed: int) -> np.ndarray:
     return np.random.default_rng(seed).uniform(lo - 3, hi + 3, (n, 3))
 
 
+def _agreeing(probe: FaceProbe, fast, n: int, seed: int) -> int:
+    """How many of ``n`` points around the face ``fast`` answers; each answer must be
+    DistShapeShape's (signed, unsigned) within 1e-9 mm."""
+    answered = 0
+    for p in _around(probe, n, seed):
+        found = fast(p)
+        if found is not None:
+            answered += 1
+            np.testing.assert_allclose(found, probe.face_distance(p), atol=DEPTH)
+    return answered
+
+
 @pytest.mark.parametrize("name", ["finish_slab", "bspline_boss"])
 def test_planar_twins_give_occts_distances(name):
     """Four extruded sides each; the B-spline tops, a cylinder, a true plane: no twin."""
@@ -54,11 +66,7 @@ def test_planar_twins_give_occts_distances(name):
         twins += twin is not None
         if twin is None:
             continue
-        for p in _around(probe, 25, k):
-            closed = twin.plane_distance(p)
-            if closed is not None:
-                compared += 1
-                np.testing.assert_allclose(closed, probe.face_distance(p), atol=DEPTH)
+        compared += _agreeing(probe, twin.plane_distance, 25, k)
     assert twins == 4 and compared > 60
 
 
@@ -74,26 +82,15 @@ def test_interior_feet_give_occts_distances(name, kinds):
         probe = FaceProbe(part.face(k).topods, part.tol)
         if probe.adaptor.GetType() not in kinds:
             continue
-        for p in _around(probe, 30, k):
-            fast = probe.interior_distance(p)
-            if fast is not None:
-                found += 1
-                np.testing.assert_allclose(fast, probe.face_distance(p), atol=DEPTH)
+        found += _agreeing(probe, probe.interior_distance, 30, k)
     assert found > 15
 
 
 def _windowed(pts, moves, step):
-    """The matching rule as written before the k-d tree: a window around the last match."""
+    """The matching rule as it was: every move by the window around the last match."""
     match, at = np.zeros(len(moves), int), 0
     for j, m in enumerate(moves):
-        lo, hi = max(at - MATCH_WINDOW, 0), min(at + MATCH_WINDOW + 1, len(pts))
-        gap = np.linalg.norm(pts[lo:hi] - m, axis=1)
-        at = lo + int(np.argmin(gap))
-        if gap.min() > FAR_MATCH_STEPS * step:
-            far = int(np.argmin(np.linalg.norm(pts - m, axis=1)))
-            if np.linalg.norm(pts[far] - m) < gap.min():
-                at = far
-        match[j] = at
+        at = match[j] = window_match(pts, m, at, step)
     return match
 
 

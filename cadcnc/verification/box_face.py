@@ -29,12 +29,11 @@ def whole_box(face, box) -> bool:
     if wires.More():  # a second wire: a hole
         return False
     umin, umax, wmin, wmax = box
-    explorer = TopExp_Explorer(face, TopAbs_EDGE)
+    edges, explorer = [], TopExp_Explorer(face, TopAbs_EDGE)
     while explorer.More():
-        edge = TopoDS.Edge_s(explorer.Current())
+        edges.append(TopoDS.Edge_s(explorer.Current()))
         explorer.Next()
-        if BRep_Tool.Degenerated_s(edge):
-            continue
+    for edge in (e for e in edges if not BRep_Tool.Degenerated_s(e)):
         curve = BRepAdaptor_Curve2d(edge, face)
         if curve.GetType() != GeomAbs_Line:
             return False

@@ -97,16 +97,22 @@ def _match(pts: np.ndarray, moves: np.ndarray, step: float) -> np.ndarray:
         if unique[j] and at - MATCH_WINDOW <= g <= at + MATCH_WINDOW:
             at = match[j] = g
             continue
-        m = moves[j]
-        lo, hi = max(at - MATCH_WINDOW, 0), min(at + MATCH_WINDOW + 1, len(pts))
-        gap = np.linalg.norm(pts[lo:hi] - m, axis=1)
-        at = lo + int(np.argmin(gap))
-        if gap.min() > FAR_MATCH_STEPS * step:
-            far = int(np.argmin(np.linalg.norm(pts - m, axis=1)))
-            if np.linalg.norm(pts[far] - m) < gap.min():
-                at = far
-        match[j] = at
+        at = match[j] = window_match(pts, moves[j], at, step)
     return match
+
+
+def window_match(pts: np.ndarray, m: np.ndarray, at: int, step: float) -> int:
+    """The centre of ``pts`` matched to the move ``m`` after a move matched to ``at``:
+    the nearest within :data:`MATCH_WINDOW` of ``at``, or the nearest of all when that
+    one is farther than :data:`FAR_MATCH_STEPS` ``step`` and another is nearer."""
+    lo, hi = max(at - MATCH_WINDOW, 0), min(at + MATCH_WINDOW + 1, len(pts))
+    gap = np.linalg.norm(pts[lo:hi] - m, axis=1)
+    at = lo + int(np.argmin(gap))
+    if gap.min() > FAR_MATCH_STEPS * step:
+        far = int(np.argmin(np.linalg.norm(pts - m, axis=1)))
+        if np.linalg.norm(pts[far] - m) < gap.min():
+            at = far
+    return at
 
 
 def _whole(line: Polyline, surfaces, ball: float, tol: Tolerances, n_faces: int,
