@@ -9,7 +9,6 @@ from ..job import Finish, Job, PairPath, Pencil
 from ..program.program import Program
 from ..work import MAX_CYCLES
 from .finish.finish import JOIN, finish_program
-from .parallel import start_workers
 from .path.pair_program import program_for_job
 from .pencil.pencil import CHAIN_GAP, pencil_program
 
@@ -34,8 +33,6 @@ def run(part, job: Job, *, progress=None, times: dict | None = None,
     part = setup_part(part, job)   # the tool axis up: the program in work coordinates
     check_clearance(part, job)
     op = job.operation
-    if isinstance(op, (Pencil, Finish)):   # the workers start while the operation plans
-        start_workers(part, jobs)
     if isinstance(op, PairPath):
         return program_for_job(part, job, progress=progress, max_cycles=max_cycles)
     if isinstance(op, Pencil):
