@@ -2,8 +2,8 @@
 
 :func:`gate_cuts` gates each ``(toolpath, moves, blend)`` on the part and returns the
 :class:`~cadcnc.verification.gate.GateResult` of each, in order, whatever the number of
-processes. In a worker the part is rebuilt from BRep bytes once
-(:mod:`cadcnc.geometry.part_bytes`). What a gate found that the next gate of the same
+processes; the workers take the longest cuts first. In a worker the part is rebuilt
+from BRep bytes once (:mod:`cadcnc.geometry.part_bytes`). What a gate found that the next gate of the same
 cut can reuse (the pair's checks, exact distances: :mod:`.gate_cache`) comes back with
 its result and is handed to the next one: the cut-back step and the program gate share
 it in whichever processes they run.
@@ -13,13 +13,13 @@ from __future__ import annotations
 
 from ..geometry.part_bytes import part_blob, part_from_blob
 from ..tolerances import Tolerances
-from ..workers import map_ordered
+from ..ops.parallel import on_workers
 from .gate import GateResult, gouge_gate
 from .gate_cache import cache_for, open_shared, toolpath_key
 from .surface_checks import resolve_part
 
 
-def _gate_task(part, task) -> tuple[GateResult, tuple | None]:
+def _gate_task(part, task, beat=None) -> tuple[GateResult, tuple | None]:
     """One cut's gate (in a worker or here) and, when asked, what it found to share."""
     toolpath, moves, blend, tol, reference, share, want = task
     since = 0
@@ -56,9 +56,8 @@ def gate_cuts(part, items: list, tol: Tolerances, *, jobs: int | None = 1,
         if progress is not None:
             progress("cuts", count[0], len(tasks))
 
-    out = map_ordered(_gate_task, tasks, part=part, jobs=jobs, build=part_from_blob,
-                      build_args=lambda: part_blob(part), on_result=arrived,
-                      what="the gate of cut")
+    sizes = [len(tp.points) + (0 if moves is None else len(moves)) for tp, moves, _ in items]
+    out = on_workers(_gate_task, tasks, part, jobs, arrived, "the gate of cut", sizes=sizes)
     return [r for r, _ in out]
 
 

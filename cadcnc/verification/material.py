@@ -28,6 +28,7 @@ from OCP.TopoDS import TopoDS
 
 from ..tolerances import Tolerances
 from .bounds import point_box_distance
+from .planar import planar_twin
 from .probe import FaceProbe
 
 IN, OUT, ON = "in", "out", "on"
@@ -69,6 +70,7 @@ class PartFaces:
         for k in range(1, n + 1):
             self.loose[k] = _box(part.face(k).topods, optimal=False)
         self._tight: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._twins: dict[int, FaceProbe | None] = {}
 
     def __len__(self) -> int:
         return len(self.loose) - 1
@@ -80,8 +82,10 @@ class PartFaces:
 
     def distance(self, n: int, point) -> tuple[float, float]:
         """(signed, unsigned) distance from ``point`` to face ``n``
-        (:meth:`FaceProbe.face_distance`; on a plane its closed form,
-        :meth:`FaceProbe.plane_distance`), from the memo when the same point was asked
+        (:meth:`FaceProbe.face_distance`; on a plane, or a face that is one in all but
+        name (:func:`~.planar.planar_twin`), the closed form
+        :meth:`FaceProbe.plane_distance`; else an interior foot that OCCT's searches
+        prove nearest, :meth:`FaceProbe.interior_distance`), from the memo when the same point was asked
         before (OCCT's answer for the same input: the same numbers)."""
         if self.memo is None:
             return self.probe(n).face_distance(point)
@@ -89,9 +93,16 @@ class PartFaces:
         found = self.memo.get(key)
         if found is None:
             probe = self.probe(n)
-            found = probe.plane_distance(point) or probe.face_distance(point)
+            found = probe.plane_distance(point) or self._twin_distance(n, point) \
+                or probe.interior_distance(point) or probe.face_distance(point)
             self.memo[key] = found
         return found
+
+    def _twin_distance(self, n: int, point) -> tuple[float, float] | None:
+        if n not in self._twins:
+            self._twins[n] = planar_twin(self.probe(n), self.tol)
+        twin = self._twins[n]
+        return None if twin is None else twin.plane_distance(point)
 
     def box(self, n: int) -> tuple[np.ndarray, np.ndarray]:
         """The face's optimal box grown by :data:`BOX_MARGIN` (computed once)."""

@@ -25,7 +25,8 @@ from OCP.Geom import Geom_OffsetSurface
 from OCP.GeomAdaptor import GeomAdaptor_Curve, GeomAdaptor_Surface
 from OCP.GeomAPI import GeomAPI_IntSS, GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
 from OCP.ElSLib import ElSLib
-from OCP.GeomAbs import GeomAbs_Line, GeomAbs_Plane
+from OCP.GeomAbs import (GeomAbs_Cylinder, GeomAbs_Line, GeomAbs_Plane, GeomAbs_Sphere,
+                          GeomAbs_Torus)
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
 from OCP.TopExp import TopExp_Explorer
@@ -34,10 +35,22 @@ from OCP.TopoDS import TopoDS
 from ..geometry.part import optimal_box
 from ..tolerances import DEFAULT, Tolerances
 from ..trim import BOUNDARY, INSIDE, OUTSIDE
+from .box_face import whole_box
 
 _STATES = {TopAbs_IN: INSIDE, TopAbs_ON: BOUNDARY}
 NEWTON_PARAMETER_PRECISION = 1e-12
 """Convergence of the seeded Newton search in (u, w): a solver precision, not a threshold."""
+_RADIAL = {  # ElSLib's parameters of a point: those of its radial foot on the surface
+    GeomAbs_Cylinder: lambda a, p: ElSLib.Parameters_s(a.Cylinder(), p),
+    GeomAbs_Sphere: lambda a, p: ElSLib.Parameters_s(a.Sphere(), p),
+    GeomAbs_Torus: lambda a, p: ElSLib.Parameters_s(a.Torus(), p),
+}
+BOX_EDGE_TIE = 1e-10
+"""The edges' distance may exceed the global search's by this (mm) on a whole box face."""
+EDGE_CLEAR = 1e-6
+"""How much farther (mm) than an interior foot every edge must be for that foot to be the
+face's nearest point (:meth:`FaceProbe.interior_distance`): DistShapeShape counts a
+boundary point within its precision (1e-7) of the nearest distance as a foot too."""
 SEGMENT_AS_POINT = 1e-7
 """A segment shorter than this (mm, OCCT's Precision::Confusion) has no edge: its
 midpoint's distance less half its length stands for it (a lower bound, within 1e-7)."""
@@ -65,11 +78,12 @@ class FaceProbe:
                                               NEWTON_PARAMETER_PRECISION)
         self._dss = BRepExtrema_DistShapeShape()
         self._dss.LoadS2(topods_face)
-        self._p, self._du, self._dw = gp_Pnt(), gp_Vec(), gp_Vec()
+        self._p, self._du, self._dw, self._q = gp_Pnt(), gp_Vec(), gp_Vec(), gp_Pnt()
         self._bbox = None
         self._fclass = None
         self._project = None
         self._edges = None
+        self._natural = None
 
     # -- surface -----------------------------------------------------------------------
     def normal(self, u: float, w: float) -> np.ndarray:
@@ -92,7 +106,8 @@ class FaceProbe:
 
     def project_seeded(self, point, u0: float, w0: float):
         """(u, w, distance) by a local Newton search started at (u0, w0), or None."""
-        self._locate.Perform(gp_Pnt(*point), float(u0), float(w0))
+        self._q.SetCoord(float(point[0]), float(point[1]), float(point[2]))
+        self._locate.Perform(self._q, float(u0), float(w0))
         if not self._locate.IsDone():
             return None
         u, w = self._locate.Point().Parameter()
@@ -121,8 +136,11 @@ class FaceProbe:
 
     def signed(self, point, u: float, w: float, dist: float) -> float:
         """``dist`` signed by the side of the surface the point is on (+ out of material)."""
-        n = self.normal(u, w)
-        side = (np.asarray(point) - self._p.Coord()) @ n  # _p: the foot point
+        self.adaptor.D1(u, w, self._p, self._du, self._dw)  # _p: the foot point
+        nx, ny, nz = self._du.Crossed(self._dw).Coord()
+        qx, qy, qz = self._p.Coord()
+        side = self.sign * ((float(point[0]) - qx) * nx + (float(point[1]) - qy) * ny
+                            + (float(point[2]) - qz) * nz)  # along the normal, unscaled
         return dist if side >= 0 else -dist
 
     # -- trimmed face ------------------------------------------------------------------
@@ -243,6 +261,49 @@ class FaceProbe:
         d = self.edge_gap(point)
         return (d, d) if math.isfinite(d) else None
 
+    def interior_distance(self, point) -> tuple[float, float] | None:
+        """:meth:`face_distance` where the surface's nearest point lies inside the
+        trimmed face and OCCT's projections on the face's edges (:meth:`edge_gap`) are all
+        farther by :data:`EDGE_CLEAR`: no point of the face is nearer, and no boundary
+        point ties. The nearest surface point: on a cylinder, sphere or torus the radial
+        foot (ElSLib's parameters of the point, the nearest point of the whole surface);
+        elsewhere OCCT's global search over the face's parameter box
+        (:meth:`project_global`, the search DistShapeShape runs on the face). On a face
+        that is its whole parameter box (:meth:`natural`), a foot on the box's side puts
+        no point of the face nearer than the search's distance: the distance is the
+        edges', when they are no farther than that by :data:`BOX_EDGE_TIE` (unsigned, as
+        DistShapeShape gives a foot on the boundary). None elsewhere (DistShapeShape
+        decides)."""
+        found = self._analytic_foot(point) if self.adaptor.GetType() in _RADIAL \
+            else self.project_global(point)
+        if found is None:
+            return None
+        u, w, d = found
+        if not d >= self.tol.noise:
+            return None
+        if self.state(u, w) != INSIDE:  # on a whole parameter box: its edges' distance
+            if self.adaptor.GetType() in _RADIAL or not self.natural():
+                return None
+            e = self.edge_gap(point)
+            return (e, e) if e <= d + BOX_EDGE_TIE else None
+        if not self.edge_gap(point, d + EDGE_CLEAR) >= d + EDGE_CLEAR:
+            return None
+        return self.signed(point, u, w, d), d
+
+    def natural(self) -> bool:
+        """Whether the trimmed face is its whole parameter box: one wire whose edges run
+        straight along u or w on the box's sides (their pcurves), computed once."""
+        if self._natural is None:
+            self._natural = whole_box(self.face, self.box)
+        return self._natural
+
+    def _analytic_foot(self, point) -> tuple[float, float, float]:
+        """(u, w, distance) of the radial foot on a cylinder, sphere or torus: a nearest
+        point of the whole surface (on the axis, centre or core circle, one of many)."""
+        self._q.SetCoord(float(point[0]), float(point[1]), float(point[2]))
+        u, w = _RADIAL[self.adaptor.GetType()](self.adaptor, self._q)
+        return u, w, self.adaptor.Value(u, w).Distance(self._q)
+
     def bbox(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) corners of the face's optimal bounding box, mm (computed once)."""
         if self._bbox is None:
@@ -324,3 +385,4 @@ def _edges_of(face) -> tuple[np.ndarray, list, bool]:
     straight = all(c is not None and GeomAdaptor_Curve(c).GetType() == GeomAbs_Line
                    for c, _, _ in curves)
     return np.array(boxes, float).reshape(-1, 6), curves, straight
+

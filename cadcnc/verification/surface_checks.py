@@ -87,7 +87,7 @@ def check_surface(probe: FaceProbe, face_no, offset: float, points: np.ndarray,
     n = len(points)
     dev, fdev, dist = np.empty(n), np.empty(n), np.empty(n)
     states, exact = [], {}
-    for k, p in enumerate(points):
+    for k, p in enumerate(np.asarray(points, float).tolist()):  # floats: cheaper to OCCT
         if tick and k % TICK == 0:
             tick(k, n)
         res = probe.project_seeded(p, *uw[k])

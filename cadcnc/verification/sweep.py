@@ -26,6 +26,11 @@ import numpy as np
 from .bounds import end_distance_for, point_box_distance, segment_lower_bound
 from .material import IN, ON, OUT, Material, PartFaces
 
+FAR_MARGIN = 1e-9
+"""How far (mm) beyond what a face must be proven to keep a loose box must be for the
+faces' shared first test (:meth:`Polyline._far`) to settle it."""
+FAR_BLOCK = 2_000_000
+"""Face-point distances computed at once by that test (memory: ~5 arrays of this many)."""
 EXACT_SLACK = 1e-7
 """How far (mm) OCCT's exact segment distance may sit outside the interval the samples
 allow before it is distrusted (its extrema converge to ~1e-9 mm)."""
@@ -84,12 +89,37 @@ class Polyline:
         near = set(self.faces.near(pts.min(axis=0), pts.max(axis=0), reach)) | set(self.known)
         near = sorted(near)
         self.faces_near = len(near)
+        far = self._far(near)
         for count, k in enumerate(near, 1):
             if self.progress:
                 self.progress(self.stage, count, len(near))
-            self._face(k)
+            if k in far:  # what _face concludes from the loose box alone
+                self.d_lb = np.minimum(self.d_lb, point_box_distance(pts, *self.faces.loose[k]))
+            else:
+                self._face(k)
         self._membership()
         return self
+
+    def _far(self, near: list[int]) -> set[int]:
+        """The faces of ``near`` (not known) whose loose box alone proves every point and
+        move clear, by :meth:`_face`'s first test for all faces at once, with
+        :data:`FAR_MARGIN` to spare (a face within it takes :meth:`_face`'s own test)."""
+        pts, n, length = self.points, len(self.points), self.length
+        base = self.ball + self.hit if self.hit is not None else 0.0
+        todo = [k for k in near if k not in self.known]
+        out: set[int] = set()
+        step = max(1, FAR_BLOCK // max(n, 1))
+        for i in range(0, len(todo), step):
+            ks = np.array(todo[i:i + step])
+            lo, hi = self.faces.loose[ks, 0][:, None], self.faces.loose[ks, 1][:, None]
+            gap = np.maximum(np.maximum(lo - pts[None], pts[None] - hi), 0.0)
+            box = np.sqrt((gap * gap).sum(axis=2))  # (faces, points)
+            clear = (box >= base + FAR_MARGIN).all(axis=1)
+            if self.clearance is not None and n > 1:
+                seg = segment_lower_bound(box[:, :-1], box[:, 1:], length[None])
+                clear &= (seg >= self.clearance + FAR_MARGIN).all(axis=1)
+            out.update(ks[clear].tolist())
+        return out
 
     def _reach(self, box):
         """(need (N,), near_seg (N-1,)): the distance each point must be proven to keep,

@@ -14,6 +14,7 @@ hit of unknown (nan) depth, never as a miss. Lengths in mm.
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ..tolerances import Tolerances
 from .probe import FaceProbe
@@ -23,6 +24,8 @@ from .sweep import Polyline
 
 FAR_MATCH_STEPS = 4.0  # a move farther than 4 steps from the centre found near it is
 MATCH_WINDOW = 64      # matched against every centre (a link); else within 64 centres
+UNIQUE_REL, UNIQUE_ABS = 1e-9, 1e-12  # a nearest centre nearer than the next by more than
+                                      # round-off is the nearest whichever way measured
 
 
 def check_whole_part(part, probes: dict[int, FaceProbe], toolpath,
@@ -60,26 +63,56 @@ def check_whole_part(part, probes: dict[int, FaceProbe], toolpath,
 
 
 def _anchors(centres: Polyline, moves: np.ndarray):
-    """(match, centres, {face: distances at the centres}) for :class:`Polyline`."""
+    """(match, centres, {face: distances at the centres}) for :class:`Polyline`.
+
+    Each move is matched to the nearest centre within :data:`MATCH_WINDOW` of the
+    previous move's (else to the nearest of all, when that window's is farther than
+    :data:`FAR_MATCH_STEPS` steps and another is nearer): :func:`_match`."""
     pts = centres.points
     dists = {}
     for k, (idx, d, _) in centres.samples.items():
         dense = np.full(len(pts), np.nan)
         dense[idx] = d
         dists[k] = dense
-    step = float(centres.length.max()) if len(centres.length) else 1.0
+    return _match(pts, moves, float(centres.length.max()) if len(centres.length) else 1.0), \
+        pts, dists
+
+
+def _match(pts: np.ndarray, moves: np.ndarray, step: float) -> np.ndarray:
+    """(M,) index of the centre each move is matched to (:func:`_anchors`).
+
+    A k-d tree gives each move its two nearest centres; where the nearest is unique (the
+    second farther by more than round-off) and lies in the window, it is the window's
+    nearest and the rule's answer; elsewhere the window is searched as the rule says."""
     match = np.zeros(len(moves), int)
+    if not len(moves):
+        return match
+    near, idx = cKDTree(pts).query(moves, k=2)
+    near = near.reshape(len(moves), -1)
+    idx = idx.reshape(len(moves), -1)
+    unique = (near[:, -1] > near[:, 0] * (1 + UNIQUE_REL) + UNIQUE_ABS) | (len(pts) < 2)
     at = 0
-    for j, m in enumerate(moves):
-        lo, hi = max(at - MATCH_WINDOW, 0), min(at + MATCH_WINDOW + 1, len(pts))
-        gap = np.linalg.norm(pts[lo:hi] - m, axis=1)
-        at = lo + int(np.argmin(gap))
-        if gap.min() > FAR_MATCH_STEPS * step:
-            far = int(np.argmin(np.linalg.norm(pts - m, axis=1)))
-            if np.linalg.norm(pts[far] - m) < gap.min():
-                at = far
-        match[j] = at
-    return match, pts, dists
+    for j in range(len(moves)):
+        g = int(idx[j, 0])
+        if unique[j] and at - MATCH_WINDOW <= g <= at + MATCH_WINDOW:
+            at = match[j] = g
+            continue
+        at = match[j] = window_match(pts, moves[j], at, step)
+    return match
+
+
+def window_match(pts: np.ndarray, m: np.ndarray, at: int, step: float) -> int:
+    """The centre of ``pts`` matched to the move ``m`` after a move matched to ``at``:
+    the nearest within :data:`MATCH_WINDOW` of ``at``, or the nearest of all when that
+    one is farther than :data:`FAR_MATCH_STEPS` ``step`` and another is nearer."""
+    lo, hi = max(at - MATCH_WINDOW, 0), min(at + MATCH_WINDOW + 1, len(pts))
+    gap = np.linalg.norm(pts[lo:hi] - m, axis=1)
+    at = lo + int(np.argmin(gap))
+    if gap.min() > FAR_MATCH_STEPS * step:
+        far = int(np.argmin(np.linalg.norm(pts - m, axis=1)))
+        if np.linalg.norm(pts[far] - m) < gap.min():
+            at = far
+    return at
 
 
 def _whole(line: Polyline, surfaces, ball: float, tol: Tolerances, n_faces: int,

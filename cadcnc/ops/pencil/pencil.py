@@ -132,8 +132,10 @@ def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = 
     portable = (lambda c: c) if jobs == 1 else (lambda c: _rail_refs(part, c))
     tasks = [(job, [(k, portable(todo[k])) for k in ks], max_cycles)
              for ks in groups.values()]
+    sizes = [sum(todo[k].length + search_samples(todo[k].length, tool.offset, todo[k].closed)
+                 for k in ks) for ks in groups.values()]   # the largest pairs first
     for _, seconds, counts in on_workers(_pair_corners, tasks, part, jobs, arrived,
-                                         "the corners of pair", beat):
+                                         "the corners of pair", beat, sizes):
         for name, t in seconds.items():
             stage.add(name, t)
         for name, n in counts.items():

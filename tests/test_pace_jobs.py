@@ -1,0 +1,59 @@
+"""Workers started early and fed the largest tasks first (issue 24) change no answer.
+
+:func:`cadcnc.ops.parallel.start_workers` starts the pool while the caller goes on;
+:func:`~cadcnc.ops.parallel.on_workers` waits for it, reuses it, hands the workers the
+tasks by decreasing size and still returns (and reports) every result under its own
+task's index; one job runs here in task order.
+"""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+import cadcnc
+from cadcnc.ops.parallel import on_workers, start_workers, workers_ready
+from cadcnc.workers import close
+from conftest import FIXTURES
+
+
+def _where(part, task, beat=None):
+    """(task, faces of the part, worker's pid)."""
+    return task, len(part), os.getpid()
+
+
+@pytest.fixture(scope="module")
+def part():
+    yield cadcnc.load_step(FIXTURES / "step_block.step")
+    close()
+
+
+def test_largest_first_keeps_every_result_in_its_place(part):
+    start_workers(part, 2)
+    tasks = list(range(9))
+    sizes = [3, 9, 1, 9, 5, 0, 2, 8, 4]
+    seen: list = []
+    out = on_workers(_where, tasks, part, 2, lambda k, res: seen.append((k, res[0])),
+                     sizes=sizes)
+    assert [r[0] for r in out] == tasks and all(r[1] == len(part) for r in out)
+    assert sorted(seen) == [(k, k) for k in tasks]   # each reported under its own index
+    assert {r[2] for r in out} - {os.getpid()}       # the workers ran them
+    assert not {r[2] for r in out} & {os.getpid()}
+    # the pool started in the background is the one used: the same two workers again
+    again = on_workers(_where, tasks, part, 2, sizes=sizes[::-1])
+    assert {r[2] for r in again} <= {r[2] for r in out}
+
+
+def test_one_job_runs_here_in_order(part):
+    order: list = []
+    out = on_workers(_where, [4, 1, 3], part, 1, lambda k, res: order.append(k),
+                     sizes=[1, 2, 3])
+    assert [r[0] for r in out] == [4, 1, 3] and order == [0, 1, 2]
+    assert {r[2] for r in out} == {os.getpid()}
+
+
+def test_waiting_for_workers_never_started_is_a_no_op(part):
+    workers_ready(part)
+    start_workers(part, 1)   # one job: no pool
+    workers_ready(part)
