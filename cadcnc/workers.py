@@ -150,6 +150,13 @@ def _shutdown(key: int, kill: bool = False) -> None:
     ender.join(KILL_AFTER_S)
 
 
+def _number(bad: list[int], numbers: Sequence[int] | None) -> str:
+    """The number of the first task that did not finish, as the caller counts them."""
+    if not bad:
+        return "?"
+    return str(numbers[bad[0]] if numbers is not None else bad[0] + 1)
+
+
 @contextmanager
 def _ctrl_c_deferred() -> Iterator[None]:
     """Hold a Ctrl-C (SIGINT) until the block ends. Submitting starts the pool's workers;
@@ -178,12 +185,14 @@ atexit.register(close)
 def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: int | None,
                 build: Callable, build_args: Callable[[], tuple],
                 on_result: Callable[[int, Any], None] | None = None,
-                what: str = "task") -> list:
+                what: str = "task", numbers: Sequence[int] | None = None) -> list:
     """``[fn(part, t) for t in tasks]``, on ``jobs`` processes (module doc).
 
     ``fn`` must be a module-level function (it is pickled by name); ``build(*build_args())``
     rebuilds ``part`` in a worker (``build_args`` is called only when a pool starts).
-    ``what(k)``-style naming: ``what`` names a task in the dead-worker error.
+    ``what(k)``-style naming: ``what`` names a task in the dead-worker error, and
+    ``numbers[k]`` its number there (default ``k + 1``: tasks handed out reordered keep
+    the caller's numbers).
     """
     tasks = list(tasks)
     jobs = min(check_jobs(jobs), max(len(tasks), 1))
@@ -211,7 +220,7 @@ def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: i
     except BrokenProcessPool as e:
         bad = sorted(k for f, k in futures.items() if not f.done() or f.exception())
         _shutdown(id(part), kill=True)
-        raise WorkerError(f"a worker process died during {what} {bad[0] + 1 if bad else '?'} "
+        raise WorkerError(f"a worker process died during {what} {_number(bad, numbers)} "
                           f"of {len(tasks)} (killed, out of memory, or a crash in native "
                           "code); nothing written. --jobs 1 runs in one process") from e
     except BaseException:  # Ctrl-C, or an error in a task: stop every worker

@@ -1,20 +1,20 @@
-"""Workers started early and fed the largest tasks first (issue 24) change no answer.
+"""Workers fed the largest tasks first (issue 24) change no answer.
 
-:func:`cadcnc.ops.parallel.start_workers` starts the pool while the caller goes on;
-:func:`~cadcnc.ops.parallel.on_workers` waits for it, reuses it, hands the workers the
-tasks by decreasing size and still returns (and reports) every result under its own
-task's index; one job runs here in task order.
+:func:`cadcnc.ops.parallel.on_workers` hands the workers the tasks by decreasing size
+and still returns (and reports) every result under its own task's index, and a worker
+that dies is named by the caller's task number; one job runs here in task order.
 """
 
 from __future__ import annotations
 
 import os
+import signal
 
 import pytest
 
 import cadcnc
-from cadcnc.ops.parallel import on_workers, start_workers, workers_ready
-from cadcnc.workers import close
+from cadcnc.ops.parallel import on_workers
+from cadcnc.workers import WorkerError, close
 from conftest import FIXTURES
 
 
@@ -30,7 +30,6 @@ def part():
 
 
 def test_largest_first_keeps_every_result_in_its_place(part):
-    start_workers(part, 2)
     tasks = list(range(9))
     sizes = [3, 9, 1, 9, 5, 0, 2, 8, 4]
     seen: list = []
@@ -40,7 +39,7 @@ def test_largest_first_keeps_every_result_in_its_place(part):
     assert sorted(seen) == [(k, k) for k in tasks]   # each reported under its own index
     assert {r[2] for r in out} - {os.getpid()}       # the workers ran them
     assert not {r[2] for r in out} & {os.getpid()}
-    # the pool started in the background is the one used: the same two workers again
+    # the pool is kept for the part: the same two workers again
     again = on_workers(_where, tasks, part, 2, sizes=sizes[::-1])
     assert {r[2] for r in again} <= {r[2] for r in out}
 
@@ -53,7 +52,13 @@ def test_one_job_runs_here_in_order(part):
     assert {r[2] for r in out} == {os.getpid()}
 
 
-def test_waiting_for_workers_never_started_is_a_no_op(part):
-    workers_ready(part)
-    start_workers(part, 1)   # one job: no pool
-    workers_ready(part)
+def _die_on_7(part, task, beat=None):
+    if task == 7:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return task
+
+
+def test_a_dead_worker_is_named_by_the_callers_task_number(part):
+    sizes = [0, 0, 0, 0, 0, 0, 0, 9]          # task 8 (index 7) goes first
+    with pytest.raises(WorkerError, match=r"died during corner 8 of 8"):
+        on_workers(_die_on_7, list(range(8)), part, 2, what="corner", sizes=sizes)
