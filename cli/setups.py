@@ -23,6 +23,7 @@ def suffixed(out: str, tag: str) -> str:
 
 def setups_command(args) -> int:
     import cadcnc
+    from cadcnc import workers
     from cadcnc.errors import EXIT_NOTHING, InputError, NothingToCutError
     from cadcnc.io.output_set import OutputSet, check_destination
     from cadcnc.io.outputs import SUFFIXES, render
@@ -31,6 +32,7 @@ def setups_command(args) -> int:
     from cadcnc.ops.pencil.pencil import CHAIN_GAP
     from cadcnc.ops.pencil.setups import AUTO, axis_tag, parse_setups, pencil_setups
     from cadcnc.units import parse_length
+    from cadcnc.workers import check_jobs
     from cadcnc.verification.judgement import judge, settle, worst
 
     from .options import gcode_keywords, pencil_job, wants_gcode
@@ -50,8 +52,12 @@ def setups_command(args) -> int:
     for n in job.operation.faces or ():
         part.face(n)
     report = None if args.quiet else (lambda done, total, what: None)
-    result = pencil_setups(part, job, args.setups, overlap, progress=report,
-                           max_cycles=args.max_cycles)
+    jobs = check_jobs(getattr(args, "jobs", None))
+    try:
+        result = pencil_setups(part, job, args.setups, overlap, progress=report,
+                               max_cycles=args.max_cycles, jobs=jobs)
+    finally:
+        workers.close()   # each setup's part has its own workers
     t_cut = time.monotonic() - t0
     name = Path(args.step).name
     gcode = gcode_keywords(args) if wants_gcode(args.output) else None
@@ -75,7 +81,9 @@ def setups_command(args) -> int:
             continue
         verdict = judge(program, run.part, f"cadcnc: {what}", gcode=gcode,
                         allow_partial=args.allow_partial, allow_gouge=args.allow_gouge,
-                        progress=stage_progress(args, f"{what}: gouge check", after_s=1.0))
+                        progress=stage_progress(args, f"{what}: gouge check", after_s=1.0),
+                        jobs=jobs)
+        workers.close()
         for line in verdict.messages:
             say_error(line)
         codes.append(verdict.code)

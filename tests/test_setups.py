@@ -138,3 +138,21 @@ def test_worst_exit_code():
     assert worst([EXIT_OK, EXIT_NOTHING]) == EXIT_NOTHING
     assert worst([EXIT_PARTIAL, EXIT_OK, EXIT_NOTHING]) == EXIT_PARTIAL
     assert worst([EXIT_PARTIAL, EXIT_GOUGE]) == EXIT_GOUGE
+
+
+def test_setups_give_the_same_bytes_on_two_processes(shared_corner, tmp_path):
+    """``--jobs 2`` runs each setup's corners and gate on two worker processes (two corners
+    here: the wall's and the fence's), and writes the bytes one process writes."""
+    part, floor, wall, step = shared_corner
+    fence = next(f.number for f in part.faces if f.kind == "plane" and abs(
+        f.point(*(sum(r) / 2 for r in (f.u_range, f.w_range)))[0] - 35) < 1e-9)
+    assert part.pair_class(floor, fence) == "concave"
+    out = {}
+    for jobs in (1, 2):
+        d = tmp_path / str(jobs)
+        d.mkdir()
+        cadcnc_cli("pencil", step, "--radius", R, "--faces", floor, wall, fence, "--setups",
+                   "+Z,+X", "--jobs", jobs, "-o", d / "P.json", "-o", d / "P.ngc", check=0)
+        out[jobs] = {p.name: p.read_bytes() for p in d.iterdir()}
+    assert sorted(out[1]) == ["P+X.json", "P+X.ngc", "P+Z.json", "P+Z.ngc"]
+    assert out[1] == out[2]

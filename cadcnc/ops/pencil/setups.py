@@ -105,11 +105,13 @@ def parse_setups(value) -> list[tuple[float, float, float]] | str:
 
 
 def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
-                  progress=None, max_cycles: int | None = None) -> SetupsResult:
+                  progress=None, max_cycles: int | None = None,
+                  jobs: int | None = 1) -> SetupsResult:
     """The fewest setups of ``job`` (a :class:`~cadcnc.job.Pencil` job) on ``part`` among
     ``setups`` (AUTO: the six principal axes; or a list of axes): module doc. ``overlap``:
-    mm of lap at a boundary with an earlier setup. Raises NothingToCutError when no
-    candidate reaches anything."""
+    mm of lap at a boundary with an earlier setup; ``jobs``: processes for each setup's
+    corners (None: every core). Raises NothingToCutError when no candidate reaches
+    anything."""
     if not isinstance(job.operation, Pencil):
         raise InputError("setups are for the pencil operation")
     if not (isinstance(overlap, (int, float)) and overlap >= 0 and np.isfinite(overlap)):
@@ -125,7 +127,7 @@ def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
         setup = setup_in(sp) or Setup(np.asarray(axis), np.eye(3), np.zeros(3))
         extra = {} if max_cycles is None else {"max_cycles": max_cycles}
         try:
-            program = pencil_program(sp, sub, progress=progress, **extra)
+            program = pencil_program(sp, sub, progress=progress, jobs=jobs, **extra)
             error = ""
         except NothingToCutError as e:
             program, error = Program(sub), str(e)
