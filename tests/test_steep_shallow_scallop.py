@@ -47,7 +47,7 @@ def test_the_walls_edges_along_the_planes_get_half_the_spacing():
     s = sample_faces(part("wall"), wall, 0.5)
     n = np.array([0.0, 1.0, 0.0])
     f = (s.points + 3.0 * s.normals) @ n
-    along = along_edges(s, f)
+    along, slope = along_edges(s, f, across(s, n)[1])
     on_y = s.edge & (np.abs(np.abs(s.points[:, 1]) - 10.0) < 1e-6)
     on_x = s.edge & (np.abs(np.abs(s.points[:, 0]) - 20.0) < 1e-6)
     assert on_y.sum() > 100 and on_x.sum() > 20
@@ -91,3 +91,27 @@ def test_steep_shallow_union_is_within_the_scallop(monkeypatch, name, radius, fa
         assert r.unmachined_area == 0.0
     note = next(n for n in prog.notes if n.startswith("uncut"))
     assert "0.00 mm^2 over the limit" in note
+
+
+def test_an_oblique_edge_is_served_by_the_next_plane_or_the_leaving_pass_end():
+    """The boss's fillet foot (a circle r 11 on the plate) runs at every angle to the
+    planes (angle 0): at each of its samples where the centre coordinate changes slower
+    than 0.9 g mm per mm, either a plane lies within half a chord on the face's side, or
+    the plane on the outer side at f - x ends its pass x / (s g) along the edge, within
+    half a chord (c / g, c the spacing)."""
+    fillet = FACTS["boss"]["fillet"]
+    faces = FACTS["boss"]["faces"]
+    s = sample_faces(part("boss"), faces, float(centre_chord(0.05, 0.0, 2.0)) / 4)
+    plan = plan_planes(s, 2.0, 0.0, 0.0, scallop=0.05)
+    k, g = across(s, plan.normal)
+    side, slope = along_edges(s, plan.f, g)
+    foot = (s.faces == fillet) & s.edge & (np.abs(s.points[:, 2] - 5.0) < 1e-6)
+    oblique = foot & (side != 0) & (slope > 0.3) & (slope < 0.9)   # not along the planes
+    assert oblique.sum() > 50
+    planes = np.sort(plan.offsets)
+    for i in np.flatnonzero(foot & (side != 0) & (plan.reason == "")):
+        x = (planes - plan.f[i]) * side[i]                 # > 0: on the face's side
+        inside, outside = x[x >= 0], -x[x <= 0]
+        half = 0.5 * plan.spacing[i]
+        assert (len(inside) and inside.min() <= half + 1e-9) or (
+            len(outside) and outside.min() / slope[i] <= half + 1e-9), i

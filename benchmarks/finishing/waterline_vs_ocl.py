@@ -17,7 +17,7 @@ one thread, in a subprocess (ocl_waterline_worker.py). Measured:
   loops (face samples, critical heights, levels, OCCT's offset sections, the loops with
   their guard and self-check); its whole program also (links and the uncut report; the
   gate apart). Modules are imported before the clock starts (OCL's import is not timed
-  either); the first fixture of a process includes loading numba's cached code.
+  either), and an untimed first run loads numba's cached code (``--cold``: no such run).
 
     python -m benchmarks.finishing.waterline_vs_ocl [--fixtures dome wall boss]
         [--tol 1e-2 1e-3] [--json OUT] [--png docs/img/waterline_vs_ocl.png]
@@ -200,7 +200,11 @@ def main(argv=None) -> int:
     ap.add_argument("--stepdown", type=float, default=STEPDOWN)
     ap.add_argument("--json")
     ap.add_argument("--png")
+    ap.add_argument("--cold", action="store_true",
+                    help="no untimed first run (numba's cached code loaded inside the clock)")
     args = ap.parse_args(argv)
+    if not args.cold and args.fixtures:   # loads numba's cached code, as OCL's is loaded
+        cadcnc_run(args.fixtures[0], args.stepdown)
     load = os.getloadavg()
     rows = []
     for name in args.fixtures:   # written as each fixture is done (long runs)

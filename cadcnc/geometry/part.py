@@ -138,6 +138,7 @@ class Part:
         self._faces: dict[int, FaceSurface] = {}
         self._edges: dict[tuple[int, int], list[SharedEdge]] | None = None
         self._bbox: tuple[np.ndarray, np.ndarray] | None = None
+        self._face_boxes: tuple[np.ndarray, np.ndarray] | None = None
         self.warnings: list[str] = []  # what OCCT printed while reading the file
 
     @classmethod
@@ -173,8 +174,19 @@ class Part:
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo (3,), hi (3,)) of the part's optimal axis-aligned bounding box, mm."""
         if self._bbox is None:
-            self._bbox = optimal_box(self.shape, use_triangulation=True)
+            lo, hi = self.face_boxes()
+            self._bbox = lo.min(axis=0), hi.max(axis=0)
         return self._bbox
+
+    def face_boxes(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lows (n, 3), highs (n, 3)) of every face's optimal box (mm; face k at row k - 1),
+        computed once: the part's box is their union, and the guards share them."""
+        if self._face_boxes is None:
+            boxes = [optimal_box(self.face(k).topods, use_triangulation=False)
+                     for k in range(1, len(self) + 1)]
+            self._face_boxes = (np.array([b[0] for b in boxes]).reshape(-1, 3),
+                                np.array([b[1] for b in boxes]).reshape(-1, 3))
+        return self._face_boxes
 
     @property
     def top(self) -> float:

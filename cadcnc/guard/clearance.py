@@ -45,7 +45,6 @@ from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.gp import gp_Pnt
 
 from .analytic import AnalyticFace
-from ..geometry.part import optimal_box
 from ..tolerances import DEFAULT
 
 TIE = 1e-9  # mm: margins this close are the same contact
@@ -295,9 +294,8 @@ def _part_data(part) -> tuple:
     if data is None:
         faces = [part.face(k) for k in range(1, len(part) + 1)]
         analytic = [AnalyticFace(f) for f in faces]   # closed forms, or kind None
-        boxes = [optimal_box(f.topods, use_triangulation=False) for f in faces]
-        data = (faces, analytic, np.array([b[0] for b in boxes]).reshape(-1, 3) - BOX_SLACK,
-                np.array([b[1] for b in boxes]).reshape(-1, 3) + BOX_SLACK)
+        lo, hi = part.face_boxes()   # shared with the part's own box
+        data = (faces, analytic, lo - BOX_SLACK, hi + BOX_SLACK)
         _PART_DATA[part] = data
     return data
 

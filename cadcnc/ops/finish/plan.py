@@ -18,9 +18,9 @@ the distance between the planes (a slope across the passes brings them closer). 
 the ball cannot serve are set apart with their reason: normals pointing down
 (``unreachable``), concave tighter than the ball (``too tight``), within
 ``PARALLEL_DEG`` of parallel to the planes (``parallel wall``). Where a face's boundary
-runs along the planes, a plane whose contact leaves the face there has no pass over a long
-stretch of the edge; the edge is then cut from the next plane inside only, which must lie
-within half a chord of it (:func:`along_edges`, :func:`edge_intervals`). Lengths mm.
+runs along or obliquely to the planes, a plane whose contact leaves the face there ends its
+pass far along the edge; the edge is cut from the next plane inside, or from that pass's
+end, each within half a chord (:func:`along_edges`, :func:`edge_intervals`). Lengths mm.
 """
 
 from __future__ import annotations
@@ -43,9 +43,11 @@ DOWN_NZ = -1e-9
 MAX_SAMPLES = 60_000
 """Samples over all the selected faces at most (the grid is made coarser above)."""
 MIN_PER_SIDE = 4
-EDGE_ALONG = 0.5
-"""mm/mm: a boundary along which the centre coordinate changes slower than this runs along
-the planes (:func:`along_edges`)."""
+EDGE_ALONG = 0.9
+"""A boundary along which the centre coordinate changes slower than this many times g mm per
+mm (g = sqrt(1 - (n . N)^2), the planes' spacing over the chord) needs a plane near it
+(:func:`along_edges`); from 1 on, planes a spacing apart serve it (between 0.9 and 1 they
+leave at most (2 / 1.9)^2 H, where the planes are a whole spacing apart)."""
 EDGE_STEEP_DEG = 60.0
 """deg: boundary samples steeper than this get no edge interval."""
 EDGE_INSET = 0.125
@@ -247,23 +249,25 @@ def plan_planes(samples: FaceSamples, radius: float, allowance: float, angle: fl
     refuse_over(f"finishing {hi - lo:.4g} mm across the planes (R' {r1:g} mm) for a "
                 f"scallop of {scallop:g} mm", estimate, max_planes, "guide planes",
                 "give a larger --scallop, or a smaller --radius")
-    a, e = edge_intervals(along_edges(samples, f), f, spacing)
+    a, e = edge_intervals(*along_edges(samples, f, g), f, spacing)
     extra = int(np.ceil((e.max() - a.min()) / (e - a).min())) + 1 if len(a) else 0
     offsets = adaptive_offsets(f, spacing, lo, hi, limit=int(1.5 * estimate) + 2 + extra,
                                edges=(a, e))
     return PlanePlan(angle, n, offsets, f, reason, spacing)
 
 
-def along_edges(samples: FaceSamples, f: np.ndarray) -> np.ndarray:
-    """(N,) for each boundary sample (``samples.edge``) where the face's boundary runs
-    along the planes (the centre coordinate ``f`` (N,) changes by less than ``EDGE_ALONG``
-    mm per mm to the two nearest boundary samples of the same face) the side of f the face
-    lies on (+1 or -1: its nearest samples' mean); 0 elsewhere. There a pass whose contact
-    leaves the face is missing over a long stretch of the edge, which is then cut from the
-    next plane inside only (:func:`edge_intervals`)."""
-    out = np.zeros(len(samples))
+def along_edges(samples: FaceSamples, f: np.ndarray, g: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """(side, slope), each (N,): for each boundary sample (``samples.edge``) where the
+    face's boundary runs obliquely to the planes (the centre coordinate ``f`` (N,) changes
+    by less than ``EDGE_ALONG`` g (N,) mm per mm to its two nearest boundary samples of the
+    same face: the larger of the two, over g, is ``slope``), the side of f the face lies on (+1 or -1: its
+    nearest samples' mean); 0 elsewhere. There the pass of the plane on the outer side
+    leaves the face, its end 1 / slope times farther along the edge than the plane is
+    across it (:func:`edge_intervals`)."""
+    side, slope = np.zeros(len(samples)), np.ones(len(samples))
     if samples.edge is None:
-        return out
+        return side, slope
     for face in np.unique(samples.faces):
         mine = np.flatnonzero(samples.faces == face)
         idx = mine[samples.edge[mine]]
@@ -271,25 +275,32 @@ def along_edges(samples: FaceSamples, f: np.ndarray) -> np.ndarray:
             continue
         p = samples.points[idx]
         dist, near = cKDTree(p).query(p, k=3)
-        slope = np.abs(f[idx][near[:, 1:]] - f[idx][:, None]) / np.maximum(dist[:, 1:], 1e-12)
+        s = (np.abs(f[idx][near[:, 1:]] - f[idx][:, None])
+             / np.maximum(dist[:, 1:], 1e-12)).max(axis=1) / np.maximum(g[idx], 1e-12)
         # on a steep edge (over EDGE_STEEP_DEG) the planes are close already (g small);
         # in steep-shallow it is waterline's
         steep = samples.normals[idx, 2] < math.cos(math.radians(EDGE_STEEP_DEG))
-        along = (slope.max(axis=1) < EDGE_ALONG) & ~steep
+        along = (s < EDGE_ALONG) & ~steep
         inner = cKDTree(samples.points[mine]).query(p[along], k=min(9, len(mine)))[1]
-        out[idx[along]] = np.sign((f[mine][inner] - f[idx[along]][:, None]).mean(axis=1))
-    return out
+        side[idx[along]] = np.sign((f[mine][inner] - f[idx[along]][:, None]).mean(axis=1))
+        slope[idx[along]] = s[along]
+    return side, slope
 
 
-def edge_intervals(side: np.ndarray, f: np.ndarray, spacing: np.ndarray):
-    """(a, e): for each boundary sample running along the planes (``side`` != 0, finite
-    ``spacing``), the interval of f (mm) that must hold a plane: within half its chord
-    of it on the face's side (and ``EDGE_INSET`` of a spacing inside it: a plane through
-    the edge itself would run along it), so that the edge's cusp stays within H there."""
+def edge_intervals(side: np.ndarray, slope: np.ndarray, f: np.ndarray, spacing: np.ndarray):
+    """(a, e): for each boundary sample at ``f`` running obliquely to the planes (``side``
+    != 0, ``slope`` s < 1, finite ``spacing``; all (N,)), the interval of f (mm) that must
+    hold a plane so that the edge's cusp stays within H there. A plane within half a chord
+    on the face's side passes over the sample; one on the outer side at f - x leaves the
+    face x / s along the edge from it: within half a chord when x <= s c / 2. The interval
+    runs from ``EDGE_INSET`` of a spacing inside (a plane along the edge itself would run
+    on it; at s = 0) to s c / 2 outside (at s = 1), linearly in s: a part of [f - s c / 2,
+    f + c / 2] (mirrored for side -1), c the sample's spacing."""
     sel = (side != 0) & np.isfinite(spacing)
-    half, inner = 0.5 * spacing[sel], EDGE_INSET * spacing[sel]
-    lo = np.where(side[sel] > 0, f[sel] + inner, f[sel] - half)
-    return lo, lo + half - inner
+    half, inner, s = 0.5 * spacing[sel], EDGE_INSET * spacing[sel], slope[sel]
+    near = inner - (inner + half) * np.clip(s, 0.0, 1.0)   # towards the face from f
+    lo = np.where(side[sel] > 0, f[sel] + near, f[sel] - half)
+    return lo, np.where(side[sel] > 0, f[sel] + half, f[sel] - near)
 
 
 def planes_estimate(lo: float, hi: float, *, stepover: float | None = None, f=None,
