@@ -142,7 +142,12 @@ def test_every_cut_point_on_the_offset_and_nothing_gouges(name, faces, stepover)
     assert np.abs(dev).max() <= 1e-6, np.abs(dev).max()
     gate = gate_program(prog, part)
     assert gate.ok, gate.message
-    assert [c[:2] for c in calls] == [(k, len(calls)) for k in range(1, len(calls) + 1)]
+    # one report as each plane ends (1..N of N), plus heartbeats within a slow plane (a
+    # cold kernel cache), which repeat the planes done so far
+    done, totals = [c[0] for c in calls], {c[1] for c in calls}
+    assert len(totals) == 1 and done == sorted(done)
+    n = totals.pop()
+    assert sorted(set(done) - {0}) == list(range(1, n + 1)) and done[-1] == n
 
 
 def test_zigzag_stays_down_only_where_verified_and_oneway_retracts():
