@@ -23,6 +23,12 @@ class Tolerances:
       sphere degenerates to the offset tangent plane.
     - ``tangent_sin``: |n1 x n2| below this means the two faces are tangent, the
       intersection direction is undefined (sin of ~0.57 deg).
+    - ``stretch_tangent_sin``: the stretch search's tangent rule: a corner position is
+      feasible only where |n1 x n2| (at its exact contacts) is at least this, twice
+      ``tangent_sin``. Near tangency the interpolator's centre strays from the offset
+      intersection curve along its ill-conditioned direction (by ~2 um at sin 0.01, still
+      on both offset surfaces), so its own |n1 x n2| reads a few per cent off the exact
+      value; the margin keeps a cut started at a tangent limit from stopping there.
     - ``tangent_edge_deg``: a dihedral angle within this of 180 deg classifies an edge
       sample as tangent/smooth.
     - ``start`` (mm): the initial tangency is solved to this residual.
@@ -76,6 +82,7 @@ class Tolerances:
     near_singular: float = 1e-4
     flat_curvature: float = 1e-9
     tangent_sin: float = 1e-2
+    stretch_tangent_sin: float = 2e-2
     tangent_edge_deg: float = 1.0
     start: float = 1e-9
     on_boundary: float = 1e-6

@@ -16,8 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .centre_curve import polyline_length, travel_direction
 from .stretches import (UNSOLVED, EdgeStretches, Limit, Sample, Stretch, locate_limit,
-                        polyline_length, sample_at)
+                        sample_at)
 
 FIRST_PROBE = 1e-7   # mm of edge past the stop: the first position judged (then doubled)
 BISECTIONS = 60      # halvings locating the stop's arc length between two samples
@@ -59,9 +60,12 @@ def split_at_stop(found: EdgeStretches, st: Stretch, stop
         if not resume.ok or resume.s <= end_bad.s:
             return head, []
     start_good, start_bad = locate_limit(feas, curve, resume, end_bad)
+    later = [x for x in run if x.s > start_good.s]
     rest = Stretch(st.edge, Limit(start_good.tangency, start_bad.rule, start_bad.detail,
-                                  start_good.s), st.end, start_good.tangent,
-                   _length(start_good, [x for x in run if x.s > start_good.s], st.end))
+                                  start_good.s), st.end,
+                   travel_direction([start_good.tangency] + [x.tangency for x in later]
+                                    + [st.end.tangency], start_good.tangent),
+                   _length(start_good, later, st.end))
     return head, [rest]
 
 

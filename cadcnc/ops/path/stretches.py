@@ -2,7 +2,8 @@
 
 A *feasible* ball position of a pair (i, j) is a centre touching both offset surfaces
 (Newton, :func:`~cadcnc.interp.tangency.solve_tangency`) whose feet lie on the trimmed
-faces (inside or on the boundary), where the faces are not tangent, where neither
+faces (inside or on the boundary), where the faces are not tangent (|n1 x n2| at least
+``Tolerances.stretch_tangent_sin``), where neither
 contact's concave curvature along the path is tighter than the ball (R' k <= 1, up to
 the spec's 1 um), and where the ball and its shank clear the rest of the part
 (:class:`~cadcnc.guard.clearance.ClearanceGuard`). A *stretch* is a maximal
@@ -43,6 +44,7 @@ from ...interp.tangency import solve_tangency
 from ...job import Job
 from ...tolerances import Tolerances
 from ...guard import guard_for
+from .centre_curve import polyline_length, travel_direction
 
 SPACING = 0.4       # mm of edge between samples (refined to MAX_CHORD of centres)
 MIN_SAMPLES = 9     # per edge
@@ -98,7 +100,8 @@ class Limit:
 class Stretch:
     """A maximal feasible piece of the offset intersection curve along edge ``edge``.
 
-    ``direction`` is the edge's tangent at the start (the path runs start to end);
+    ``direction`` is the cut's sense at the start (towards the next centre, see
+    :func:`travel_direction`; the path runs start to end);
     ``length`` the centre polyline's length over the samples, mm.
     """
 
@@ -182,7 +185,7 @@ class Feasibility:
         c2 = Contact(self.s2, self.offsets[1], *tan.uv2)
         t = np.cross(c1.n, c2.n)
         sin = float(np.linalg.norm(t))
-        if sin < self.tol.tangent_sin:
+        if sin < self.tol.stretch_tangent_sin:
             return TANGENT, f"|n1 x n2| = {sin:.3g}"
         off = [f"face {s.number}" for s, uv in ((self.s1, tan.uv1), (self.s2, tan.uv2))
                if not s.contains(*uv)]
@@ -352,14 +355,9 @@ def _stretches(feas, curve, samples: list[Sample], edge: int) -> list[Stretch]:
                        samples[before])
         end = _limit(feas, curve, samples[last], None if after is None else samples[after])
         pts = [start.tangency] + [samples[i].tangency for i in run] + [end.tangency]
-        out.append(Stretch(edge, start, end, samples[first].tangent, polyline_length(pts)))
+        out.append(Stretch(edge, start, end, travel_direction(pts, samples[first].tangent),
+                           polyline_length(pts)))
     return out
-
-
-def polyline_length(tangencies: list[Tangency]) -> float:
-    """Length of the polyline through the tangencies' centres, mm."""
-    pts = np.array([t.p for t in tangencies])
-    return float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
 
 
 def pair_stretches(s1, s2, job: Job, guard: ClearanceGuard | None = None,
