@@ -28,13 +28,11 @@ from scipy.spatial import cKDTree
 
 from ...geometry.part import Part
 from ...job import Finish, Job
-from ...program.linking import linked
 from ...program.program import CutSegment, Program
 from ...work import MAX_PLANES
-from ..common import safe_height
 from .plan import FaceSamples, plan_planes
 from .uncut import UncutReport, uncut_report
-from .waterline import JOIN, stay_down_links, waterline_cuts, waterline_program, \
+from .waterline import entered_program, waterline_cuts, waterline_program, \
     waterline_samples
 
 
@@ -133,8 +131,7 @@ def strategy_program(part: Part, job: Job, raster, *, progress=None,
         plan = plan_planes(low, job.tool.radius, job.tool.allowance, op.angle,
                            stepover=op.stepover, scallop=op.scallop, max_planes=max_planes)
         reports.append((low, plan))
-    program = Program(job, linked(cuts, safe_height(part, job), join=JOIN,
-                                  stay_down=stay_down_links(part, job)), skipped)
+    program = entered_program(part, job, cuts, skipped)
     measured = [uncut_report(program, part, s, p) for s, p in reports]
     report = measured[0] if len(measured) == 1 else merged(*measured)
     program.skipped += report.skipped()

@@ -7,7 +7,8 @@ half a stepdown), finds every loop and open piece of each level exactly
 (:func:`~.loops.level_cuts`: the raster passes' guide-surface interpolation with a
 horizontal guide plane, offsets (R', 0)), and links them: straight at the feed where that
 move of the ball and shank is verified clear of the part (within a level, and from one
-level down to the next: a ramp), otherwise a retract and a plunge. What the levels left
+level down to the next: a ramp), otherwise a retract and a plunge, each loop entered by
+the rule of :mod:`cadcnc.ops.entries` (as raster's passes and pencil's corners). What the levels left
 (the flat areas, for raster; scallops over the limit) is reported like raster's
 (:mod:`.uncut`). Lengths mm.
 """
@@ -23,10 +24,10 @@ from ...geometry.offset_section import offset_face
 from ...geometry.part import Part
 from ...guard.stay_down import StayDown
 from ...job import Job
-from ...program.linking import linked
 from ...program.program import CutSegment, Program, Skipped
 from ...work import MAX_PLANES, Heartbeat
 from ..common import safe_height
+from ..entries import entered_program_segments
 from .levels import CRITICAL_MM, LevelPlan, check_stepdown, critical_heights, plan_levels
 from .loops import level_cuts
 from .plan import MAX_SAMPLES, FaceSamples, centre_chord, sample_faces
@@ -110,6 +111,18 @@ def stay_down_links(part: Part, job: Job):
                     job.tolerances.hit)
 
 
+def entered_program(part: Part, job: Job, cuts: list[CutSegment], skipped: list[Skipped]
+                    ) -> Program:
+    """The program of the levels' ``cuts`` in order, each entered by the one rule of
+    :mod:`cadcnc.ops.entries` (a loop whose start the tool cannot plunge onto is entered
+    elsewhere, or from the side, and noted; with none clear it is skipped, ``unreachable``),
+    linked straight where the move is clear."""
+    segments, unreachable, notes = entered_program_segments(
+        part, job, cuts, safe_height(part, job), join=JOIN,
+        stay_down=stay_down_links(part, job))
+    return Program(job, segments, skipped + unreachable, notes)
+
+
 def waterline_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX_PLANES,
                       clock=time.monotonic, work: dict | None = None) -> Program:
     """The waterline finishing program of a :class:`~cadcnc.job.Finish` ``job``
@@ -118,8 +131,7 @@ def waterline_program(part: Part, job: Job, *, progress=None, max_planes: int = 
     samples = waterline_samples(part, job, work)
     res = waterline_cuts(part, job, samples, progress=progress, max_levels=max_planes,
                          clock=clock, work=work)
-    program = Program(job, linked(res.cuts, safe_height(part, job), join=JOIN,
-                                  stay_down=stay_down_links(part, job)), res.skipped)
+    program = entered_program(part, job, res.cuts, res.skipped)
     report = uncut_report(program, part, samples, res.plan)
     program.skipped += report.skipped()
     program.notes += res.plan.moved + report.notes()
