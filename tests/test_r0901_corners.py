@@ -10,6 +10,9 @@ Fixtures (fixtures/build_r0901_corners.py, cut from OCCT's r0901_ec.stp):
   sent along the edge's tangent stepped off its stretch at once (exit 6). The cut now
   starts towards the stretch's next centre.
 
+And a search that does not depend on the work zero (a sample seeded on the wrong branch
+is solved again from the anchor, ``stretches.RESEED``).
+
 Judged by OCCT, not by our classifier or kernel: the cut points lie R' from both faces
 and no face of the part is nearer; the tangent limits' exact contacts (Newton) give
 |n1 x n2| at the margin.
@@ -18,6 +21,7 @@ and no face of the part is nearer; the tangent limits' exact contacts (Newton) g
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -125,3 +129,20 @@ def test_a_cut_starts_towards_its_stretch():
             a, tangent = e.curve.point_tangent(st.start.s)
             against += np.dot(tangent, chord) < 0.0
     assert against >= 1
+
+
+def test_the_corner_does_not_depend_on_the_work_zero():
+    """The same program (part coordinates) whatever the work zero. Before, with the zero
+    at the part's origin the search's first sample solved on another offset intersection
+    curve (its contact on the cylinder off the face) and followed it: "no feasible ball
+    position" (exit 3) for a corner cut complete with the default zero."""
+    name = "r0901_near_tangent"
+    p, base = part(name), job(name)
+    expected = job_setup(base, p).to_part(
+        np.concatenate([c.path.points for c in program(name).cuts]))
+    for origin in ((0.0, 0.0, 0.0), (100.0, -50.0, 20.0)):
+        j = replace(base, origin=origin)
+        got = job_setup(j, p).to_part(
+            np.concatenate([c.path.points for c in cadcnc.run(p, j).cuts]))
+        assert got.shape == expected.shape
+        assert np.abs(got - expected).max() < 1e-9

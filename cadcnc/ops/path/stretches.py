@@ -3,11 +3,11 @@
 A *feasible* ball position of a pair (i, j) is a centre touching both offset surfaces
 (Newton, :func:`~cadcnc.interp.tangency.solve_tangency`) whose feet lie on the trimmed
 faces (inside or on the boundary), where the faces are not tangent (|n1 x n2| at least
-``Tolerances.stretch_tangent_sin``), where neither
-contact's concave curvature along the path is tighter than the ball (R' k <= 1, up to
-the spec's 1 um), and where the ball and its shank clear the rest of the part
-(:class:`~cadcnc.guard.clearance.ClearanceGuard`). A *stretch* is a maximal
-connected piece of the offset intersection curve made of feasible positions.
+``Tolerances.stretch_tangent_sin``), where neither contact's concave curvature along the
+path is tighter than the ball (R' k <= 1, up to the spec's 1 um), and where the ball and
+its shank clear the rest of the part (:class:`~cadcnc.guard.clearance.ClearanceGuard`).
+A *stretch* is a maximal connected piece of the offset intersection curve made of
+feasible positions.
 
 Method: tangency samples anchored on planes normal to the edge, every ``spacing`` mm of
 edge (0.4 mm, at least 9 per edge) and continued ``R' + 1`` mm beyond each end of an
@@ -57,6 +57,12 @@ BOUNDARY, COLLISION, CURVATURE, TANGENT = "boundary", "collision", "curvature", 
 UNSOLVED = "unsolved"   # no tangency found from the sample's anchor
 SEARCH = "search"       # the stretch goes on past the searched extension of the edge
 CLOSED = "closed"       # a closed edge feasible all around
+
+RESEED = (BOUNDARY, TANGENT, UNSOLVED)
+"""Rules a seeded sample may fail on the wrong branch (two offset intersection curves
+near each other, where faces turn tangent). A sample on the edge failing another rule than
+its neighbour is solved again from the anchor, and kept if feasible: the stretches do not
+depend on where the chain started (0.35 % more samples on 64 pairs of r0901_ec)."""
 
 REASONS = {
     BOUNDARY: "a contact lies off its face",
@@ -205,18 +211,16 @@ class Feasibility:
 
 def too_tight(rk: float, offset: float, tol: Tolerances) -> bool:
     """Whether a concave curvature k with R' k = ``rk`` is tighter than a ball of offset
-    R' (mm) can follow. R' k = 1 is a tie: the ball fits the face exactly (a hole of its
-    own radius) and does not cut it; past 1 + gouge / 2 R' it cuts the face deeper than
-    the spec's 1 um (a cylinder of radius R'/(R' k) is cut by ~2 R' (R' k - 1)). A ball
-    of R' <= 0 is a point: no curvature is too tight for it."""
+    R' (mm) can follow. R' k = 1 is a tie (a hole of the ball's radius is not cut); past
+    1 + gouge / 2 R' it cuts deeper than the spec's 1 um (a cylinder of radius R'/(R' k)
+    is cut by ~2 R' (R' k - 1)). A ball of R' <= 0 is a point: nothing is too tight."""
     if not offset > 0.0:
         return False
     return rk > 1.0 + tol.gouge / (2.0 * offset)
 
 
 def _project(surface, point) -> tuple[float, float]:
-    """(u, w) of the surface point nearest ``point``: in the face's parameter box, else
-    on the whole surface (anchors past the edge's ends may project outside the box)."""
+    """(u, w) nearest ``point``: in the face's box, else on the whole surface."""
     try:
         return surface.project(point)[:2]
     except GeometryError:
@@ -252,11 +256,19 @@ def edge_stretches(feas: Feasibility, shared_edge, edge: int,
     samples: list[Sample] = []
     for s in grid:   # each seeded from the last solved sample: stays on one branch
         last = next((x for x in reversed(samples[-1:]) if x.tangency is not None), None)
-        samples.append(sample_at(feas, curve, float(s), last))
+        samples.append(_reseeded(feas, curve, float(s), last))
     samples = _refine(feas, curve, samples, out)
     out.samples = samples
     out.stretches = _stretches(feas, curve, samples, edge)
     return out
+
+
+def _reseeded(feas: Feasibility, curve: EdgeCurve, s: float, last: Sample | None) -> Sample:
+    """The sample at ``s`` seeded from ``last``, or from the anchor (see RESEED)."""
+    x = sample_at(feas, curve, s, last)
+    if last is None or x.rule not in RESEED or x.rule == last.rule or not 0 <= s <= curve.length:
+        return x
+    return max(x, sample_at(feas, curve, s, None), key=lambda y: y.ok)
 
 
 def sample_at(feas: Feasibility, curve: EdgeCurve, s: float, seed: Sample | None) -> Sample:
@@ -363,11 +375,9 @@ def _stretches(feas, curve, samples: list[Sample], edge: int) -> list[Stretch]:
 def pair_stretches(s1, s2, job: Job, guard: ClearanceGuard | None = None,
                    spacing: float = SPACING, feas: Feasibility | None = None
                    ) -> list[EdgeStretches]:
-    """Every stretch of every shared concave edge of two faces of one part.
-
-    ``guard`` defaults to the job's tool (R', shank length, tolerance ``hit``); ``feas``:
-    the judge of positions to use (one whose ``beat`` reports progress), else built here.
-    """
+    """Every stretch of every shared concave edge of two faces of one part. ``guard``
+    defaults to the job's tool (R', shank length, tolerance ``hit``); ``feas``: the judge
+    of positions to use (one whose ``beat`` reports progress), else built here."""
     part = s1.part
     edges = [e for e in part.shared_edges(s1.number, s2.number) if e.edge_class == CONCAVE]
     if feas is None:
