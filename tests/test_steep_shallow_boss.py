@@ -17,6 +17,7 @@ import json
 import math
 
 import numpy as np
+import pytest
 from scipy.spatial import cKDTree
 
 import cadcnc
@@ -137,3 +138,39 @@ def test_the_fillet_between_them_is_within_the_scallop():
             left[i] = max(0.0, float((a[inside] - np.sqrt(R * R - b2[inside])).min()))
     assert np.isfinite(left).all()
     assert left.max() <= H + 1e-6, (left.max(), p[np.argmax(left)])
+
+
+def on_offset(p: np.ndarray) -> np.ndarray:
+    """(N,) whether each centre (N, 3) is R' from the boss (closed forms, 1e-9 mm): on the
+    fillet's, the wall's, the top edge's (a torus round the circle r 8, z 15) or the top's
+    offset, within their ranges."""
+    r, z = np.hypot(p[:, 0], p[:, 1]), p[:, 2]
+    top, rb, e = FACTS["boss_top"], FACTS["boss_radius"], 1e-9
+    fillet = (np.abs(np.hypot(r - TUBE_R, z - TUBE_Z) - INNER) <= e) & (z <= TUBE_Z + e)
+    wall = (np.abs(r - WALL) <= e) & (z >= TUBE_Z - e) & (z <= top + e)
+    edge = (np.abs(np.hypot(r - rb, z - top) - R) <= e) & (r >= rb - e) & (z >= top - e)
+    flat = (np.abs(z - top - R) <= e) & (r <= rb + e)
+    return fillet | wall | edge | flat
+
+
+def test_a_plane_just_inside_the_top_rolls_back_down_over_its_edge():
+    """y 7.8772 (a plane of the raster part at --scallop 0.2) crosses the top (r 8) over
+    x +-1.40 only, near its edge's tangent: the roll from the top back down onto the wall
+    solved each arc point's edge parameter in a bracket round the whole arc, which held
+    two roots (h > 0 only between them) and never changed sign: the chain failed. Now the
+    pass is one chain from the plate's foot to the other: fillet, wall, the arc over the
+    edge, the top, the arc back, wall, fillet; every point R' from the boss."""
+    y = 7.8772
+    part = cadcnc.load_step(FIXTURES / FACTS["file"])
+    job = Job(Tool(R, 0.0, None), 1500.0, 0.004, Finish(tuple(FACTS["faces"]), None, 0.2,
+                                                       0.0, "zigzag"), source=part.source)
+    res = pass_cuts(part, job.operation.faces, GuidePlane(0.0, y), job)
+    assert not [s for s in res.skipped if s.reason == FAILED], res.skipped
+    assert len(res.cuts) == 7
+    for a, b in zip(res.cuts, res.cuts[1:]):
+        assert np.linalg.norm(a.points[-1] - b.points[0]) <= 1e-9
+    p = np.vstack([c.points for c in res.cuts])
+    assert np.abs(p[:, 1] - y).max() <= 1e-9 and on_offset(p).all()
+    foot = math.sqrt(TUBE_R ** 2 - y * y)
+    assert np.allclose([p[0, 0], p[-1, 0]], [-foot, foot], atol=1e-9)
+    assert p[:, 2].max() == pytest.approx(FACTS["boss_top"] + R, abs=1e-9)
