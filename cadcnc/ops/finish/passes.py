@@ -39,7 +39,7 @@ from ...interp.stepper import Stepper, Tangency
 from ...job import Job, PairPath
 from ...program.program import FAILED, STOPPED_SHORT, CutSegment, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
-from .check import pass_problems
+from .check import along_pass, pass_problems
 from .crossings import Crossing, pass_tangent
 from .setup import PassSetup, guide_face, pass_setup
 from .polish import polish
@@ -163,8 +163,11 @@ class _Pass:
 
     # -- the pass -----------------------------------------------------------------------
     def run(self) -> PassResult:
-        entries = sorted((c for cs in self.crossings.values() for c in cs if c.entry),
-                         key=lambda c: c.s)
+        # in their order along the pass, not by s alone: on a wall descended the entry at
+        # its top comes first, so its chain goes on into the face below through that face's
+        # entry at the wall's foot (equal s) before that entry could start a second chain
+        entries = [c for c in along_pass([c for cs in self.crossings.values() for c in cs],
+                                         self.travel) if c.entry]
         for c in entries:
             if c.used:
                 continue

@@ -169,7 +169,8 @@ def _arc_points(at, n: int, t_first: float, t_last: float, nrm, off: float, span
         elif k == n:
             t = t_last
         else:
-            t = _root(lambda x: float(at(x, alpha)[0] @ nrm - off), t_prev, t_last, span)
+            t = _root(lambda x: float(at(x, alpha)[0] @ nrm - off), t_prev, t_last,
+                      abs(t_last - t_prev) / (n - k + 1), span)
         c, q, uv, m = at(t, alpha)
         points.append(c)
         contacts.append(q)
@@ -179,16 +180,22 @@ def _arc_points(at, n: int, t_first: float, t_last: float, nrm, off: float, span
     return points, contacts, uvs, normals
 
 
-def _root(h, t0: float, t1: float, span: float) -> float:
-    """A root of h between (or, widening, around) edge parameters t0 and t1."""
-    lo, hi = min(t0, t1), max(t0, t1)
-    pad = max(hi - lo, 1e-9 * max(span, 1.0))
+def _root(h, t0: float, t1: float, step: float, span: float) -> float:
+    """The root of h nearest the edge parameter t0 (the arc's previous point): brackets
+    from t0 to t0 +- pad, the side towards t1 first, pad from ``step`` doubling. Not a
+    bracket round t0 and t1: where the plane runs near the edge's tangent (an edge circle
+    just inside the plane's offset) h is positive only between two roots, on both sides
+    of the arc's, and a wide bracket holding both never changes sign."""
+    h0 = h(t0)
+    if h0 == 0.0:
+        return t0
+    toward = 1.0 if t1 >= t0 else -1.0
+    pad = max(step, 1e-9 * max(span, 1.0))
     for _ in range(60):
-        a, b = lo - pad, hi + pad
-        ha, hb = h(a), h(b)
-        if ha == 0.0:
-            return a
-        if hb == 0.0 or math.copysign(1.0, ha) != math.copysign(1.0, hb):
-            return brentq(h, a, b, xtol=ROOT_XTOL, rtol=4 * np.finfo(float).eps)
+        for b in (t0 + toward * pad, t0 - toward * pad):
+            hb = h(b)
+            if hb == 0.0 or math.copysign(1.0, hb) != math.copysign(1.0, h0):
+                return brentq(h, min(t0, b), max(t0, b), xtol=ROOT_XTOL,
+                              rtol=4 * np.finfo(float).eps)
         pad *= 2.0
     raise StartPointError("roll-over arc: no point of the arc found on the guide plane")
