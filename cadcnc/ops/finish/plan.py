@@ -38,7 +38,7 @@ from ...errors import InputError
 from ...trim import OUTSIDE
 from ...work import MAX_PLANES, refuse_over
 from .polish import face_derivatives
-from .slope import cross_pairs, least_over_pairs
+from .slope import strip_pairs
 
 PARALLEL_DEG = 5.0
 """deg: a face whose normal is this near the planes' normal is a wall parallel to them."""
@@ -251,10 +251,7 @@ def plan_planes(samples: FaceSamples, radius: float, allowance: float, angle: fl
         return PlanePlan(angle, n, first + stepover * np.arange(count), f, reason)
     c, serve = centre_chord(scallop, k, radius, allowance), reason == ""
     spacing = np.where(serve, c * g, np.inf)
-    i, j = cross_pairs(q, samples.normals, n, c, serve, samples.spacing)
-    gap = 0.5 * samples.spacing * g * np.maximum(1.0, 1.0 - r1 * k)   # reach_j (.slope)
-    pairs = (f[i], f[j] - gap[j], f[j] + gap[j], c[i] * g[j])
-    bound = np.where(serve, c * least_over_pairs(g, i, j), np.inf)   # whatever the strip
+    pairs, bound = strip_pairs(samples, q, f, n, k, g, c, serve, r1)
     estimate = work["planes_estimate"] = planes_estimate(lo, hi, f=f, spacing=bound)
     refuse_over(f"finishing {hi - lo:.4g} mm across the planes (R' {r1:g} mm) for a "
                 f"scallop of {scallop:g} mm", estimate, max_planes, "guide planes",

@@ -17,7 +17,8 @@ within c_i of q_i) and within one sample spacing s of i's cross-section
 (|t_i . (q_j - q_i)| <= s). A pair binds a strip when f_i lies in it and f_j within
 ``reach_j`` of it, the f-distance from a point of the arc to its nearest sample
 (s g_j max(1, B_j) / 2, B = 1 - R' k the offset's stretch): at the strip's ends the arc's g
-is then that of a sample at or just past the end. Sampled, as the spacing is. Lengths mm.
+is then that of a sample at or just past the end. Sampled, as the spacing is. The
+waterline levels take the same rule with n = +Z (g the sine of the slope). Lengths mm.
 """
 
 from __future__ import annotations
@@ -60,3 +61,18 @@ def least_over_pairs(values: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.nda
     out = np.array(values, float)
     np.minimum.at(out, i, values[j])
     return out
+
+
+def strip_pairs(samples, q: np.ndarray, f: np.ndarray, normal: np.ndarray, k: np.ndarray,
+                g: np.ndarray, chord: np.ndarray, serve: np.ndarray, offset: float):
+    """(pairs, bound) of samples (a FaceSamples) at ideal centres ``q`` (N, 3), centre
+    coordinate ``f`` (N,) along the planes' ``normal`` (3,), curvature ``k`` and slope
+    factor ``g`` across them, allowed chord ``chord`` (all (N,)); ``serve`` (N,) the samples
+    the planes serve; ``offset`` R' (mm). ``pairs`` (f_i, f_j - reach_j, f_j + reach_j,
+    c_i g_j) for :func:`~.plan.adaptive_offsets`; ``bound`` (N,) c_i times the smallest
+    g_j of i's pairs (inf where not served): a spacing that holds whatever the strip, for
+    the estimate (module doc)."""
+    i, j = cross_pairs(q, samples.normals, normal, chord, serve, samples.spacing)
+    reach = 0.5 * samples.spacing * g * np.maximum(1.0, 1.0 - offset * k)
+    pairs = (f[i], f[j] - reach[j], f[j] + reach[j], chord[i] * g[j])
+    return pairs, np.where(serve, chord * least_over_pairs(g, i, j), np.inf)
