@@ -10,7 +10,8 @@ exact where the top is a horizontal face or a horizontal tangency (:func:`critic
   two neighbouring centres a chord c apart on the offset surface leave a cusp H high
   (:func:`~cadcnc.ops.finish.plan.centre_chord`, the surface's normal curvature k taken
   down the slope), and on a face sloping at phi from horizontal the levels are
-  ``Delta z = c sin phi = c sqrt(1 - N_z^2)`` apart: the raster planes' rule with the
+  ``Delta z = c sin phi = c sqrt(1 - N_z^2)`` apart, phi the gentlest between the two
+  levels on the sample's cross-section (:mod:`.slope`): the raster planes' rule with the
   planes' normal +Z (:func:`~cadcnc.ops.finish.plan.across`). A vertical wall takes
   the full chord; a near-flat area (within ``FLAT_DEG`` of horizontal) is left to raster
   (``flat``).
@@ -35,6 +36,7 @@ from ...errors import InputError
 from ...work import MAX_PLANES, refuse_over
 from .polish import face_derivatives
 from .plan import FaceSamples, across, adaptive_offsets, centre_chord, planes_estimate
+from .slope import strip_pairs
 
 FLAT_DEG = 5.0
 """deg: a sample whose normal is within this of +Z is flat: left to raster."""
@@ -171,13 +173,16 @@ def plan_levels(samples: FaceSamples, radius: float, allowance: float, *,
         levels = hi - stepdown * np.arange(int(math.floor((hi - lo) / stepdown + 1e-12)) + 1)
         half = np.full(len(levels), 0.5 * stepdown)
     else:
-        spacing = np.where(reason == "", centre_chord(scallop, k, radius, allowance) * g,
-                           np.inf)
-        estimate = work["planes_estimate"] = planes_estimate(-hi, -lo, f=-f, spacing=spacing)
+        c, serve = centre_chord(scallop, k, radius, allowance), reason == ""
+        spacing = np.where(serve, c * g, np.inf)
+        q = samples.points + r1 * samples.normals
+        pairs, bound = strip_pairs(samples, q, -f, Z, k, g, c, serve, r1)   # (.slope)
+        estimate = work["planes_estimate"] = planes_estimate(-hi, -lo, f=-f, spacing=bound)
         refuse_over(f"waterline levels over {hi - lo:.4g} mm (R' {r1:g} mm) for a scallop "
                     f"of {scallop:g} mm", estimate, max_levels, "levels",
                     "give a larger --scallop")
-        levels = -adaptive_offsets(-f, spacing, -hi, -lo, limit=int(1.5 * estimate) + 2)
+        levels = -adaptive_offsets(-f, spacing, -hi, -lo, limit=int(1.5 * estimate) + 2,
+                                   pairs=pairs)
         gaps = np.abs(np.diff(levels))
         half = 0.5 * (np.r_[gaps, gaps[-1:]] if len(gaps) else np.full(1, hi - lo))
     marks = list(critical) + [(hi, "the top of the faces"), (lo, "the bottom of the faces")]

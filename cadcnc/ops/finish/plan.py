@@ -8,13 +8,16 @@ from either end). With a scallop height H they are placed one after another, eac
 from the last as every sample between them allows (docs/finish.md, "Spacing"):
 
     c = 2 sqrt(2 R H - H^2) sqrt(B / A) sqrt(1 - s^2),   s^2 = (2 R H - H^2) k^2 / (4 A B)
-    A = |1 - (C + H) k|,  B = |1 - R' k|,  Delta = c sqrt(1 - (n . N)^2)
+    A = |1 - (C + H) k|,  B = |1 - R' k|,  Delta = c_i g_j,  g = sqrt(1 - (n . N)^2)
 
 c is the distance between neighbouring ball centres across the passes that leaves a cusp
 H high on the surface offset by the allowance C (ball R, R' = R + C; k the surface's normal
 curvature across the passes, the sign of docs/method.md: < 0 convex), exact for a
-circular cross-section; sqrt(1 - (n . N)^2) turns that distance on the offset surface into
-the distance between the planes (a slope across the passes brings them closer). Samples
+circular cross-section; g turns that distance on the offset surface into the distance
+between the planes (a slope across the passes brings them closer): the smallest c_i g_j
+over the samples i between two planes and the samples j on i's cross-section between
+them within c_i (:mod:`.slope`: the chord through a sample is set by the slope all
+across the strip, not at the sample alone). Samples
 the ball cannot serve are set apart with their reason: normals pointing down
 (``unreachable``), concave tighter than the ball (``too tight``), within
 ``PARALLEL_DEG`` of parallel to the planes (``parallel wall``). Where a face's boundary
@@ -35,6 +38,7 @@ from ...errors import InputError
 from ...trim import OUTSIDE
 from ...work import MAX_PLANES, refuse_over
 from .polish import face_derivatives
+from .slope import strip_pairs
 
 PARALLEL_DEG = 5.0
 """deg: a face whose normal is this near the planes' normal is a wall parallel to them."""
@@ -230,7 +234,8 @@ def plan_planes(samples: FaceSamples, radius: float, allowance: float, angle: fl
     r1 = radius + allowance
     n = plane_normal(angle)
     k, g = across(samples, n)
-    f = (samples.points + r1 * samples.normals) @ n
+    q = samples.points + r1 * samples.normals
+    f = q @ n
     reason = sample_reasons(samples, k, g, r1)
     reach = reason != "unreachable"
     if not reach.any():
@@ -244,15 +249,17 @@ def plan_planes(samples: FaceSamples, radius: float, allowance: float, angle: fl
         count = int(count)
         first = 0.5 * (lo + hi) - 0.5 * (count - 1) * stepover
         return PlanePlan(angle, n, first + stepover * np.arange(count), f, reason)
-    spacing = np.where(reason == "", centre_chord(scallop, k, radius, allowance) * g, np.inf)
-    estimate = work["planes_estimate"] = planes_estimate(lo, hi, f=f, spacing=spacing)
+    c, serve = centre_chord(scallop, k, radius, allowance), reason == ""
+    spacing = np.where(serve, c * g, np.inf)
+    pairs, bound = strip_pairs(samples, q, f, n, k, g, c, serve, r1)
+    estimate = work["planes_estimate"] = planes_estimate(lo, hi, f=f, spacing=bound)
     refuse_over(f"finishing {hi - lo:.4g} mm across the planes (R' {r1:g} mm) for a "
                 f"scallop of {scallop:g} mm", estimate, max_planes, "guide planes",
                 "give a larger --scallop, or a smaller --radius")
     a, e = edge_intervals(*along_edges(samples, f, g), f, spacing)
     extra = int(np.ceil((e.max() - a.min()) / (e - a).min())) + 1 if len(a) else 0
     offsets = adaptive_offsets(f, spacing, lo, hi, limit=int(1.5 * estimate) + 2 + extra,
-                               edges=(a, e))
+                               edges=(a, e), pairs=pairs)
     return PlanePlan(angle, n, offsets, f, reason, spacing)
 
 
@@ -331,14 +338,15 @@ def planes_estimate(lo: float, hi: float, *, stepover: float | None = None, f=No
 
 
 def adaptive_offsets(f: np.ndarray, spacing: np.ndarray, lo: float, hi: float,
-                     limit: int = MAX_PLANES, edges=None) -> np.ndarray:
+                     limit: int = MAX_PLANES, edges=None, pairs=None) -> np.ndarray:
     """Plane offsets from ``lo`` to ``hi`` (mm): the first within half the spacing its
     samples allow of ``lo``, each next as far from the last as the smallest ``spacing``
     (N,) of the samples whose ``f`` (N,) lies between them, the last within half a spacing
     of ``hi``. ``edges``: intervals (a, e) (M,) each of which must hold a plane: a next
     plane comes no later than the first end e of an interval starting after the last
-    (the greedy stabbing). More than ``limit`` planes is an error (the estimate was
-    wrong)."""
+    (the greedy stabbing). ``pairs`` (fi, lo_j, hi_j, v) (P,): a spacing v binding the
+    planes where fi lies between them and [lo_j, hi_j] meets them (:mod:`.slope`). More
+    than ``limit`` planes is an error (the estimate was wrong)."""
     order = np.argsort(f)
     fs, sp = f[order], spacing[order]
     finite = sp[np.isfinite(sp)]
@@ -349,6 +357,9 @@ def adaptive_offsets(f: np.ndarray, spacing: np.ndarray, lo: float, hi: float,
     by = np.argsort(a)
     a = a[by]
     ends = np.minimum.accumulate(e[by][::-1])[::-1] if len(a) else e   # min end of a[i:]
+    pi, plo, phi, pv = (np.zeros(0),) * 4 if pairs is None else pairs
+    po = np.argsort(pi)
+    pi, plo, phi, pv = pi[po], plo[po], phi[po], pv[po]
 
     def allowed(x: float) -> float:
         """The smallest spacing of the samples in [x, x + d], shrinking d to it."""
@@ -356,6 +367,9 @@ def adaptive_offsets(f: np.ndarray, spacing: np.ndarray, lo: float, hi: float,
         for _ in range(60):
             i, j = np.searchsorted(fs, x, side="left"), np.searchsorted(fs, x + d, side="right")
             m = float(sp[i:j].min()) if j > i else math.inf
+            i, j = np.searchsorted(pi, x, side="left"), np.searchsorted(pi, x + d, side="right")
+            on = (phi[i:j] >= x) & (plo[i:j] <= x + d)
+            m = min(m, float(pv[i:j][on].min(initial=math.inf)))
             if m >= d:
                 return d
             d = m
