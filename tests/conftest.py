@@ -76,6 +76,19 @@ def load_fixture(name: str):
     return _parts[name]
 
 
+def occt_distance(point, shape) -> float:
+    """OCCT's distance (mm) from a point (3,) to a shape: BRepExtrema_DistShapeShape."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+    from OCP.gp import gp_Pnt
+
+    d = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, point)))
+                                   .Vertex(), shape)
+    d.Perform()
+    assert d.IsDone()
+    return d.Value()
+
+
 @pytest.fixture
 def fixture_part():
     return load_fixture

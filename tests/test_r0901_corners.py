@@ -25,9 +25,6 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
-from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-from OCP.gp import gp_Pnt
 
 import cadcnc
 from cadcnc.geometry.setup import job_setup, setup_part
@@ -35,7 +32,7 @@ from cadcnc.interp.cycle import Contact
 from cadcnc.ops.path.stretches import TANGENT, pair_stretches
 from cadcnc.tolerances import DEFAULT
 
-from conftest import FIXTURES
+from conftest import FIXTURES, occt_distance as distance
 
 FACTS = json.loads((FIXTURES / "r0901_corners.json").read_text())
 _cache: dict = {}
@@ -58,15 +55,6 @@ def program(name: str):
     if key not in _cache:
         _cache[key] = cadcnc.run(part(name), job(name))
     return _cache[key]
-
-
-def distance(point, shape) -> float:
-    """OCCT's distance (mm) from a point to a shape."""
-    d = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, point)))
-                                   .Vertex(), shape)
-    d.Perform()
-    assert d.IsDone()
-    return d.Value()
 
 
 def stretches(name: str):

@@ -17,9 +17,6 @@ import json
 
 import numpy as np
 import pytest
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
-from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-from OCP.gp import gp_Pnt
 
 import cadcnc
 from cadcnc.geometry.part_bytes import part_blob, part_from_blob
@@ -28,7 +25,7 @@ from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.stretch_split import split_at_stop
 from cadcnc.ops.path.stretches import pair_stretches
 
-from conftest import FIXTURES
+from conftest import FIXTURES, occt_distance as distance
 
 FACTS = json.loads((FIXTURES / "grazed_hole.json").read_text())
 R = FACTS["radius"]
@@ -47,15 +44,6 @@ def program():
             faces=tuple(FACTS["pair"])))
         _cache["program"] = cadcnc.run(part(), job)
     return _cache["program"]
-
-
-def distance(point, shape) -> float:
-    """OCCT's distance (mm) from a point to a shape."""
-    d = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, point)))
-                                   .Vertex(), shape)
-    d.Perform()
-    assert d.IsDone()
-    return d.Value()
 
 
 def test_the_gap_is_real_by_occt():
