@@ -8,6 +8,10 @@ from dataclasses import dataclass, fields
 from .errors import InputError
 
 
+STRETCH_TANGENT_MARGIN = 2.0
+"""The stretch search's tangent limit over the interpolator's (``stretch_tangent_sin``)."""
+
+
 @dataclass(frozen=True)
 class Tolerances:
     """Every threshold cadcnc uses. Pass a modified copy (``dataclasses.replace``) to change one.
@@ -23,9 +27,9 @@ class Tolerances:
       sphere degenerates to the offset tangent plane.
     - ``tangent_sin``: |n1 x n2| below this means the two faces are tangent, the
       intersection direction is undefined (sin of ~0.57 deg).
-    - ``stretch_tangent_sin``: the stretch search's tangent rule: a corner position is
-      feasible only where |n1 x n2| (at its exact contacts) is at least this, twice
-      ``tangent_sin``. Near tangency the interpolator's centre strays from the offset
+    - ``stretch_tangent_sin`` (derived, not set): the stretch search's tangent rule: a
+      corner position is feasible only where |n1 x n2| (at its exact contacts) is at least
+      STRETCH_TANGENT_MARGIN (2) times ``tangent_sin``. Near tangency the interpolator's centre strays from the offset
       intersection curve along its ill-conditioned direction (by ~2 um at sin 0.01, still
       on both offset surfaces), so its own |n1 x n2| reads a few per cent off the exact
       value; the margin keeps a cut started at a tangent limit from stopping there.
@@ -82,7 +86,6 @@ class Tolerances:
     near_singular: float = 1e-4
     flat_curvature: float = 1e-9
     tangent_sin: float = 1e-2
-    stretch_tangent_sin: float = 2e-2
     tangent_edge_deg: float = 1.0
     start: float = 1e-9
     on_boundary: float = 1e-6
@@ -101,6 +104,10 @@ class Tolerances:
     classify_loose: float = 1e-4
     intersection: float = 1e-7
     sewing: float = 1e-2
+
+    @property
+    def stretch_tangent_sin(self) -> float:
+        return STRETCH_TANGENT_MARGIN * self.tangent_sin
 
     def __post_init__(self):
         for f in fields(self):

@@ -8,9 +8,9 @@ half a stepdown), finds every loop and open piece of each level exactly
 horizontal guide plane, offsets (R', 0)), and links them: straight at the feed where that
 move of the ball and shank is verified clear of the part (within a level, and from one
 level down to the next: a ramp), otherwise a retract and a plunge, each loop entered by
-the rule of :mod:`cadcnc.ops.entries` (as raster's passes and pencil's corners). What the levels left
-(the flat areas, for raster; scallops over the limit) is reported like raster's
-(:mod:`.uncut`). Lengths mm.
+the rule of :mod:`cadcnc.ops.entries` (as raster's passes and pencil's corners). What the
+levels left (the flat areas, for raster; scallops over the limit) is reported like
+raster's (:mod:`.uncut`). Lengths mm.
 """
 
 from __future__ import annotations
