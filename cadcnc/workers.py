@@ -5,8 +5,10 @@ Operations (pencil corners, finishing planes) and the gouge gate (one task per c
 tasks run here, in order, on the caller's part; else in a
 ``concurrent.futures.ProcessPoolExecutor`` whose workers rebuild the part once each
 (the ``build`` function and its arguments, e.g. BRep bytes: OCCT shapes do not pickle),
-so start-up (imports, compiled kernels, the part's faces) is paid once per worker, not
-per task. The pool is kept for the part and reused by the next call with the same
+so start-up (the part's faces) is paid once per worker, not per task. Workers are forked
+from a server process that has the library imported and its compiled kernels loaded
+(:data:`PRELOAD`); :func:`start` starts it early, while the caller still reads the part
+and plans. The pool is kept for the part and reused by the next call with the same
 part (the gate after the computation) until :func:`close` or exit.
 
 Results come back in task order whatever the number of workers, so outputs do not
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import atexit
 import multiprocessing
+import multiprocessing.forkserver
 import os
 import signal
 import threading
@@ -31,8 +34,9 @@ from typing import Any, Callable, Iterator, Sequence
 
 from .errors import CadcncError, InputError
 
-PRELOAD = ["cadcnc.ops.run", "cadcnc.verification.gate_jobs"]
-"""Modules the workers' server imports once (every worker starts with them loaded)."""
+PRELOAD = ["cadcnc.ops.run", "cadcnc.verification.gate_jobs", "cadcnc.ops.warm_up"]
+"""Modules the workers' server imports once (every worker starts with them loaded; the
+last runs a small job, so the compiled kernels are loaded too: :mod:`cadcnc.ops.warm`)."""
 ENV = "CADCNC_JOBS"
 """The default number of processes when none is given (unset: every core)."""
 WATCH_S = 0.5
@@ -67,6 +71,15 @@ def check_jobs(jobs: int | None) -> int:
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise InputError(f"jobs (--jobs) must be a whole number of processes >= 1, got {jobs!r}")
     return jobs
+
+
+def start(jobs: int | None) -> None:
+    """Start the workers' server now when ``jobs`` asks for more than one process (None:
+    every core), so that its imports and warm-up (:data:`PRELOAD`, a few seconds) run on
+    another core while this process reads the part and plans; the pools started later
+    fork their workers from it at once. InputError for a bad ``jobs``."""
+    if check_jobs(jobs) > 1 and _context().get_start_method() == "forkserver":
+        multiprocessing.forkserver.ensure_running()
 
 
 def _init(build: Callable, args: tuple, parent: int) -> None:

@@ -16,6 +16,7 @@ from importlib.metadata import version
 
 from cadcnc.errors import EXIT_INTERRUPTED, CadcncError  # light: the package loads OCCT lazily
 from cadcnc.interrupts import sigint_deferred
+from cadcnc import workers
 
 from .operation import DEFAULT_FEED, DEFAULT_PERIOD, add_axis_options, add_max_cycles
 
@@ -211,6 +212,8 @@ def main(argv: list[str] | None = None) -> int:
         # importing the library (OCCT) takes ~1.5 s: `--help` and usage errors don't pay it;
         # Ctrl-C inside OCCT's C-extension import would surface as an ImportError
         with sigint_deferred():
+            if getattr(args, "jobs", 1) != 1:   # its imports run beside ours
+                workers.start(args.jobs)
             if args.command == "faces":   # reads the part only: no interpolation core
                 from .faces import faces as run
             else:

@@ -36,6 +36,7 @@ from ..job import Job
 from ..program.linking import Visit, linked
 from ..program.program import CutSegment, LinkSegment, Skipped
 from ..program.toolpath import toolpath_piece
+from .parallel import on_workers
 
 UNREACHABLE = "unreachable"
 SIDES = ((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, -1.0, 0.0))
@@ -152,10 +153,25 @@ def _entry(cut: CutSegment, access: Access) -> tuple[int, np.ndarray | None, str
                       f"({', '.join(SIDE_NAMES)}) at its height: blocked too")
 
 
-def visit_for(cut: CutSegment, access: Access) -> Visit | Skipped:
-    """The :class:`Visit` that enters, cuts and leaves ``cut`` (module doc), or its
-    :class:`Skipped` (UNREACHABLE) when no entry is clear."""
+def entry_plan(cut: CutSegment, access: Access) -> tuple[int, np.ndarray | None, str, bool]:
+    """Where ``cut`` is entered and whether the tool leaves straight up: (index, side
+    point or None, why not, out) as :func:`_entry` gives them, ``out`` whether the plunge
+    from the last point cut is clear (asked only when it decides the :class:`Visit`).
+    Plain values: a worker's answer (:func:`entered_program_segments`)."""
     k, side, why = _entry(cut, access)
+    if k < 0:
+        return k, side, why, False
+    n = len(cut.points) - 1
+    last = n if k == 0 else 0
+    out = side is None and (last == k or access.plunge(cut.path.faces, cut.points[last])[0])
+    return k, side, why, out
+
+
+def visit_for(cut: CutSegment, access: Access, plan=None) -> Visit | Skipped:
+    """The :class:`Visit` that enters, cuts and leaves ``cut`` (module doc), or its
+    :class:`Skipped` (UNREACHABLE) when no entry is clear; ``plan``: its
+    :func:`entry_plan` when already known."""
+    k, side, why, out = entry_plan(cut, access) if plan is None else plan
     path, n = cut.path, len(cut.points) - 1
     if k < 0:
         return Skipped(path.faces, UNREACHABLE, f"cut of {path.length:.3f} mm: {why}",
@@ -168,24 +184,25 @@ def visit_for(cut: CutSegment, access: Access) -> Visit | Skipped:
     else:
         segments = [piece(k, n, False), _retrace(path, k, n, True), piece(0, k, True)]
         last = 0
-    if side is None and (last == k or access.plunge(path.faces, cut.points[last])[0]):
+    if out:
         return Visit(segments, None, None)
     if last != k:   # back along the cut to where the tool came in
         segments.append(_retrace(path, min(k, last), max(k, last), last > k))
     return Visit(segments, side, side)
 
 
-def entered(cuts: list[CutSegment], access: Access, tick=None
+def entered(cuts: list[CutSegment], access: Access, tick=None, plans=None
             ) -> tuple[list, list[Skipped], list[str]]:
     """Each cut as it is entered (the cut itself when a plunge onto its start and out of
     its end are clear, else its :class:`Visit`), those skipped as UNREACHABLE, and a note
     counting the cuts entered otherwise than at their start (none when every one is).
-    ``tick(k, n)``: called before cut k of n is looked at (a heartbeat)."""
+    ``tick(k, n)``: called before cut k of n is looked at (a heartbeat); ``plans``: each
+    cut's :func:`entry_plan` when already known."""
     out, skipped, ways = [], [], {}
     for k, cut in enumerate(cuts):
-        if tick is not None:
+        if tick is not None and plans is None:
             tick(k, len(cuts))
-        v = visit_for(cut, access)
+        v = visit_for(cut, access, None if plans is None else plans[k])
         if isinstance(v, Skipped):
             skipped.append(v)
             continue
@@ -215,12 +232,38 @@ def _way(cut: CutSegment, v: Visit) -> str:
 
 
 def entered_program_segments(part, job: Job, cuts: list[CutSegment], z_safe: float,
-                             join: float = 0.0, stay_down=None, order=None, tick=None
-                             ) -> tuple[list, list[Skipped], list[str]]:
+                             join: float = 0.0, stay_down=None, order=None, tick=None,
+                             jobs: int | None = 1) -> tuple[list, list[Skipped], list[str]]:
     """The segments of a program of ``cuts`` (each entered by the rule of the module doc,
     then ordered by ``order(items)`` when given, and linked), the cuts skipped, and the
-    note on entries (:func:`entered`, with ``tick``)."""
-    items, skipped, notes = entered(cuts, Access(part, job, z_safe), tick)
+    note on entries (:func:`entered`, with ``tick``). ``jobs``: processes looking for
+    the cuts' entries (None: every core); the answer does not depend on it."""
+    access, plans = Access(part, job, z_safe), None
+    if jobs != 1 and len(cuts) > 1:
+        seen = [0]
+
+        def told(_: int, _plan) -> None:
+            seen[0] += 1
+            if tick is not None:
+                tick(seen[0], len(cuts))
+
+        plans = on_workers(_plan_task, [(job, z_safe, cut) for cut in cuts], part, jobs,
+                           told, "the entry of cut")
+    items, skipped, notes = entered(cuts, access, tick, plans)
     if order is not None:
         items = order(items)
     return linked(items, z_safe, join=join, stay_down=stay_down), skipped, notes
+
+
+_ACCESS: list = [None]
+"""In a worker: the last (part, job, z_safe, Access), kept for the next cut's entry."""
+
+
+def _plan_task(part, task, beat=None) -> tuple:
+    """One cut's :func:`entry_plan` (an :func:`on_workers` task), its Access (and the
+    guards it builds) shared with the process's next cut of the same part and job."""
+    job, z_safe, cut = task
+    held = _ACCESS[0]
+    if held is None or held[0] is not part or held[1] != job or held[2] != z_safe:
+        held = _ACCESS[0] = (part, job, z_safe, Access(part, job, z_safe))
+    return entry_plan(cut, held[3])

@@ -8,6 +8,7 @@ from ..geometry.setup import setup_part
 from ..job import Finish, Job, PairPath, Pencil
 from ..program.program import Program
 from ..work import MAX_CYCLES
+from ..workers import start
 from .finish.finish import JOIN, finish_program
 from .path.pair_program import program_for_job
 from .pencil.pencil import CHAIN_GAP, pencil_program
@@ -28,6 +29,7 @@ def run(part, job: Job, *, progress=None, times: dict | None = None,
     core; default 1, this process); the program is the same whatever it is."""
     if not isinstance(job, Job):
         raise InputError(f"job must be a cadcnc.Job, got {type(job).__name__}")
+    start(jobs)   # the workers' server warms up while the part is read and planned
     if not isinstance(part, Part):
         part = Part.from_cadquery(part, job.tolerances)
     part = setup_part(part, job)   # the tool axis up: the program in work coordinates

@@ -117,7 +117,7 @@ def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX
     stay_down = stay_down_links(part, job) if pattern == "zigzag" else None
     segments, unreachable, notes = entered_program_segments(
         part, job, cuts, safe_height(part, job), join=JOIN, stay_down=stay_down,
-        tick=lambda k, n: beat.beat(f"entries: {k} of {n} cuts"))
+        tick=lambda k, n: beat.beat(f"entries: {k} of {n} cuts"), jobs=jobs)
     program = Program(job, segments, skipped + unreachable, notes)
     report = uncut_report(program, part, samples, plan)
     program.skipped += report.skipped()

@@ -147,7 +147,7 @@ def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = 
         segments, unreachable, notes = entered_program_segments(
             part, job, cuts, safe_height(part, job), join=CHAIN_GAP,
             order=lambda items: order_cuts(items, CHAIN_GAP),
-            tick=lambda k, n: beat.beat(f"linking: {k} of {n} cuts entered"))
+            tick=lambda k, n: beat.beat(f"linking: {k} of {n} cuts entered"), jobs=jobs)
     return Program(job, segments, skipped + unreachable, notes)
 
 
