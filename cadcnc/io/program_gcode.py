@@ -35,27 +35,10 @@ def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: b
     """One RS274/NGC program for ``program`` (see the module doc); InputError on a point
     or word that cannot be written. ``spindle`` and ``plunge_feed`` default to the job's;
     ``notes``: comment lines after the title (a setup's axis and work zero)."""
-    if not program.segments:
-        raise InputError("the program has no segment: nothing to write")
-    tol = DEFAULT_TOLERANCE if tolerance is None else float(tolerance)
-    digits = digits_for(tol)
-    feed = program.job.feed
-    plunge_feed = program.job.plunge_feed if plunge_feed is None else plunge_feed
-    spindle = program.job.spindle if spindle is None else spindle
-    plunge = feed if plunge_feed is None else check_number("plunge feed", plunge_feed,
-                                                            "mm/min")
-    if spindle is not None:
-        check_number("spindle speed", spindle, "rpm")
-    for name, f in (("feed", feed), ("plunge feed", plunge)):
-        if float(num(f, 3)) <= 0:
-            raise InputError(f"{name} {f:g} mm/min prints as F0: too slow for G-code")
-    dz = program.job.tool.radius if tool_tip else 0.0
+    tol, digits, feed, plunge, spindle, dz = _writable(program, tolerance, tool_tip, spindle,
+                                                       plunge_feed)
     n = lambda v: num(v, digits)  # noqa: E731
     xyz = lambda p: f"X{n(p[0])} Y{n(p[1])} Z{n(p[2] - dz)}"  # noqa: E731
-    for k, seg in enumerate(program.segments, 1):
-        if not np.all(np.isfinite(seg.points)):
-            raise InputError(f"segment {k} ({seg.kind}) has a non-finite point: nothing "
-                             "written")
     point_name = "tool tip (ball centre Z - R)" if tool_tip else "ball centre"
     first = program.segments[0].points[0]
     lines = [
@@ -102,6 +85,30 @@ def program_ngc(program: Program, *, tolerance: float | None = None, tool_tip: b
     return "\n".join(lines) + "\n"
 
 
+def _writable(program: Program, tolerance, tool_tip, spindle, plunge_feed) -> tuple:
+    """(tolerance, decimals, feed, plunge feed, spindle, Z offset) :func:`program_ngc`
+    writes ``program`` with; InputError when a point or a word cannot be written."""
+    if not program.segments:
+        raise InputError("the program has no segment: nothing to write")
+    tol = DEFAULT_TOLERANCE if tolerance is None else float(tolerance)
+    feed = program.job.feed
+    plunge_feed = program.job.plunge_feed if plunge_feed is None else plunge_feed
+    spindle = program.job.spindle if spindle is None else spindle
+    plunge = feed if plunge_feed is None else check_number("plunge feed", plunge_feed,
+                                                            "mm/min")
+    if spindle is not None:
+        check_number("spindle speed", spindle, "rpm")
+    for name, f in (("feed", feed), ("plunge feed", plunge)):
+        if float(num(f, 3)) <= 0:
+            raise InputError(f"{name} {f:g} mm/min prints as F0: too slow for G-code")
+    for k, seg in enumerate(program.segments, 1):
+        if not np.all(np.isfinite(seg.points)):
+            raise InputError(f"segment {k} ({seg.kind}) has a non-finite point: nothing "
+                             "written")
+    dz = program.job.tool.radius if tool_tip else 0.0
+    return tol, digits_for(tol), feed, plunge, spindle, dz
+
+
 _SEGMENT = re.compile(r"^\(segment \d+: (cut|link)")
 
 
@@ -126,11 +133,35 @@ def segment_moves(text: str, tool_tip_offset: float = 0.0) -> list[np.ndarray]:
             for m in out]
 
 
-def program_written_moves(program: Program, **options) -> list[np.ndarray]:
-    """Per segment of ``program``, the positions :func:`program_ngc` with ``options``
-    commands (see :func:`segment_moves`): what the whole-program gouge gate checks."""
-    text = program_ngc(program, **options)
-    return segment_moves(text, program.job.tool.radius if options.get("tool_tip") else 0.0)
+def program_written_moves(program: Program, *, tolerance: float | None = None,
+                          tool_tip: bool = False, spindle: float | None = None,
+                          plunge_feed: float | None = None, **_text) -> list[np.ndarray]:
+    """Per segment of ``program``, the positions :func:`program_ngc` with these options
+    commands, as :func:`segment_moves` reads them from its text (the same floats: each
+    coordinate as its written decimal), without writing the text: what the
+    whole-program gouge gate checks. InputError as :func:`program_ngc`; ``_text``: its
+    options that change only the text (title, notes, blend)."""
+    _, digits, _, _, _, dz = _writable(program, tolerance, tool_tip, spindle, plunge_feed)
+    pos = _as_written(program.segments[0].points[:1], digits, dz)
+    out = []
+    for seg in program.segments:
+        if seg.kind == "cut" and tolerance:
+            pts = seg.points[simplify(seg.points, tolerance)[1:]]
+        else:
+            pts = seg.points[1:]
+        moves = np.vstack([pos, _as_written(pts, digits, dz)])
+        out.append(moves)
+        pos = moves[-1:]
+    return out
+
+
+def _as_written(points: np.ndarray, digits: int, dz: float) -> np.ndarray:
+    """(N, 3) ball centres as :func:`program_ngc` writes them and the machine reads them
+    back: each coordinate (Z less ``dz``) to ``digits`` decimals, Z plus ``dz`` again."""
+    pts = np.array(points, dtype=float).reshape(-1, 3)
+    pts[:, 2] -= dz
+    flat = [float(f"{v:.{digits}f}") + 0.0 for v in pts.ravel().tolist()]  # "-0" is "0"
+    return np.array(flat, dtype=float).reshape(-1, 3) + (0.0, 0.0, dz)
 
 
 def to_ngc(paths, *, safe_z: float | None = None, **options) -> str:
