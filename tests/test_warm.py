@@ -24,3 +24,13 @@ def test_warm_loads_cached_kernels_before_their_first_call():
     before, after, loaded, misses = map(int, _python(WARM).split())
     assert before == 0 and after >= 1 and loaded >= after
     assert misses == 0   # loaded from the cache, not compiled
+
+
+START = ("import multiprocessing.forkserver as f; from cadcnc import workers; "
+         "workers.start(1); one = f._forkserver._forkserver_pid; "
+         "workers.start(2); print(one, f._forkserver._forkserver_pid)")
+
+
+def test_the_workers_server_starts_early_only_for_more_than_one_process():
+    one, two = _python(START).split()
+    assert one == "None" and int(two) > 0
