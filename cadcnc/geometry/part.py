@@ -139,7 +139,6 @@ class Part:
         self._faces: dict[int, FaceSurface] = {}
         self._edges: dict[tuple[int, int], list[SharedEdge]] | None = None
         self._emap: TopTools_IndexedDataMapOfShapeListOfShape | None = None
-        self._oriented_edges: dict[tuple[int, int], object] | None = None
         self._bbox: tuple[np.ndarray, np.ndarray] | None = None
         self._face_boxes: tuple[np.ndarray, np.ndarray] | None = None
         self.warnings: list[str] = []  # what OCCT printed while reading the file
@@ -241,9 +240,10 @@ class Part:
 
     def _classify_edges(self) -> dict[tuple[int, int], list[SharedEdge]]:
         result: dict[tuple[int, int], list[SharedEdge]] = {}
+        oriented = self._orientations()
         for k, edge, numbers in self._shared_edge_keys():
-            sides = [EdgeSide(self._oriented(k, n, edge), self.face(n)) for n in numbers]
-            shared = self._classify_edge(edge, *numbers, sides=sides)
+            sides = [EdgeSide(oriented[k, n], self.face(n)) for n in numbers]
+            shared = self._classify_edge(edge, *numbers, sides)
             result.setdefault((numbers[0], numbers[1]), []).append(shared)
         return dict(sorted(result.items()))
 
@@ -255,38 +255,42 @@ class Part:
             edge = TopoDS.Edge_s(emap.FindKey(k))
             if BRep_Tool.Degenerated_s(edge):
                 continue
-            numbers = sorted({self._fmap.FindIndex(f) for f in emap.FindFromIndex(k)})
+            numbers = self._face_numbers(emap.FindFromIndex(k))
             if len(numbers) == 2:
                 out.append((k, edge, numbers))
         return out
 
-    def _oriented(self, k: int, n: int, edge):
-        """Edge k of :meth:`edge_map` as oriented in face n (its first occurrence in the
-        face's wires); one walk over every face's edges answers them all."""
-        if self._oriented_edges is None:
-            emap, found = self.edge_map(), {}
-            for m in range(1, len(self) + 1):
-                exp = TopExp_Explorer(self._fmap.FindKey(m), TopAbs_EDGE)
-                while exp.More():
-                    found.setdefault((emap.FindIndex(exp.Current()), m),
-                                     TopoDS.Edge_s(exp.Current()))
-                    exp.Next()
-            self._oriented_edges = found
-        found = self._oriented_edges.get((k, n))
-        return found if found is not None else _oriented_in(edge, self.face(n))
+    def _face_numbers(self, faces) -> list[int]:
+        """The sorted distinct numbers of an OCCT list of this part's faces (read by
+        First/Last: iterating such a list from Python costs ~0.5 ms)."""
+        n = faces.Extent()
+        shapes = [faces.First(), faces.Last()][:n] if n <= 2 else list(faces)
+        return sorted({self._fmap.FindIndex(f) for f in shapes})
 
-    def _classify_edge(self, edge, i: int, j: int, samples: int = 9,
-                       sides: list["EdgeSide"] | None = None) -> SharedEdge:
+    def _orientations(self) -> dict[tuple[int, int], object]:
+        """{(k, n): edge k of :meth:`edge_map` as oriented in face n (its first occurrence
+        in the face's wires)}, from one walk over every face's edges."""
+        emap, found = self.edge_map(), {}
+        for n in range(1, len(self) + 1):
+            exp = TopExp_Explorer(self._fmap.FindKey(n), TopAbs_EDGE)
+            while exp.More():
+                found.setdefault((emap.FindIndex(exp.Current()), n),
+                                 TopoDS.Edge_s(exp.Current()))
+                exp.Next()
+        return found
+
+    def _classify_edge(self, edge, i: int, j: int, sides: list["EdgeSide"],
+                       samples: int = 9) -> SharedEdge:
+        """The SharedEdge of ``edge`` between faces i < j seen from ``sides`` (its
+        :class:`EdgeSide` in face i, then in face j), sampled at ``samples`` parameters."""
         curve = BRepAdaptor_Curve(edge)
         t0, t1 = curve.FirstParameter(), curve.LastParameter()
         ts = t0 + (t1 - t0) * (np.arange(samples) + 0.5) / samples
-        if sides is None:
-            sides = [EdgeSide(_oriented_in(edge, self.face(n)), self.face(n)) for n in (i, j)]
         angles, points = [], []
         for t in ts:
             p = np.array(curve.Value(t).Coord())
             (d1, n1), (d2, n2) = (side.inward_and_normal(t) for side in sides)
-            theta = math.degrees(math.atan2(np.linalg.norm(cross(d1, d2)), d1 @ d2))
+            theta = math.degrees(math.atan2(_norm(cross(d1, d2)), d1 @ d2))
             angles.append(360.0 - theta if d2 @ n1 > 0 else theta)
             points.append(p)
         angles = np.array(angles)
@@ -338,7 +342,7 @@ class EdgeSide:
         if self._sign < 0:
             tangent = -tangent
         d = cross(n, tangent)
-        return d / np.linalg.norm(d), n
+        return d / _norm(d), n
 
 
 def _oriented_in(edge, face: FaceSurface):
@@ -364,4 +368,10 @@ def _point_and_tangent(curve: BRepAdaptor_Curve, t: float) -> tuple[np.ndarray, 
     p, v = gp_Pnt(), gp_Vec()
     curve.D1(t, p, v)
     d = np.array(v.Coord())
-    return np.array(p.Coord()), d / np.linalg.norm(d)
+    return np.array(p.Coord()), d / _norm(d)
+
+
+def _norm(v: np.ndarray) -> float:
+    """|v| of a (3,) float array: np.linalg.norm's value (the square root of v.dot(v))
+    without its overhead."""
+    return math.sqrt(v.dot(v))
