@@ -207,6 +207,16 @@ class Part:
             self._edges = self._classify_edges()
         return self._edges
 
+    @property
+    def adjacency_known(self) -> bool:
+        """Whether :attr:`adjacency` is computed (or taken) already."""
+        return self._edges is not None
+
+    def take_adjacency(self, edges: dict[tuple[int, int], list[SharedEdge]]) -> None:
+        """Use ``edges`` as :attr:`adjacency` instead of classifying: those of a copy of this
+        part, with this part's own edge objects (:mod:`.part_bytes`)."""
+        self._edges = edges
+
     def shared_edges(self, i: int, j: int) -> list[SharedEdge]:
         self.face(i), self.face(j)
         return self.adjacency.get((min(i, j), max(i, j)), [])
@@ -241,13 +251,13 @@ class Part:
     def _classify_edges(self) -> dict[tuple[int, int], list[SharedEdge]]:
         result: dict[tuple[int, int], list[SharedEdge]] = {}
         oriented = self._orientations()
-        for k, edge, numbers in self._shared_edge_keys():
+        for k, edge, numbers in self.shared_edge_indices():
             sides = [EdgeSide(oriented[k, n], self.face(n)) for n in numbers]
             shared = self._classify_edge(edge, *numbers, sides)
             result.setdefault((numbers[0], numbers[1]), []).append(shared)
         return dict(sorted(result.items()))
 
-    def _shared_edge_keys(self) -> list[tuple[int, object, list[int]]]:
+    def shared_edge_indices(self) -> list[tuple[int, object, list[int]]]:
         """(index in :meth:`edge_map`, edge, [i, j]) of every edge two faces i < j share
         (seams, collapsed and non-manifold edges left out)."""
         emap, out = self.edge_map(), []
