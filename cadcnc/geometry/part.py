@@ -252,7 +252,7 @@ class Part:
         result: dict[tuple[int, int], list[SharedEdge]] = {}
         oriented = self._orientations()
         for k, edge, numbers in self.shared_edge_indices():
-            sides = [EdgeSide(oriented[k, n], self.face(n)) for n in numbers]
+            sides = [EdgeSide(oriented.get((k, n)), self.face(n)) for n in numbers]
             shared = self._classify_edge(edge, *numbers, sides)
             result.setdefault((numbers[0], numbers[1]), []).append(shared)
         return dict(sorted(result.items()))
