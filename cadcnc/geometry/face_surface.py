@@ -218,7 +218,7 @@ class FaceSurface:
 
     def singularity(self, ru: np.ndarray, rw: np.ndarray) -> float:
         """|r_u x r_w| / (|r_u|^2 + |r_w|^2): 0 at a singular point, 1/2 for a square grid."""
-        c = np.cross(ru, rw)
+        c = dg.cross(ru, rw)
         return float(math.sqrt(c @ c) / (ru @ ru + rw @ rw + 1e-300))
 
     def normal(self, u: float, w: float) -> np.ndarray:
@@ -234,7 +234,7 @@ class FaceSurface:
             raise SingularPointError(
                 f"{self!r}: singular parameter point (u={u:.6g}, w={w:.6g}): "
                 "r_u x r_w vanishes (pole, apex or degenerate edge), no normal", u, w)
-        c = np.cross(ru, rw)
+        c = dg.cross(ru, rw)
         return self._sign * c / np.linalg.norm(c)
 
     def is_singular(self, u: float, w: float) -> bool:

@@ -26,6 +26,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
 from ..errors import FaceNumberError, InputError, StepFileError
+from .differential import cross
 from .face_surface import FaceSurface
 from .material_side import FLIPPED, SOLID, SurfaceModel, material_sides
 from .sewing import file_faces, sew
@@ -137,6 +138,7 @@ class Part:
             self._fmap.Add(f)
         self._faces: dict[int, FaceSurface] = {}
         self._edges: dict[tuple[int, int], list[SharedEdge]] | None = None
+        self._emap: TopTools_IndexedDataMapOfShapeListOfShape | None = None
         self._bbox: tuple[np.ndarray, np.ndarray] | None = None
         self._face_boxes: tuple[np.ndarray, np.ndarray] | None = None
         self.warnings: list[str] = []  # what OCCT printed while reading the file
@@ -205,6 +207,16 @@ class Part:
             self._edges = self._classify_edges()
         return self._edges
 
+    @property
+    def adjacency_known(self) -> bool:
+        """Whether :attr:`adjacency` is computed (or taken) already."""
+        return self._edges is not None
+
+    def take_adjacency(self, edges: dict[tuple[int, int], list[SharedEdge]]) -> None:
+        """Use ``edges`` as :attr:`adjacency` instead of classifying: those of a copy of this
+        part, with this part's own edge objects (:mod:`.part_bytes`)."""
+        self._edges = edges
+
     def shared_edges(self, i: int, j: int) -> list[SharedEdge]:
         self.face(i), self.face(j)
         return self.adjacency.get((min(i, j), max(i, j)), [])
@@ -228,31 +240,67 @@ class Part:
         """Pairs whose every shared edge is concave: the candidates for an intersection path."""
         return [pair for pair in self.adjacency if self.pair_class(*pair) == CONCAVE]
 
+    def edge_map(self) -> TopTools_IndexedDataMapOfShapeListOfShape:
+        """Every edge of ``shape`` -> the faces holding it, in OCCT's
+        ``TopExp::MapShapesAndAncestors`` order (built once): edge k of the adjacency."""
+        if self._emap is None:
+            self._emap = TopTools_IndexedDataMapOfShapeListOfShape()
+            TopExp.MapShapesAndAncestors_s(self.shape, TopAbs_EDGE, TopAbs_FACE, self._emap)
+        return self._emap
+
     def _classify_edges(self) -> dict[tuple[int, int], list[SharedEdge]]:
-        emap = TopTools_IndexedDataMapOfShapeListOfShape()
-        TopExp.MapShapesAndAncestors_s(self.shape, TopAbs_EDGE, TopAbs_FACE, emap)
         result: dict[tuple[int, int], list[SharedEdge]] = {}
+        oriented = self._orientations()
+        for k, edge, numbers in self.shared_edge_indices():
+            sides = [EdgeSide(oriented.get((k, n)), self.face(n)) for n in numbers]
+            shared = self._classify_edge(edge, *numbers, sides)
+            result.setdefault((numbers[0], numbers[1]), []).append(shared)
+        return dict(sorted(result.items()))
+
+    def shared_edge_indices(self) -> list[tuple[int, object, list[int]]]:
+        """(index in :meth:`edge_map`, edge, [i, j]) of every edge two faces i < j share
+        (seams, collapsed and non-manifold edges left out)."""
+        emap, out = self.edge_map(), []
         for k in range(1, emap.Extent() + 1):
             edge = TopoDS.Edge_s(emap.FindKey(k))
             if BRep_Tool.Degenerated_s(edge):
                 continue
-            numbers = sorted({self._fmap.FindIndex(f) for f in emap.FindFromIndex(k)})
-            if len(numbers) != 2:
-                continue  # seam (one face) or non-manifold edge
-            shared = self._classify_edge(edge, *numbers)
-            result.setdefault((numbers[0], numbers[1]), []).append(shared)
-        return dict(sorted(result.items()))
+            numbers = self._face_numbers(emap.FindFromIndex(k))
+            if len(numbers) == 2:
+                out.append((k, edge, numbers))
+        return out
 
-    def _classify_edge(self, edge, i: int, j: int, samples: int = 9) -> SharedEdge:
+    def _face_numbers(self, faces) -> list[int]:
+        """The sorted distinct numbers of an OCCT list of this part's faces (read by
+        First/Last: iterating such a list from Python costs ~0.5 ms)."""
+        n = faces.Extent()
+        shapes = [faces.First(), faces.Last()][:n] if n <= 2 else list(faces)
+        return sorted({self._fmap.FindIndex(f) for f in shapes})
+
+    def _orientations(self) -> dict[tuple[int, int], object]:
+        """{(k, n): edge k of :meth:`edge_map` as oriented in face n (its first occurrence
+        in the face's wires)}, from one walk over every face's edges."""
+        emap, found = self.edge_map(), {}
+        for n in range(1, len(self) + 1):
+            exp = TopExp_Explorer(self._fmap.FindKey(n), TopAbs_EDGE)
+            while exp.More():
+                found.setdefault((emap.FindIndex(exp.Current()), n),
+                                 TopoDS.Edge_s(exp.Current()))
+                exp.Next()
+        return found
+
+    def _classify_edge(self, edge, i: int, j: int, sides: list["EdgeSide"],
+                       samples: int = 9) -> SharedEdge:
+        """The SharedEdge of ``edge`` between faces i < j seen from ``sides`` (its
+        :class:`EdgeSide` in face i, then in face j), sampled at ``samples`` parameters."""
         curve = BRepAdaptor_Curve(edge)
         t0, t1 = curve.FirstParameter(), curve.LastParameter()
         ts = t0 + (t1 - t0) * (np.arange(samples) + 0.5) / samples
         angles, points = [], []
         for t in ts:
             p = np.array(curve.Value(t).Coord())
-            sides = [self.inward_and_normal(edge, self.face(n), t) for n in (i, j)]
-            (d1, n1), (d2, n2) = sides
-            theta = math.degrees(math.atan2(np.linalg.norm(np.cross(d1, d2)), d1 @ d2))
+            (d1, n1), (d2, n2) = (side.inward_and_normal(t) for side in sides)
+            theta = math.degrees(math.atan2(_norm(cross(d1, d2)), d1 @ d2))
             angles.append(360.0 - theta if d2 @ n1 > 0 else theta)
             points.append(p)
         angles = np.array(angles)
@@ -275,25 +323,46 @@ class Part:
 
     @staticmethod
     def inward_and_normal(edge, face: FaceSurface, t: float):
-        """(inward direction, outward normal) of ``face`` at edge parameter t.
+        """(inward direction, outward normal) of ``face`` at edge parameter t
+        (:meth:`EdgeSide.inward_and_normal`; an :class:`EdgeSide` kept for many t is
+        faster)."""
+        return EdgeSide(_oriented_in(edge, face), face).inward_and_normal(t)
+
+
+class EdgeSide:
+    """An edge seen from one of its faces: the edge ``oriented`` as in the face's wires,
+    its curve on the face and its 3-D curve, built once for many parameters."""
+
+    def __init__(self, oriented, face: FaceSurface):
+        self.face = face
+        self.oriented = oriented
+        self._uv = BRepAdaptor_Curve2d(oriented, face.topods)
+        self._curve = BRepAdaptor_Curve(oriented)
+        self._sign = -1.0 if oriented.Orientation() == TopAbs_REVERSED else 1.0
+
+    def inward_and_normal(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """((3,) inward direction, (3,) outward normal) of the face at edge parameter t.
 
         The face's wires leave the material on the left seen from the normal, so with T
         the edge tangent as oriented in this face, n x T points into the face.
         """
-        oriented = None
-        exp = TopExp_Explorer(face.topods, TopAbs_EDGE)
-        while exp.More():
-            if exp.Current().IsSame(edge):
-                oriented = TopoDS.Edge_s(exp.Current())
-                break
-            exp.Next()
-        uv = BRepAdaptor_Curve2d(oriented, face.topods).Value(t)
-        n = face.normal(uv.X(), uv.Y())
-        tangent = _point_and_tangent(BRepAdaptor_Curve(oriented), t)[1]
-        if oriented.Orientation() == TopAbs_REVERSED:
+        uv = self._uv.Value(t)
+        n = self.face.normal(uv.X(), uv.Y())
+        tangent = _point_and_tangent(self._curve, t)[1]
+        if self._sign < 0:
             tangent = -tangent
-        d = np.cross(n, tangent)
-        return d / np.linalg.norm(d), n
+        d = cross(n, tangent)
+        return d / _norm(d), n
+
+
+def _oriented_in(edge, face: FaceSurface):
+    """``edge`` as oriented in ``face`` (its first occurrence in the face's wires)."""
+    exp = TopExp_Explorer(face.topods, TopAbs_EDGE)
+    while exp.More():
+        if exp.Current().IsSame(edge):
+            return TopoDS.Edge_s(exp.Current())
+        exp.Next()
+    return None
 
 
 def optimal_box(shape, use_triangulation: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -309,4 +378,10 @@ def _point_and_tangent(curve: BRepAdaptor_Curve, t: float) -> tuple[np.ndarray, 
     p, v = gp_Pnt(), gp_Vec()
     curve.D1(t, p, v)
     d = np.array(v.Coord())
-    return np.array(p.Coord()), d / np.linalg.norm(d)
+    return np.array(p.Coord()), d / _norm(d)
+
+
+def _norm(v: np.ndarray) -> float:
+    """|v| of a (3,) float array: np.linalg.norm's value (the square root of v.dot(v))
+    without its overhead."""
+    return math.sqrt(v.dot(v))
