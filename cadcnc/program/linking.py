@@ -163,25 +163,18 @@ def linked(cuts: list, z_safe: float, approach_mm: float = APPROACH,
     return out
 
 
-def _travel(a: np.ndarray, b: np.ndarray) -> float:
-    """Cost of moving from a cut's end a to the next cut's start b: 0 for a chain, else the
-    horizontal distance (the lift and plunge are the same for every order)."""
-    return float(np.hypot(*(b[:2] - a[:2])))
-
-
-def order_cuts(cuts: list[CutSegment], join: float = 0.0) -> list[CutSegment]:
-    """``cuts`` reordered (each keeps its direction) to shorten the travel between them:
-    chains first (a cut starting within ``join`` of another's end follows it), then nearest
-    neighbour from the first cut, then 2-opt on the sequence of chains."""
-    if len(cuts) < 2:
-        return list(cuts)
-    starts = np.array([c.points[0] for c in cuts])
-    ends = np.array([c.points[-1] for c in cuts])
+def _chains(starts: np.ndarray, ends: np.ndarray, join: float) -> list[list[int]]:
+    """Cut indices grouped into chains (a cut starting within ``join`` mm of another's end
+    follows it; among several, the nearest not yet taken), heads in index order first.
+    ``starts``, ``ends``: (n, 3) mm."""
+    n = len(starts)
     nxt: dict[int, int] = {}
     taken: set[int] = set()
-    for i in range(len(cuts)):  # chains: i's end meets j's start
+    for i in range(n):  # chains: i's end meets j's start
         d = np.linalg.norm(starts - ends[i], axis=1)
         d[i] = np.inf
+        if (d > join).all():   # no candidate: the scan below would stop at its first
+            continue
         for j in np.argsort(d):
             if d[j] > join:
                 break
@@ -189,10 +182,10 @@ def order_cuts(cuts: list[CutSegment], join: float = 0.0) -> list[CutSegment]:
                 nxt[i] = int(j)
                 taken.add(int(j))
                 break
-    heads = [i for i in range(len(cuts)) if i not in taken] or [0]
+    heads = [i for i in range(n) if i not in taken] or [0]
     chains = []
     seen: set[int] = set()
-    for h in heads + list(range(len(cuts))):
+    for h in heads + list(range(n)):
         if h in seen:
             continue
         chain = [h]
@@ -201,27 +194,77 @@ def order_cuts(cuts: list[CutSegment], join: float = 0.0) -> list[CutSegment]:
             chain.append(nxt[chain[-1]])
             seen.add(chain[-1])
         chains.append(chain)
-    first = lambda ch: starts[ch[0]]  # noqa: E731
-    last = lambda ch: ends[ch[-1]]  # noqa: E731
-    order = [chains.pop(0)]
-    while chains:  # nearest neighbour
-        k = min(range(len(chains)), key=lambda m: _travel(last(order[-1]), first(chains[m])))
-        order.append(chains.pop(k))
-    improved = len(order) <= TWO_OPT_MAX
-    while improved:  # 2-opt on chains kept in their direction: reverse the visiting order
+    return chains
+
+
+def _travels(ends: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """Cost of moving from each end (m, 2+) to each start (k, 2+), (m, k): the horizontal
+    distance (the lift and plunge are the same for every order; a chain is inside a
+    chain). The same float as ``np.hypot`` of each one pair's differences."""
+    dx = starts[None, :, 0] - ends[:, None, 0]
+    dy = starts[None, :, 1] - ends[:, None, 1]
+    return np.hypot(dx, dy)
+
+
+def _nearest_neighbour(firsts: np.ndarray, lasts: np.ndarray) -> np.ndarray:
+    """Chain order from chain 0, each next the nearest of those left (the first of equals
+    in index order). ``firsts``, ``lasts``: (m, 3) mm, each chain's start and end."""
+    order, rest = [0], np.arange(1, len(firsts))
+    while rest.size:
+        k = int(np.argmin(_travels(lasts[order[-1]][None], firsts[rest])[0]))
+        order.append(int(rest[k]))
+        rest = np.delete(rest, k)
+    return np.array(order)
+
+
+def _first_gain(d: np.ndarray, o: np.ndarray, i: int, j0: int) -> int:
+    """The first j >= j0 for which reversing ``o[i:j + 1]`` shortens the travel by more
+    than 1e-9 mm, or -1. ``d``: (m, m) travels between chains, ``o``: (m,) the order.
+    Each sum adds the same floats in the same order as a loop over one (i, j) would."""
+    m = len(o)
+    fwd = np.cumsum(d[o[i:-1], o[i + 1:]])         # travel inside o[i..j], j = i+1..m-1
+    rev = np.cumsum(d[o[i + 1:], o[i:-1]])         # the same, reversed
+    js = np.arange(j0, m)
+    tail_before = np.zeros(len(js))
+    tail_after = np.zeros(len(js))
+    tail_before[:-1] = d[o[js[:-1]], o[js[:-1] + 1]]
+    tail_after[:-1] = d[o[i], o[js[:-1] + 1]]
+    before = d[o[i - 1], o[i]] + tail_before
+    after = d[o[i - 1], o[js]] + tail_after
+    better = after + rev[js - i - 1] < before + fwd[js - i - 1] - 1e-9
+    hit = np.flatnonzero(better)
+    return int(js[hit[0]]) if hit.size else -1
+
+
+def _two_opt(d: np.ndarray, o: np.ndarray) -> np.ndarray:
+    """``o`` improved by 2-opt (first improvement, i then j ascending, passes until none):
+    a stretch of chains, each kept in its direction, visited in reverse order."""
+    o = o.copy()
+    improved = True
+    while improved:
         improved = False
-        for i in range(1, len(order) - 1):
-            for j in range(i + 1, len(order)):
-                before = _travel(last(order[i - 1]), first(order[i]))
-                after = _travel(last(order[i - 1]), first(order[j]))
-                if j + 1 < len(order):
-                    before += _travel(last(order[j]), first(order[j + 1]))
-                    after += _travel(last(order[i]), first(order[j + 1]))
-                inner_before = sum(_travel(last(order[m]), first(order[m + 1]))
-                                   for m in range(i, j))
-                inner_after = sum(_travel(last(order[m + 1]), first(order[m]))
-                                  for m in range(i, j))
-                if after + inner_after < before + inner_before - 1e-9:
-                    order[i:j + 1] = order[i:j + 1][::-1]
-                    improved = True
-    return [cuts[k] for chain in order for k in chain]
+        for i in range(1, len(o) - 1):
+            j = _first_gain(d, o, i, i + 1)
+            while j >= 0:
+                o[i:j + 1] = o[i:j + 1][::-1].copy()
+                improved = True
+                j = _first_gain(d, o, i, j + 1) if j + 1 < len(o) else -1
+    return o
+
+
+def order_cuts(cuts: list[CutSegment], join: float = 0.0) -> list[CutSegment]:
+    """``cuts`` reordered (each keeps its direction) to shorten the travel between them:
+    chains first (a cut starting within ``join`` of another's end follows it), then nearest
+    neighbour from the first cut, then 2-opt on the sequence of chains (at most
+    ``TWO_OPT_MAX`` of them)."""
+    if len(cuts) < 2:
+        return list(cuts)
+    starts = np.array([c.points[0] for c in cuts])
+    ends = np.array([c.points[-1] for c in cuts])
+    chains = _chains(starts, ends, join)
+    firsts = starts[[ch[0] for ch in chains]]
+    lasts = ends[[ch[-1] for ch in chains]]
+    order = _nearest_neighbour(firsts, lasts)
+    if len(order) <= TWO_OPT_MAX:
+        order = _two_opt(_travels(lasts, firsts), order)
+    return [cuts[k] for c in order for k in chains[c]]

@@ -121,14 +121,17 @@ def uncut_report(program, part, samples, plan) -> UncutReport:
         tree, kk = cKDTree(pts), min(NEIGHBOURS, len(pts))
         k, _ = across(samples, n)
         base = samples.points + allowance * nrm
+        chord, ok = np.zeros(len(q)), np.zeros(len(q), dtype=bool)
         for a in range(0, len(q), CHUNK):   # rows are independent; a chunk stays in cache
             b = slice(a, a + CHUNK)
             dist, idx = tree.query(q[b], k=kk, distance_upper_bound=r1)
             dist, idx = dist.reshape(len(q[b]), -1), idx.reshape(len(q[b]), -1)
             found = np.isfinite(dist)
-            c = pts[np.where(found, idx, 0)]                               # (n, K, 3)
+            c = np.take(pts, np.where(found, idx, 0), axis=0)              # (n, K, 3)
             leftover[b] = _leftover(c, found, base[b], nrm[b], radius)
-            scallop[b] = _cusps(c, found, dist, q[b], nrm[b], n, k[b], radius, allowance)
+            chord[b], ok[b] = _chords(c, dist, q[b], nrm[b], n)
+        # elementwise: one bisection over every row (fewer, longer array operations)
+        scallop = np.where(ok, _scallop_of_chord(chord, k, radius, allowance), np.nan)
     reason = np.array(plan.reason, dtype=object)
     machined = (leftover <= threshold) & (reason == "")
     area = samples.areas
@@ -157,24 +160,23 @@ def _leftover(c, found, base, nrm, radius: float) -> np.ndarray:
     return np.maximum(t.min(axis=1), 0.0)
 
 
-def _cusps(c, found, dist, q, nrm, n, k, radius: float, allowance: float) -> np.ndarray:
-    """(N,) the cusp height between the nearest cut points either side of each sample's
-    ideal centre q across the planes (nan where one side has none)."""
+def _chords(c, dist, q, nrm, n) -> tuple[np.ndarray, np.ndarray]:
+    """(chord, ok), each (N,): the distance across the passes (mm) between the nearest cut
+    points either side of each sample's ideal centre q across the planes, and whether
+    both sides have one (``dist`` is inf where a neighbour was not found)."""
     side = (c - q[:, None, :]) @ n                                        # (N, K)
-    d = np.where(found, dist, np.inf)
-    lo = np.where(side <= 0, d, np.inf).argmin(axis=1)
-    hi = np.where(side > 0, d, np.inf).argmin(axis=1)
+    lo = np.where(side <= 0, dist, np.inf).argmin(axis=1)
+    hi = np.where(side > 0, dist, np.inf).argmin(axis=1)
     rows = np.arange(len(q))
-    ok = np.isfinite(d[rows, lo]) & (side[rows, lo] <= 0) & np.isfinite(d[rows, hi]) & (
-        side[rows, hi] > 0)
+    ok = np.isfinite(dist[rows, lo]) & (side[rows, lo] <= 0) & np.isfinite(
+        dist[rows, hi]) & (side[rows, hi] > 0)
     v = c[rows, hi] - c[rows, lo]
     t = np.cross(nrm, n)
     tn = np.linalg.norm(t, axis=1)
     ok &= tn > 1e-9
     t = t / np.maximum(tn, 1e-300)[:, None]
     v = v - np.einsum("nj,nj->n", v, t)[:, None] * t
-    chord = np.linalg.norm(v, axis=1)
-    return np.where(ok, _scallop_of_chord(chord, k, radius, allowance), np.nan)
+    return np.linalg.norm(v, axis=1), ok
 
 
 def _scallop_of_chord(chord, k, radius: float, allowance: float) -> np.ndarray:
