@@ -36,6 +36,7 @@ from ..job import Job
 from ..program.linking import Visit, linked
 from ..program.program import CutSegment, LinkSegment, Skipped
 from ..program.toolpath import toolpath_piece
+from ..workers import check_jobs
 from .parallel import on_workers
 
 UNREACHABLE = "unreachable"
@@ -239,7 +240,7 @@ def entered_program_segments(part, job: Job, cuts: list[CutSegment], z_safe: flo
     note on entries (:func:`entered`, with ``tick``). ``jobs``: processes looking for
     the cuts' entries (None: every core); the answer does not depend on it."""
     access, plans = Access(part, job, z_safe), None
-    if jobs != 1 and len(cuts) > 1:
+    if check_jobs(jobs) > 1 and len(cuts) > 1:
         seen = [0]
 
         def told(_: int, _plan) -> None:
