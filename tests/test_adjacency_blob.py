@@ -15,6 +15,9 @@ import pickle
 import numpy as np
 import pytest
 from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRep import BRep_Builder
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+from OCP.TopoDS import TopoDS_Compound
 from OCP.gp import gp_Pnt
 
 import cadcnc
@@ -146,3 +149,13 @@ def test_a_record_that_does_not_fit_is_dropped(classified):
     assert not same.adjacency_known
     assert take_adjacency_record(same, (extent, rows))
     assert_same_adjacency(slot, same)
+
+
+def test_a_free_edge_beside_the_faces_is_no_shared_edge():
+    """An edge no face holds (a wire in the compound) is left out, as a seam is."""
+    builder, both = BRep_Builder(), TopoDS_Compound()
+    builder.MakeCompound(both)
+    builder.Add(both, fresh("step_slot.step").shape)
+    builder.Add(both, BRepBuilderAPI_MakeEdge(gp_Pnt(500, 0, 0), gp_Pnt(510, 0, 0)).Edge())
+    part, alone = Part(both), fresh("step_slot.step")
+    assert_same_adjacency(alone, part)

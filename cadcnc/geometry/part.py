@@ -274,6 +274,8 @@ class Part:
         """The sorted distinct numbers of an OCCT list of this part's faces (read by
         First/Last: iterating such a list from Python costs ~0.5 ms)."""
         n = faces.Extent()
+        if n == 0:   # a free edge (a wire beside the faces): no face holds it
+            return []
         shapes = [faces.First(), faces.Last()][:n] if n <= 2 else list(faces)
         return sorted({self._fmap.FindIndex(f) for f in shapes})
 
