@@ -3,13 +3,22 @@
 Operations (pencil corners, finishing planes) and the gouge gate (one task per cut) hand
 :func:`map_ordered` a function and a list of tasks. With ``jobs`` 1 (or one task) the
 tasks run here, in order, on the caller's part; else in a
-``concurrent.futures.ProcessPoolExecutor`` whose workers rebuild the part once each
-(the ``build`` function and its arguments, e.g. BRep bytes: OCCT shapes do not pickle),
-so start-up (the part's faces) is paid once per worker, not per task. Workers are forked
-from a server process that has the library imported and its compiled kernels loaded
-(:data:`PRELOAD`); :func:`start` starts it early, while the caller still reads the part
-and plans. The pool is kept for the part and reused by the next call with the same
-part (the gate after the computation) until :func:`close` or exit.
+``concurrent.futures.ProcessPoolExecutor``. How its workers start (:func:`start_method`):
+
+- *fork* (the default on Linux, in a process running no other Python thread): each worker
+  is a copy of this process, with the part, its faces and what was built for it before
+  the pool started (compiled kernels, an operation's guards) at no cost;
+- *forkserver* (in a process that runs other threads, where a copy could inherit a lock
+  another thread holds, and hang): workers are forked from a server that has the
+  library imported and its compiled kernels loaded (:data:`PRELOAD`), and rebuild the
+  part once each (the ``build`` function and its arguments, e.g. BRep bytes: OCCT
+  shapes do not pickle); :func:`start` starts the server early, while the caller still
+  reads the part and plans;
+- *spawn* where there is no fork.
+
+The pool is kept for the part and reused by the next call with the same part (the gate
+after the computation) until :func:`close` or exit; a pool for another part shuts the
+kept ones down first.
 
 Results come back in task order whatever the number of workers, so outputs do not
 depend on it. ``on_result(k, result)`` is called in the caller's process as each
@@ -39,12 +48,15 @@ PRELOAD = ["cadcnc.ops.run", "cadcnc.verification.gate_jobs", "cadcnc.ops.warm_u
 last runs a small job, so the compiled kernels are loaded too: :mod:`cadcnc.ops.warm`)."""
 ENV = "CADCNC_JOBS"
 """The default number of processes when none is given (unset: every core)."""
+START_ENV = "CADCNC_START_METHOD"
+"""How workers start when set (fork, forkserver or spawn); unset: :func:`start_method`."""
 WATCH_S = 0.5
 """How often (s) a worker checks that its parent process is still there."""
 KILL_AFTER_S = 2.0
 """How long (s) a terminated worker has to end before it is killed outright."""
 _STATE: dict[str, Any] = {}   # in a worker: the part it rebuilt
 _POOLS: dict[int, tuple[Any, int, ProcessPoolExecutor]] = {}  # id(part) -> (part, jobs, pool)
+_BUSY: set[int] = set()   # the keys of pools running a map_ordered now (another thread's)
 
 
 class WorkerError(CadcncError):
@@ -78,12 +90,31 @@ def start(jobs: int | None) -> None:
     every core), so that its imports and warm-up (:data:`PRELOAD`, a few seconds) run on
     another core while this process reads the part and plans; the pools started later
     fork their workers from it at once. InputError for a bad ``jobs``."""
-    if check_jobs(jobs) > 1 and _context().get_start_method() == "forkserver":
+    if check_jobs(jobs) > 1 and start_method() == "forkserver":
+        _context()
         multiprocessing.forkserver.ensure_running()
 
 
+def start_method() -> str:
+    """How workers start: ``CADCNC_START_METHOD`` when set; else ``fork`` when this
+    process runs no Python thread beside its main one, ``forkserver`` when it does (a
+    GUI, a Dask worker, a kept pool's threads), ``spawn`` where there is no fork (module
+    doc). Native thread pools are not counted: BLAS's prepare for a fork themselves, and
+    no worker task runs OCCT's parallel algorithms. InputError for an unknown method."""
+    methods = multiprocessing.get_all_start_methods()
+    env = os.environ.get(START_ENV, "").strip()
+    if env:
+        if env not in methods:
+            raise InputError(f"{START_ENV}={env!r}: one of {', '.join(methods)}")
+        return env
+    if "fork" in methods and threading.active_count() == 1:
+        return "fork"
+    return "forkserver" if "forkserver" in methods else "spawn"
+
+
 def _init(build: Callable, args: tuple, parent: int) -> None:
-    """In a worker: rebuild the part once (imports and compiled kernels come with it).
+    """In a worker: rebuild the part once (imports and compiled kernels come with it), or
+    take the parent's (``build`` :func:`_inherited`: a forked worker has it already).
     Ctrl-C is the parent's to handle: it terminates the workers; a worker whose parent
     is gone (killed, or ended by ``os._exit``) ends too."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -122,22 +153,29 @@ def _pool(part, jobs: int, build: Callable, args: Callable[[], tuple]) -> Proces
     held = _POOLS.get(id(part))
     if held is not None and held[0] is part and held[1] == jobs:
         return held[2]
-    if held is not None:
-        _shutdown(id(part))
-    pool = ProcessPoolExecutor(jobs, mp_context=_context(), initializer=_init,
-                               initargs=(build, args(), os.getpid()))
+    for key in [k for k in _POOLS if k not in _BUSY]:
+        _shutdown(key)   # idle pools: their threads gone, this one's workers can be forks
+    ctx = _context()
+    if ctx.get_start_method() == "fork":   # the part is not pickled: the fork copies it
+        initargs = (_inherited, (part,), os.getpid())
+    else:
+        initargs = (build, args(), os.getpid())
+    pool = ProcessPoolExecutor(jobs, mp_context=ctx, initializer=_init, initargs=initargs)
     _POOLS[id(part)] = (part, jobs, pool)
     return pool
 
 
+def _inherited(part):
+    """A forked worker's part: its parent's, copied by the fork."""
+    return part
+
+
 def _context():
-    """Workers forked from a clean server process that has the library imported (a fork
-    of this process could inherit a lock held by another thread and hang); spawned
-    where there is no fork."""
-    if "forkserver" not in multiprocessing.get_all_start_methods():
-        return multiprocessing.get_context("spawn")
-    ctx = multiprocessing.get_context("forkserver")
-    ctx.set_forkserver_preload(PRELOAD)
+    """The multiprocessing context of :func:`start_method` (the server's preload set)."""
+    method = start_method()
+    ctx = multiprocessing.get_context(method)
+    if method == "forkserver":
+        ctx.set_forkserver_preload(PRELOAD)
     return ctx
 
 
@@ -218,6 +256,7 @@ def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: i
         return out
     pool = _pool(part, jobs, build, build_args)
     futures = {}
+    _BUSY.add(id(part))
     try:
         with _ctrl_c_deferred():  # the pool starts its workers here: all or none registered
             futures = {pool.submit(_call, fn, t): k for k, t in enumerate(tasks)}
@@ -240,3 +279,5 @@ def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: i
         if id(part) in _POOLS:
             _shutdown(id(part), kill=True)
         raise
+    finally:
+        _BUSY.discard(id(part))

@@ -31,6 +31,9 @@ START = ("import multiprocessing.forkserver as f; from cadcnc import workers; "
          "workers.start(2); print(one, f._forkserver._forkserver_pid)")
 
 
-def test_the_workers_server_starts_early_only_for_more_than_one_process():
+def test_the_workers_server_starts_early_only_for_more_than_one_process(monkeypatch):
+    monkeypatch.setenv("CADCNC_START_METHOD", "forkserver")   # a threaded caller's
     one, two = _python(START).split()
     assert one == "None" and int(two) > 0
+    monkeypatch.delenv("CADCNC_START_METHOD")   # a command's: its workers are forks
+    assert _python(START).split() == ["None", "None"]

@@ -37,6 +37,7 @@ from .uncut import uncut_report
 from ..common import safe_height
 from ..entries import entered_program_segments
 from ..parallel import on_workers
+from .setup import pass_setup
 from ...job import DEFAULT_FEED, DEFAULT_PERIOD
 
 JOIN = 1e-6
@@ -110,6 +111,7 @@ def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX
         done += 1   # reported now, which restarts the heartbeat's interval
         beat.beat(f"plane {done} at {plan.offsets[k]:.3f} mm", force=True)
 
+    pass_setup(part, op.faces, job)  # the planes' guards, built before forked workers copy them
     for res in on_workers(_plane, tasks, part, jobs, arrived, "plane", beat):
         cuts += res.cuts
         skipped += res.skipped
