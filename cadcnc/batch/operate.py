@@ -95,5 +95,5 @@ def rendered(outcome: Outcome, outputs, what: str, settings: Settings) -> dict:
     the ball and the part's file name."""
     job = outcome.program.job
     title = f"{what} R {job.tool.radius:g} of {Path(job.source or '').name}"
-    return {out: render(outcome.program, out, outcome.part, title, **(settings.gcode or {}))
-            for out in outputs}
+    return {out: render(outcome.program, out, outcome.part, title, settings.jobs,
+                        **(settings.gcode or {})) for out in outputs}

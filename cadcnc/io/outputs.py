@@ -42,16 +42,17 @@ def program_csv(program: Program) -> str:
     return buf.getvalue()
 
 
-def render(program: Program, out, part=None, title: str = "", **gcode) -> str | bytes:
+def render(program: Program, out, part=None, title: str = "", jobs: int | None = 1,
+           **gcode) -> str | bytes:
     """The content of ``out`` by its suffix. ``gcode``: :func:`program_ngc` keywords
     (tolerance, tool_tip, spindle, plunge_feed); ``part`` is needed for pictures and for
     a program of another tool axis than +Z (in its work coordinates: JSON, CSV and
     pictures are written in part coordinates, the G-code in work coordinates with the
-    setup in a comment)."""
+    setup in a comment). ``jobs``: processes making a JSON (:func:`program_json`)."""
     kind = Path(out).suffix.lower()
     setup = job_setup(program.job, part)
     if kind == ".json":
-        return program_json(program, setup)
+        return program_json(program, setup, part=part, jobs=jobs)
     if kind == ".csv":
         return program_csv(in_part_coordinates(program, setup))
     if kind == ".ngc":

@@ -32,6 +32,8 @@ from ..errors import require
 from ..errors import InputError
 from ..job import Job
 from ..jsonable import plain
+from ..ops.parallel import on_workers
+from ..workers import check_jobs
 from ..geometry.setup import Setup
 from ..program.program import CutSegment, LinkSegment, Program, Skipped
 from ..program.transform import in_part_coordinates, in_setup_coordinates
@@ -49,19 +51,20 @@ def _cut_to_dict(seg: CutSegment) -> dict:
             "stretch": seg.stretch, "at_limit": seg.at_limit, "points": d.pop("points"), **d}
 
 
-def program_to_dict(program: Program) -> dict:
-    """Everything in a :class:`Program` as JSON-ready objects (see the module doc)."""
-    segments = []
-    for seg in program.segments:
-        if seg.kind == "cut":
-            segments.append(_cut_to_dict(seg))
-        else:
-            segments.append({"kind": "link", "points": seg.points.tolist(),
-                             "rapid": seg.rapid.tolist()})
+def _segment_to_dict(seg) -> dict:
+    if seg.kind == "cut":
+        return _cut_to_dict(seg)
+    return {"kind": "link", "points": seg.points.tolist(), "rapid": seg.rapid.tolist()}
+
+
+def program_to_dict(program: Program, segments=None) -> dict:
+    """Everything in a :class:`Program` as JSON-ready objects (see the module doc);
+    ``segments``: what stands for the segments' list (default: the list itself)."""
     return {
         "format": FORMAT, "version": VERSION,
         "job": plain(program.job.to_inputs(), nonfinite_as_strings=True),
-        "segments": segments,
+        "segments": [_segment_to_dict(seg) for seg in program.segments]
+        if segments is None else segments,
         "skipped": [{"faces": list(s.faces), "edge": s.edge, "reason": s.reason,
                      "detail": s.detail} for s in program.skipped],
         "notes": list(program.notes),
@@ -129,14 +132,51 @@ def setup_of_dict(d) -> Setup | None:
     return setup
 
 
-def program_json(program: Program, setup: Setup | None = None) -> str:
+def program_json(program: Program, setup: Setup | None = None, *, part=None,
+                 jobs: int | None = 1) -> str:
     """The JSON text of ``program``; a ``setup``'s program (in its work coordinates) is
-    written in part coordinates with the setup."""
-    if setup is None or setup.identity:
-        return json.dumps(program_to_dict(program), separators=(",", ":")) + "\n"
-    d = program_to_dict(in_part_coordinates(program, setup))
-    d["setup"] = setup.to_dict()
-    return json.dumps(d, separators=(",", ":")) + "\n"
+    written in part coordinates with the setup. With ``jobs`` > 1 and the ``part`` (whose
+    workers may be running already, :mod:`cadcnc.ops.parallel`), the segments' text is
+    made on worker processes, a run of segments each: the same bytes."""
+    if setup is not None and not setup.identity:
+        program = in_part_coordinates(program, setup)
+    else:
+        setup = None
+    runs = _runs(program.segments, check_jobs(jobs) if part is not None else 1)
+    hole = json.dumps(_HOLE)
+    d = program_to_dict(program, None if len(runs) < 2 else _HOLE)
+    if setup is not None:
+        d["setup"] = setup.to_dict()
+    text = json.dumps(d, separators=_SEPARATORS) + "\n"
+    if len(runs) < 2:
+        return text
+    head, tail = text.split(hole)   # the hole holds no character a file name could
+    texts = on_workers(_segments_text, runs, part, jobs, what="the JSON of segments")
+    return head + "[" + ",".join(texts) + "]" + tail
+
+
+_SEPARATORS = (",", ":")
+_HOLE = "\x00segments\x00"
+RUNS_PER_JOB = 4
+"""Runs of segments per process when the JSON is made on workers (the last to end small)."""
+
+
+def _runs(segments, jobs: int) -> list[list]:
+    """``segments`` cut into about RUNS_PER_JOB * ``jobs`` runs of similar point counts
+    (one run: no workers)."""
+    if jobs < 2 or len(segments) < 2:
+        return [list(segments)]
+    sizes = np.cumsum([len(seg.points) for seg in segments])
+    n = min(RUNS_PER_JOB * jobs, len(segments))
+    ends = np.searchsorted(sizes, sizes[-1] * np.arange(1, n) / n, side="right")
+    bounds = [0, *sorted(set(int(e) for e in ends) - {0, len(segments)}), len(segments)]
+    return [list(segments[a:b]) for a, b in zip(bounds, bounds[1:])]
+
+
+def _segments_text(part, segments, beat=None) -> str:
+    """The JSON of a run of segments, as it stands in the list (an on_workers task)."""
+    return ",".join(json.dumps(_segment_to_dict(seg), separators=_SEPARATORS)
+                    for seg in segments)
 
 
 def write_program_json(program: Program, out) -> None:
