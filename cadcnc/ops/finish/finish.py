@@ -37,6 +37,7 @@ from .uncut import uncut_report
 from ..common import safe_height
 from ..entries import entered_program_segments
 from ..parallel import on_workers
+from ...workers import check_jobs
 from .setup import pass_setup
 from ...job import DEFAULT_FEED, DEFAULT_PERIOD
 
@@ -121,7 +122,7 @@ def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX
         part, job, cuts, safe_height(part, job), join=JOIN, stay_down=stay_down,
         tick=lambda k, n: beat.beat(f"entries: {k} of {n} cuts"), jobs=jobs)
     program = Program(job, segments, skipped + unreachable, notes)
-    report = uncut_report(program, part, samples, plan)
+    report = uncut_report(program, part, samples, plan, check_jobs(jobs))
     program.skipped += report.skipped()
     program.notes += report.notes()
     return program

@@ -104,9 +104,10 @@ def scallop_limit(job) -> float:
     return stepover_scallop(spacing, job.tool.radius)
 
 
-def uncut_report(program, part, samples, plan) -> UncutReport:
+def uncut_report(program, part, samples, plan, jobs: int = 1) -> UncutReport:
     """What ``program``'s cuts left on ``samples`` of its faces (see the module doc);
-    ``plan`` the :class:`~cadcnc.ops.finish.plan.PlanePlan` they came from."""
+    ``plan`` the :class:`~cadcnc.ops.finish.plan.PlanePlan` they came from; ``jobs``
+    threads query the cut points' k-d tree (the same answers)."""
     job = program.job
     radius, allowance, r1 = job.tool.radius, job.tool.allowance, job.tool.offset
     limit = scallop_limit(job)
@@ -124,7 +125,7 @@ def uncut_report(program, part, samples, plan) -> UncutReport:
         chord, ok = np.zeros(len(q)), np.zeros(len(q), dtype=bool)
         for a in range(0, len(q), CHUNK):   # rows are independent; a chunk stays in cache
             b = slice(a, a + CHUNK)
-            dist, idx = tree.query(q[b], k=kk, distance_upper_bound=r1)
+            dist, idx = tree.query(q[b], k=kk, distance_upper_bound=r1, workers=jobs)
             dist, idx = dist.reshape(len(q[b]), -1), idx.reshape(len(q[b]), -1)
             found = np.isfinite(dist)
             c = np.take(pts, np.where(found, idx, 0), axis=0)              # (n, K, 3)
