@@ -11,6 +11,7 @@ before any work, naming the line and the key.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
@@ -55,22 +56,19 @@ def cluster():
     port = _free_port()
     bin_ = Path(sys.executable).parent
     common = ["--no-dashboard", "--dashboard-address", "127.0.0.1:0"]
+    quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     procs = [subprocess.Popen([bin_ / "dask", "scheduler", "--host", "127.0.0.1", "--port",
-                               str(port), *common], stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL)]
+                               str(port), *common], **quiet)]
     address = f"tcp://127.0.0.1:{port}"
     procs += [subprocess.Popen([bin_ / "dask", "worker", address, "--host", "127.0.0.1",
                                 "--nthreads", "1", "--preload", "cadcnc.batch.task",
-                                *common], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-              for _ in range(2)]
+                                *common], **quiet) for _ in range(2)]
     yield address
-    for p in procs[::-1]:
-        p.send_signal(signal.SIGINT)
+    for p in procs:   # each its own session: a nanny and the worker it started, at once
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(p.pid, signal.SIGKILL)
     for p in procs:
-        try:
-            p.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            p.kill()
+        p.wait(timeout=60)
 
 
 def _folder(tmp_path: Path, job: str = JOB, broken: bool = True) -> Path:
