@@ -34,10 +34,14 @@ CLI_MODULES = {"test_cli.py", "test_cli_program.py", "test_cli_smoke.py", "test_
 
 
 def pytest_xdist_auto_num_workers(config):
-    """``-n auto``: a worker per core and one more. The HAL loop's module waits ~20 s on
-    real 1 ms periods with its core idle; the extra worker runs other modules meanwhile
-    (it costs one more collection, ~10 s of CPU)."""
-    return (os.cpu_count() or 1) + 1
+    """``-n auto``: a worker per core. (One more worker paid off while a Dask cluster's
+    teardown waited ~24 s; now the suite is CPU-bound and a third worker on 2 cores took
+    281 s against 260 s, its collection and contention costing more than the waits it
+    fills: docs/notes/suite-time.md.)"""
+    try:
+        return max(len(os.sched_getaffinity(0)), 1)
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
 
 
 # The modules that take longest (CPU, or real time waiting on HAL, a cluster, a signal),
