@@ -14,7 +14,7 @@ from pathlib import Path
 from ..errors import InputError, NothingToCutError
 from ..geometry.part import Part, load_step
 from ..geometry.setup import setup_in, setup_part
-from ..io.outputs import render
+from ..io.outputs import render_all
 from ..job import Job
 from ..ops.common import safe_height
 from ..ops.run import cut_back_gap, run
@@ -95,5 +95,5 @@ def rendered(outcome: Outcome, outputs, what: str, settings: Settings) -> dict:
     the ball and the part's file name."""
     job = outcome.program.job
     title = f"{what} R {job.tool.radius:g} of {Path(job.source or '').name}"
-    return {out: render(outcome.program, out, outcome.part, title, settings.jobs,
-                        **(settings.gcode or {})) for out in outputs}
+    return render_all(outcome.program, outputs, outcome.part, title, settings.jobs,
+                      **(settings.gcode or {}))

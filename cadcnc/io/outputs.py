@@ -19,7 +19,9 @@ from ..geometry.setup import job_setup
 from ..program.program import Program
 from ..program.transform import in_part_coordinates
 from .program_gcode import program_ngc
-from .program_json import program_json
+from .program_json import join_pieces, json_pieces, program_json, segments_text
+from ..ops.parallel import on_workers
+from ..workers import check_jobs
 from .program_plot import program_picture_bytes
 from .output_set import check_destination
 from .toolpath_csv import CSV_COLUMNS, toolpath_rows
@@ -62,6 +64,54 @@ def render(program: Program, out, part=None, title: str = "", jobs: int | None =
         return program_picture_bytes(program, part, out, title)
     raise OutputError(f"{out}: unknown output format {kind!r}; use one of "
                       f"{', '.join(SUFFIXES)}")
+
+
+def render_all(program: Program, outs, part=None, title: str = "", jobs: int | None = 1,
+               **gcode) -> dict:
+    """``{out: content}`` of every output in ``outs``, as :func:`render` makes each. With
+    ``jobs`` > 1 and the ``part``, on worker processes at once: each JSON in runs of
+    segments, every other output whole (its G-code, its pictures); the same bytes."""
+    outs = list(outs)
+    n = check_jobs(jobs)
+    if n == 1 or part is None or not outs:
+        return {out: render(program, out, part, title, **gcode) for out in outs}
+    setup = job_setup(program.job, part)
+    tasks: list[tuple] = []
+    where: dict = {}   # out -> (head, tail, its first task, how many), tail None: whole
+    for out in outs:
+        if Path(out).suffix.lower() == ".json":
+            head, tail, runs = json_pieces(program, setup, n)
+            where[out] = (head, tail, len(tasks), len(runs))
+            tasks += [("runs", run) for run in runs]
+        else:
+            check_output(out)   # an unknown suffix refused here, not in a worker
+            where[out] = ("", None, len(tasks), 1)
+            tasks.append(("whole", program, out, title, gcode))
+    done = on_workers(_render_task, tasks, part, jobs, what="writing outputs",
+                      sizes=[_size(t) for t in tasks]) if tasks else []
+    contents = {}
+    for out, (head, tail, first, count) in where.items():
+        if tail is None:
+            contents[out] = done[first]
+        else:
+            contents[out] = join_pieces(head, tail, done[first:first + count]) \
+                if count else head
+    return contents
+
+
+def _render_task(part, task, beat=None):
+    """One piece of :func:`render_all` (an on_workers task, on the worker's part)."""
+    if task[0] == "runs":
+        return segments_text(part, task[1])
+    _, program, out, title, gcode = task
+    return render(program, out, part, title, **gcode)
+
+
+def _size(task) -> float:
+    """A task's expected cost: its points (a whole output: every point of the program)."""
+    if task[0] == "runs":
+        return float(sum(len(seg.points) for seg in task[1]))
+    return float(sum(len(seg.points) for seg in task[1].segments))
 
 
 def check_output(out, inputs=()) -> str:

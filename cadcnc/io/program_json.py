@@ -138,20 +138,34 @@ def program_json(program: Program, setup: Setup | None = None, *, part=None,
     written in part coordinates with the setup. With ``jobs`` > 1 and the ``part`` (whose
     workers may be running already, :mod:`cadcnc.ops.parallel`), the segments' text is
     made on worker processes, a run of segments each: the same bytes."""
+    head, tail, runs = json_pieces(program, setup, check_jobs(jobs) if part is not None else 1)
+    if not runs:
+        return head
+    texts = on_workers(segments_text, runs, part, jobs, what="the JSON of segments")
+    return join_pieces(head, tail, texts)
+
+
+def json_pieces(program: Program, setup: Setup | None, jobs: int) -> tuple[str, str, list]:
+    """(text, "", []) for one process; else (head, tail, runs): the program's JSON is
+    ``join_pieces(head, tail, [segments_text(None, run) for run in runs])``, the runs
+    (:func:`_runs`) made anywhere."""
     if setup is not None and not setup.identity:
         program = in_part_coordinates(program, setup)
     else:
         setup = None
-    runs = _runs(program.segments, check_jobs(jobs) if part is not None else 1)
-    hole = json.dumps(_HOLE)
+    runs = _runs(program.segments, jobs)
     d = program_to_dict(program, None if len(runs) < 2 else _HOLE)
     if setup is not None:
         d["setup"] = setup.to_dict()
     text = json.dumps(d, separators=_SEPARATORS) + "\n"
     if len(runs) < 2:
-        return text
-    head, tail = text.split(hole)   # the hole holds no character a file name could
-    texts = on_workers(_segments_text, runs, part, jobs, what="the JSON of segments")
+        return text, "", []
+    head, tail = text.split(json.dumps(_HOLE))   # no file name holds its NUL characters
+    return head, tail, runs
+
+
+def join_pieces(head: str, tail: str, texts: list[str]) -> str:
+    """The JSON of :func:`json_pieces`' runs, their texts in order."""
     return head + "[" + ",".join(texts) + "]" + tail
 
 
@@ -173,8 +187,9 @@ def _runs(segments, jobs: int) -> list[list]:
     return [list(segments[a:b]) for a, b in zip(bounds, bounds[1:])]
 
 
-def _segments_text(part, segments, beat=None) -> str:
-    """The JSON of a run of segments, as it stands in the list (an on_workers task)."""
+def segments_text(part, segments, beat=None) -> str:
+    """The JSON of a run of segments, as it stands in the list (an on_workers task:
+    ``part`` is not read)."""
     return ",".join(json.dumps(_segment_to_dict(seg), separators=_SEPARATORS)
                     for seg in segments)
 
