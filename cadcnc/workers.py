@@ -91,7 +91,7 @@ def start(jobs: int | None) -> None:
     another core while this process reads the part and plans; the pools started later
     fork their workers from it at once. InputError for a bad ``jobs``."""
     if check_jobs(jobs) > 1 and start_method() == "forkserver":
-        _context()
+        _context()   # sets the server's preload before it starts
         multiprocessing.forkserver.ensure_running()
 
 

@@ -44,17 +44,16 @@ def program_csv(program: Program) -> str:
     return buf.getvalue()
 
 
-def render(program: Program, out, part=None, title: str = "", jobs: int | None = 1,
-           **gcode) -> str | bytes:
+def render(program: Program, out, part=None, title: str = "", **gcode) -> str | bytes:
     """The content of ``out`` by its suffix. ``gcode``: :func:`program_ngc` keywords
     (tolerance, tool_tip, spindle, plunge_feed); ``part`` is needed for pictures and for
     a program of another tool axis than +Z (in its work coordinates: JSON, CSV and
     pictures are written in part coordinates, the G-code in work coordinates with the
-    setup in a comment). ``jobs``: processes making a JSON (:func:`program_json`)."""
+    setup in a comment). Several outputs, on worker processes: :func:`render_all`."""
     kind = Path(out).suffix.lower()
     setup = job_setup(program.job, part)
     if kind == ".json":
-        return program_json(program, setup, part=part, jobs=jobs)
+        return program_json(program, setup)
     if kind == ".csv":
         return program_csv(in_part_coordinates(program, setup))
     if kind == ".ngc":
@@ -102,7 +101,7 @@ def render_all(program: Program, outs, part=None, title: str = "", jobs: int | N
 def _render_task(part, task, beat=None):
     """One piece of :func:`render_all` (an on_workers task, on the worker's part)."""
     if task[0] == "runs":
-        return segments_text(part, task[1])
+        return segments_text(task[1])
     _, program, out, title, gcode = task
     return render(program, out, part, title, **gcode)
 

@@ -32,8 +32,6 @@ from ..errors import require
 from ..errors import InputError
 from ..job import Job
 from ..jsonable import plain
-from ..ops.parallel import on_workers
-from ..workers import check_jobs
 from ..geometry.setup import Setup
 from ..program.program import CutSegment, LinkSegment, Program, Skipped
 from ..program.transform import in_part_coordinates, in_setup_coordinates
@@ -132,22 +130,16 @@ def setup_of_dict(d) -> Setup | None:
     return setup
 
 
-def program_json(program: Program, setup: Setup | None = None, *, part=None,
-                 jobs: int | None = 1) -> str:
+def program_json(program: Program, setup: Setup | None = None) -> str:
     """The JSON text of ``program``; a ``setup``'s program (in its work coordinates) is
-    written in part coordinates with the setup. With ``jobs`` > 1 and the ``part`` (whose
-    workers may be running already, :mod:`cadcnc.ops.parallel`), the segments' text is
-    made on worker processes, a run of segments each: the same bytes."""
-    head, tail, runs = json_pieces(program, setup, check_jobs(jobs) if part is not None else 1)
-    if not runs:
-        return head
-    texts = on_workers(segments_text, runs, part, jobs, what="the JSON of segments")
-    return join_pieces(head, tail, texts)
+    written in part coordinates with the setup. (On worker processes:
+    :func:`cadcnc.io.outputs.render_all`, from :func:`json_pieces`.)"""
+    return json_pieces(program, setup, 1)[0]
 
 
 def json_pieces(program: Program, setup: Setup | None, jobs: int) -> tuple[str, str, list]:
     """(text, "", []) for one process; else (head, tail, runs): the program's JSON is
-    ``join_pieces(head, tail, [segments_text(None, run) for run in runs])``, the runs
+    ``join_pieces(head, tail, [segments_text(run) for run in runs])``, the runs
     (:func:`_runs`) made anywhere."""
     if setup is not None and not setup.identity:
         program = in_part_coordinates(program, setup)
@@ -187,9 +179,8 @@ def _runs(segments, jobs: int) -> list[list]:
     return [list(segments[a:b]) for a, b in zip(bounds, bounds[1:])]
 
 
-def segments_text(part, segments, beat=None) -> str:
-    """The JSON of a run of segments, as it stands in the list (an on_workers task:
-    ``part`` is not read)."""
+def segments_text(segments) -> str:
+    """The JSON of a run of segments (:func:`json_pieces`), as it stands in the list."""
     return ",".join(json.dumps(_segment_to_dict(seg), separators=_SEPARATORS)
                     for seg in segments)
 
