@@ -12,9 +12,7 @@ import math
 import time
 
 import numpy as np
-from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
-from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
 from OCP.BRepClass import BRepClass_FaceClassifier
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_IsInFace
@@ -22,20 +20,19 @@ from OCP.BRepTools import BRepTools
 from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.Extrema import Extrema_GenLocateExtPS
 from OCP.Geom import Geom_OffsetSurface
-from OCP.GeomAdaptor import GeomAdaptor_Curve, GeomAdaptor_Surface
+from OCP.GeomAdaptor import GeomAdaptor_Surface
 from OCP.GeomAPI import GeomAPI_IntSS, GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
 from OCP.ElSLib import ElSLib
-from OCP.GeomAbs import (GeomAbs_Cylinder, GeomAbs_Line, GeomAbs_Plane, GeomAbs_Sphere,
+from OCP.GeomAbs import (GeomAbs_Cylinder, GeomAbs_Plane, GeomAbs_Sphere,
                           GeomAbs_Torus)
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
-from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS
+from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
 
 from ..geometry.part import optimal_box
 from ..tolerances import DEFAULT, Tolerances
 from ..trim import BOUNDARY, INSIDE, OUTSIDE
 from .box_face import whole_box
+from .face_edges import FaceEdges
 
 _STATES = {TopAbs_IN: INSIDE, TopAbs_ON: BOUNDARY}
 NEWTON_PARAMETER_PRECISION = 1e-12
@@ -51,6 +48,10 @@ EDGE_CLEAR = 1e-6
 """How much farther (mm) than an interior foot every edge must be for that foot to be the
 face's nearest point (:meth:`FaceProbe.interior_distance`): DistShapeShape counts a
 boundary point within its precision (1e-7) of the nearest distance as a foot too."""
+INNER_MARGIN = 1e-4
+"""A point of a whole-box face's (u, w) box farther inside than this fraction of the
+box's span from each side is inside the face: 10^3 times or more the classifier's
+boundary band on the test parts' faces (checked against FClass2d by the tests)."""
 SEGMENT_AS_POINT = 1e-7
 """A segment shorter than this (mm, OCCT's Precision::Confusion) has no edge: its
 midpoint's distance less half its length stands for it (a lower bound, within 1e-7)."""
@@ -84,6 +85,7 @@ class FaceProbe:
         self._project = None
         self._edges = None
         self._natural = None
+        self._inner = None
 
     # -- surface -----------------------------------------------------------------------
     def normal(self, u: float, w: float) -> np.ndarray:
@@ -147,13 +149,19 @@ class FaceProbe:
     def state(self, u: float, w: float, loose: bool = False) -> str:
         """INSIDE / BOUNDARY / OUTSIDE the trimmed face.
 
-        Boundary tolerance ``tol.classify``: OCCT's face classifier built once per face
+        On a face that is its whole parameter box (:meth:`natural`), a point farther
+        than :data:`INNER_MARGIN` of the box's span inside it is INSIDE. Elsewhere,
+        boundary tolerance ``tol.classify``: OCCT's face classifier built once per face
         (BRepTopAdaptor_FClass2d, ~10x faster per point), with BRepClass_FaceClassifier
         deciding what it finds on the boundary. ``loose``: BRepClass_FaceClassifier with
         ``tol.classify_loose``.
         """
         u, w = self.wrap(u, w)
         if not loose:
+            if self._inner is None:
+                self._inner = self._inner_box()
+            if self._inner[0] < u < self._inner[1] and self._inner[2] < w < self._inner[3]:
+                return INSIDE
             if self._fclass is None:
                 self._fclass = BRepTopAdaptor_FClass2d(self.face, self.tol.classify)
             state = self._fclass.Perform(gp_Pnt2d(u, w))
@@ -208,30 +216,15 @@ class FaceProbe:
 
     def edge_gap(self, point, enough: float = math.inf) -> float:
         """The distance from ``point`` to the face's boundary, or a lower bound of it
-        that is at least ``enough``: edges in order of their box's distance
-        (``BRepBndLib::Add``); an edge nearer than ``enough`` and the best so far counts
-        by OCCT's projection on its curve over its range and the distances to its ends
-        (inf without edges)."""
+        that is at least ``enough`` (:meth:`FaceEdges.gap`: OCCT's projections on the
+        edges' curves, nearest boxes first)."""
+        return self.edges().gap(point, enough)
+
+    def edges(self) -> FaceEdges:
+        """The face's edges (:class:`~.face_edges.FaceEdges`), made once."""
         if self._edges is None:
-            self._edges = _edges_of(self.face)
-        boxes, curves, _ = self._edges
-        p = np.asarray(point, float)
-        gap = np.maximum(np.maximum(boxes[:, :3] - p, p - boxes[:, 3:]), 0.0)
-        lower = np.sqrt((gap * gap).sum(axis=1))
-        best = math.inf
-        for i in np.argsort(lower, kind="stable"):
-            if lower[i] >= best:
-                break
-            curve, t0, t1 = curves[i]
-            if lower[i] >= enough or curve is None:  # far enough, or no 3-D curve: its box
-                best = min(best, float(lower[i]))
-                if lower[i] >= enough:
-                    break
-                continue
-            found = project_on_curve(curve, p, t0, t1)
-            best = min(best, found[1] if found is not None else math.inf,
-                       *(float(np.linalg.norm(p - curve.Value(t).Coord())) for t in (t0, t1)))
-        return best
+            self._edges = FaceEdges(self.face)
+        return self._edges
 
     def plane_distance(self, point) -> tuple[float, float] | None:
         """:meth:`face_distance` by closed form on a planar face, or None (not a plane, or
@@ -254,9 +247,7 @@ class FaceProbe:
         if state == INSIDE:
             d = abs(height)
             return (d, d) if d < self.tol.noise or height >= 0 else (-d, d)
-        if self._edges is None:
-            self._edges = _edges_of(self.face)
-        if self._edges[2]:  # straight edges only: DistShapeShape is as fast
+        if self.edges().straight:  # straight edges only: DistShapeShape is as fast
             return None
         d = self.edge_gap(point)
         return (d, d) if math.isfinite(d) else None
@@ -296,6 +287,15 @@ class FaceProbe:
         if self._natural is None:
             self._natural = whole_box(self.face, self.box)
         return self._natural
+
+    def _inner_box(self) -> tuple[float, float, float, float]:
+        """(u0, u1, w0, w1): where :meth:`state` needs no classifier (an empty box
+        unless the face is :meth:`natural`)."""
+        if not self.natural():
+            return (math.inf, -math.inf, math.inf, -math.inf)
+        umin, umax, wmin, wmax = self.box
+        du, dw = INNER_MARGIN * (umax - umin), INNER_MARGIN * (wmax - wmin)
+        return (umin + du, umax - du, wmin + dw, wmax - dw)
 
     def _analytic_foot(self, point) -> tuple[float, float, float]:
         """(u, w, distance) of the radial foot on a cylinder, sphere or torus: a nearest
@@ -367,22 +367,3 @@ def shape_distances(shape, points) -> np.ndarray:
         if dss.IsDone():
             out[k] = dss.Value()
     return out
-
-
-def _edges_of(face) -> tuple[np.ndarray, list, bool]:
-    """((E, 6) boxes, [(3-D curve or None, first, last)], all straight) of the face's
-    edges, degenerate ones left out; curves located in the part's frame."""
-    boxes, curves = [], []
-    explorer = TopExp_Explorer(face, TopAbs_EDGE)
-    while explorer.More():
-        edge, box = TopoDS.Edge_s(explorer.Current()), Bnd_Box()
-        BRepBndLib.Add_s(edge, box, False)
-        if not box.IsVoid() and not BRep_Tool.Degenerated_s(edge):
-            t0, t1 = BRep_Tool.Range_s(edge)
-            boxes.append(box.Get())
-            curves.append((BRep_Tool.Curve_s(edge, t0, t1), t0, t1))
-        explorer.Next()
-    straight = all(c is not None and GeomAdaptor_Curve(c).GetType() == GeomAbs_Line
-                   for c, _, _ in curves)
-    return np.array(boxes, float).reshape(-1, 6), curves, straight
-

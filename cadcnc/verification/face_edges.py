@@ -1,0 +1,86 @@
+"""A trimmed face's boundary, for distances from points to it (OCCT's curve projections).
+
+:class:`FaceEdges` keeps, per edge of a face, its box (``BRepBndLib::Add``), its ends and
+an OCCT projector initialised once on its 3-D curve over its range: a projection per
+point then reuses the curve's adaptor and sampling (the same answers as a projector made
+for each point, ``GeomAPI_ProjectPointOnCurve(P, C, t0, t1)``, at about a third of its
+cost). Lengths in mm.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from OCP.Bnd import Bnd_Box
+from OCP.BRep import BRep_Tool
+from OCP.BRepBndLib import BRepBndLib
+from OCP.GeomAbs import GeomAbs_Line
+from OCP.GeomAdaptor import GeomAdaptor_Curve
+from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve
+from OCP.gp import gp_Pnt
+from OCP.TopAbs import TopAbs_EDGE
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
+
+
+class FaceEdges:
+    """The non-degenerate edges of a face: (E, 6) boxes, (E, 2, 3) ends, a projector per
+    edge with a 3-D curve (None without), and whether every edge is straight."""
+
+    def __init__(self, face):
+        boxes, ends, self.projectors = [], [], []
+        curves = []
+        explorer = TopExp_Explorer(face, TopAbs_EDGE)
+        while explorer.More():
+            edge, box = TopoDS.Edge_s(explorer.Current()), Bnd_Box()
+            BRepBndLib.Add_s(edge, box, False)
+            if not box.IsVoid() and not BRep_Tool.Degenerated_s(edge):
+                t0, t1 = BRep_Tool.Range_s(edge)
+                curve = BRep_Tool.Curve_s(edge, t0, t1)
+                boxes.append(box.Get())
+                curves.append(curve)
+                ends.append([curve.Value(t).Coord() for t in (t0, t1)] if curve is not None
+                            else [(math.nan,) * 3] * 2)
+                self.projectors.append(_projector(curve, t0, t1))
+            explorer.Next()
+        self.boxes = np.array(boxes, float).reshape(-1, 6)
+        self.ends = np.array(ends, float).reshape(-1, 2, 3)
+        self.straight = all(c is not None and GeomAdaptor_Curve(c).GetType() == GeomAbs_Line
+                            for c in curves)
+        self._pnt = gp_Pnt()
+
+    def gap(self, point, enough: float = math.inf) -> float:
+        """The distance from ``point`` to the boundary, or a lower bound of it that is at
+        least ``enough``: edges in order of their box's distance; an edge nearer than
+        ``enough`` and the best so far counts by OCCT's projection on its curve over its
+        range and the distances to its ends (inf without edges)."""
+        boxes = self.boxes
+        p = np.asarray(point, float)
+        gap = np.maximum(np.maximum(boxes[:, :3] - p, p - boxes[:, 3:]), 0.0)
+        lower = np.sqrt((gap * gap).sum(axis=1))
+        best = math.inf
+        for i in np.argsort(lower, kind="stable"):
+            if lower[i] >= best:
+                break
+            projector = self.projectors[i]
+            if lower[i] >= enough or projector is None:  # far enough, or no curve: its box
+                best = min(best, float(lower[i]))
+                if lower[i] >= enough:
+                    break
+                continue
+            self._pnt.SetCoord(float(p[0]), float(p[1]), float(p[2]))
+            projector.Perform(self._pnt)
+            found = projector.LowerDistance() if projector.NbPoints() else math.inf
+            a, b = self.ends[i]
+            best = min(best, found, float(np.linalg.norm(p - a)), float(np.linalg.norm(p - b)))
+        return best
+
+
+def _projector(curve, t0: float, t1: float):
+    """OCCT's projector onto ``curve`` over [t0, t1], initialised once (None: no curve)."""
+    if curve is None:
+        return None
+    projector = GeomAPI_ProjectPointOnCurve()
+    projector.Init(curve, t0, t1)
+    return projector
