@@ -48,32 +48,34 @@ class FaceEdges:
         self.ends = np.array(ends, float).reshape(-1, 2, 3)
         self.straight = all(c is not None and GeomAdaptor_Curve(c).GetType() == GeomAbs_Line
                             for c in curves)
+        self._boxes = self.boxes.tolist()
+        self._ends = self.ends.tolist()
         self._pnt = gp_Pnt()
 
     def gap(self, point, enough: float = math.inf) -> float:
         """The distance from ``point`` to the boundary, or a lower bound of it that is at
         least ``enough``: edges in order of their box's distance; an edge nearer than
         ``enough`` and the best so far counts by OCCT's projection on its curve over its
-        range and the distances to its ends (inf without edges)."""
-        boxes = self.boxes
-        p = np.asarray(point, float)
-        gap = np.maximum(np.maximum(boxes[:, :3] - p, p - boxes[:, 3:]), 0.0)
-        lower = np.sqrt((gap * gap).sum(axis=1))
+        range and the distances to its ends (inf without edges). Plain floats: a face
+        has a few edges, too few for numpy to pay."""
+        x, y, z = (float(c) for c in point)
+        lower = [math.sqrt(max(x0 - x, x - x1, 0.0) ** 2 + max(y0 - y, y - y1, 0.0) ** 2
+                           + max(z0 - z, z - z1, 0.0) ** 2)
+                 for x0, y0, z0, x1, y1, z1 in self._boxes]
         best = math.inf
-        for i in np.argsort(lower, kind="stable"):
+        for i in sorted(range(len(lower)), key=lower.__getitem__):
             if lower[i] >= best:
                 break
             projector = self.projectors[i]
             if lower[i] >= enough or projector is None:  # far enough, or no curve: its box
-                best = min(best, float(lower[i]))
+                best = min(best, lower[i])
                 if lower[i] >= enough:
                     break
                 continue
-            self._pnt.SetCoord(float(p[0]), float(p[1]), float(p[2]))
+            self._pnt.SetCoord(x, y, z)
             projector.Perform(self._pnt)
             found = projector.LowerDistance() if projector.NbPoints() else math.inf
-            a, b = self.ends[i]
-            best = min(best, found, float(np.linalg.norm(p - a)), float(np.linalg.norm(p - b)))
+            best = min(best, found, *(math.dist((x, y, z), end) for end in self._ends[i]))
         return best
 
 
