@@ -85,21 +85,23 @@ def check_surface(probe: FaceProbe, face_no, offset: float, points: np.ndarray,
     the answers are those of the full check (the reference gate's).
     """
     n = len(points)
-    dev, fdev, dist = np.empty(n), np.empty(n), np.empty(n)
-    states, exact = [], {}
-    for k, p in enumerate(np.asarray(points, float).tolist()):  # floats: cheaper to OCCT
+    dist, signed, states, exact = [], [], [], {}
+    seeds = np.asarray(uw, float).tolist()  # floats: cheaper to OCCT than numpy's
+    for k, p in enumerate(np.asarray(points, float).tolist()):
         if tick and k % TICK == 0:
             tick(k, n)
-        res = probe.project_seeded(p, *uw[k])
-        if res is None:
-            res = probe.project_global(p)
+        res = probe.project_seeded(p, *seeds[k]) or probe.project_global(p)
         u, w, d = res
-        dist[k] = d
-        dev[k] = probe.signed(p, u, w, d) - offset
+        dist.append(d)
+        signed.append(probe.signed(p, u, w, d))
         states.append(probe.state(u, w))
         if states[-1] == OUTSIDE:
             exact[k] = probe.face_distance(p)
-        fdev[k] = dev[k] if states[-1] != OUTSIDE else exact[k][0] - offset
+    dist = np.array(dist, float)
+    dev = np.array(signed, float) - offset
+    fdev = dev.copy()
+    for k, (sd, _) in exact.items():
+        fdev[k] = sd - offset
     # do not trust the seeds: an unseeded global projection and an exact point-to-face
     # distance on a sample, plus the worst cycles
     sample = set(np.linspace(0, n - 1, min(n, n_unseeded)).astype(int).tolist())
