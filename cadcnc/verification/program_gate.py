@@ -21,6 +21,7 @@ import numpy as np
 
 from ..tolerances import Tolerances
 from .gate import GateResult, gouge_gate
+from .gate_cache import shared_gates
 from .gate_jobs import gate_cuts
 from .surface_checks import resolve_part
 
@@ -133,14 +134,17 @@ def gate_program(program, part=None, tol: Tolerances | None = None, *, moves=Non
         moves = [s.points for s in program.segments]
     per_cut = cut_moves(program, list(moves))
     labels = [cut_label(k, seg) for k, seg in enumerate(program.cuts, 1)]
-    if jobs == 1:
-        results = [gouge_gate(seg.path, part, tol, moves=m, blend_mm=blend_mm,
-                              progress=progress, reference=reference)
-                   for seg, (m, _) in zip(program.cuts, per_cut)]
-    else:
-        part = resolve_part(program.cuts[0].path, part) if program.cuts else part
-        results = gate_cuts(part, [(seg.path, m, blend_mm)
-                                   for seg, (m, _) in zip(program.cuts, per_cut)],
-                            tol, jobs=jobs, reference=reference, progress=progress)
+    if not program.cuts:
+        return ProgramGate([], labels, [])
+    part = resolve_part(program.cuts[0].path, part)
+    with shared_gates(part):  # the cuts share faces, probes and distances
+        if jobs == 1:
+            results = [gouge_gate(seg.path, part, tol, moves=m, blend_mm=blend_mm,
+                                  progress=progress, reference=reference)
+                       for seg, (m, _) in zip(program.cuts, per_cut)]
+        else:
+            results = gate_cuts(part, [(seg.path, m, blend_mm)
+                                       for seg, (m, _) in zip(program.cuts, per_cut)],
+                                tol, jobs=jobs, reference=reference, progress=progress)
     links = [not r.ok and _in_links(r, own) for r, (_, own) in zip(results, per_cut)]
     return ProgramGate(results, labels, links)
