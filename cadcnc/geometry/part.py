@@ -14,9 +14,7 @@ import os
 from dataclasses import dataclass, field
 
 import numpy as np
-from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
-from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
 from OCP.GCPnts import GCPnts_AbscissaPoint
 from OCP.gp import gp_Pnt, gp_Vec
@@ -26,6 +24,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
 from ..errors import FaceNumberError, InputError, StepFileError
+from .boxes import optimal_box
 from .differential import cross
 from .face_surface import FaceSurface
 from .material_side import FLIPPED, SOLID, SurfaceModel, material_sides
@@ -365,14 +364,6 @@ def _oriented_in(edge, face: FaceSurface):
             return TopoDS.Edge_s(exp.Current())
         exp.Next()
     return None
-
-
-def optimal_box(shape, use_triangulation: bool) -> tuple[np.ndarray, np.ndarray]:
-    """(lo (3,), hi (3,)) of OCCT's optimal axis-aligned bounding box of a shape, mm."""
-    box = Bnd_Box()
-    BRepBndLib.AddOptimal_s(shape, box, use_triangulation, False)
-    xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
-    return np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
 
 
 def _point_and_tangent(curve: BRepAdaptor_Curve, t: float) -> tuple[np.ndarray, np.ndarray]:

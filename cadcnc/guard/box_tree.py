@@ -25,14 +25,6 @@ VISITS = 400
 """Boxes a BoxTree query halves, at most (then the boxes left count as they are)."""
 
 
-def segment_box_distance(p, length: float, b) -> float:
-    """Distance (mm) from the segment p .. p + length z to the box b (6,)."""
-    dx = max(b[0] - p[0], p[0] - b[3], 0.0)
-    dy = max(b[1] - p[1], p[1] - b[4], 0.0)
-    dz = max(b[2] - (p[2] + length), p[2] - b[5], 0.0)
-    return math.sqrt(dx * dx + dy * dy + dz * dz)
-
-
 class BoxTree:
     """Boxes of a face's surface over a grid of cells, halved lazily (module doc)."""
 
@@ -70,6 +62,8 @@ class BoxTree:
         stack = [((self.us[i // nw], self.us[i // nw + 1], self.ws[i % nw],
                    self.ws[i % nw + 1], 0), float(d[i])) for i in np.nonzero(~far)[0].tolist()]
         visits = 0
+        px, py, pz = float(p[0]), float(p[1]), float(p[2])
+        top = pz + length
         while stack:
             node, dist = stack.pop()
             if node[4] == DEPTH or visits > VISITS:
@@ -77,9 +71,14 @@ class BoxTree:
                     return None
                 best = min(best, dist)
                 continue
-            for kid, box in self._children(node):
+            for kid, b in self._children(node):
                 visits += 1
-                dist = segment_box_distance(p, length, box)
+                # the distance from the segment to the box b (6,), inline: a third of
+                # the query's time was the call
+                dx = max(b[0] - px, px - b[3], 0.0)
+                dy = max(b[1] - py, py - b[4], 0.0)
+                dz = max(b[2] - top, pz - b[5], 0.0)
+                dist = math.sqrt(dx * dx + dy * dy + dz * dz)
                 if dist >= want:
                     best = min(best, dist)
                 else:

@@ -63,6 +63,7 @@ REUSE = 0.3
 """mm: a cached proof whose budget falls below this is searched again (a fresh one may
 give more)."""
 MAX_BUCKETS = 200_000
+_DROPS = np.array(DROPS)
 
 
 def face_cells(face, cell_mm: float) -> tuple[np.ndarray, np.ndarray]:
@@ -139,9 +140,9 @@ class FaceBoxes:
         """OCCT's box of the face's surface over the range (any kind), widened by SLACK."""
         b = Bnd_Box()
         BndLib_AddSurface.Add_s(self.face._adaptor, u0, u1, w0, w1, 0.0, b)
-        pts = np.array(b.Get()).reshape(2, 3)
-        lo, hi = pts.min(axis=0) - SLACK, pts.max(axis=0) + SLACK
-        return (*lo.tolist(), *hi.tolist())
+        x0, y0, z0, x1, y1, z1 = b.Get()    # floats: numpy's overhead was 4/5 of a cell's time
+        return (min(x0, x1) - SLACK, min(y0, y1) - SLACK, min(z0, z1) - SLACK,
+                max(x0, x1) + SLACK, max(y0, y1) + SLACK, max(z0, z1) + SLACK)
 
     def _box(self, u0: float, u1: float, w0: float, w1: float) -> tuple:
         if self.surface is None and self.curve is None:
@@ -243,6 +244,51 @@ def _rho(px: float, py: float, z0: float, cap: float, x0: float, y0: float, size
     return best
 
 
+@numba.njit(cache=True, nogil=True)
+def _nearest(px: float, py: float, pz: float, points: np.ndarray) -> int:
+    """The index of the point of ``points`` (n, 3) nearest to (px, py, pz) (the first of
+    equals; squared distances summed x, y, z, as scipy's k-d tree)."""
+    best, k = math.inf, -1
+    for i in range(points.shape[0]):
+        dx, dy, dz = points[i, 0] - px, points[i, 1] - py, points[i, 2] - pz
+        d = dx * dx + dy * dy + dz * dz
+        if d < best:
+            best, k = d, i
+    return k
+
+
+@numba.njit(cache=True, nogil=True)
+def _best_drop(px: float, py: float, pz: float, need: float, widen: float, share: float,
+               best: float, drops: np.ndarray, search: float, x0: float, y0: float,
+               size: float, nx: int, ny: int, bucket_top: np.ndarray, start: np.ndarray,
+               members: np.ndarray, boxes: np.ndarray) -> tuple:
+    """The proof search of a budget: for each drop (decreasing, the last 0), rho0 =
+    :func:`_rho` of the cells above pz - drop within need + widen drop + search; the drop
+    whose proof min(drop, share (rho0 - need)) beats ``best`` (rho0 >= need), stopping once
+    a proof reaches its drop. Returns (best, index of the drop kept or -1, its rho0, rho
+    searches made). First rho at drop 0: the cells above pz are among those above any
+    lower height, so when they come nearer than ``need`` no drop can prove anything."""
+    rho_0 = _rho(px, py, pz - 0.0, need + widen * 0.0 + search, x0, y0, size, nx, ny,
+                 bucket_top, start, members, boxes)
+    if rho_0 < need:
+        return best, -1, 0.0, 1
+    kept, kept_rho, searches = -1, 0.0, 1
+    for i in range(drops.shape[0]):
+        drop = drops[i]
+        if drop == 0.0:
+            rho0 = rho_0
+        else:
+            searches += 1
+            rho0 = _rho(px, py, pz - drop, need + widen * drop + search, x0, y0, size, nx,
+                        ny, bucket_top, start, members, boxes)
+        if rho0 >= need and min(drop, share * (rho0 - need)) > best:
+            best = min(drop, share * (rho0 - need))
+            kept, kept_rho = i, rho0
+            if best >= drop:    # a smaller drop cannot give more
+                break
+    return best, kept, kept_rho, searches
+
+
 class HeightCells:
     """Cell boxes of one face's surface in xy buckets, and points of the trimmed face
     (module doc)."""
@@ -304,19 +350,25 @@ class HeightCells:
                     best = min(pz - z0, 0.5 * room)
                     if best >= REUSE:
                         return best
-        cached = self._proof
-        q = tuple(self.points[self.tree.query((px, py, pz))[1]].tolist())
+        q = tuple(self.points[_nearest(px, py, pz, self.points)].tolist())
         d = distance(p, q)
-        for drop in DROPS:
-            rho0 = self.rho(p, pz - drop, d + 2.0 * drop + SEARCH)
-            if rho0 >= d and min(drop, 0.5 * (rho0 - d)) > best:
-                best = min(drop, 0.5 * (rho0 - d))
-                self._proof = (px, py, pz - drop, rho0, q)
-                if best >= drop:    # a smaller drop cannot give more
-                    break
-        if self._proof is cached is not None and best < 0.0:
+        best, kept, rho0 = self.best_drop(px, py, pz, d, 2.0, 0.5, best)
+        if kept >= 0:
+            self._proof = (px, py, pz - DROPS[kept], rho0, q)
+        elif best < 0.0:
             self._proof = None
         return best
+
+    def best_drop(self, px: float, py: float, pz: float, need: float, widen: float,
+                  share: float, best: float) -> tuple[float, int, float]:
+        """(best, index in DROPS of the drop kept or -1, its rho0): the proof search of a
+        budget over the cells (:func:`_best_drop`)."""
+        best, kept, rho0, searches = _best_drop(
+            px, py, pz, float(need), widen, share, best, _DROPS, SEARCH, self.x0, self.y0,
+            self.size, self.nx, self.ny, self.bucket_top, self.start, self.members,
+            self.boxes)
+        self.searches += searches
+        return best, kept, rho0
 
     def shank_clear(self, p) -> bool:
         """Whether the shank above the ball centre ``p`` provably comes no nearer to the

@@ -39,7 +39,7 @@ from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.TopoDS import TopoDS
 
 from ..trim import INSIDE, OUTSIDE
-from .cells import DROPS, REUSE, SEARCH, HeightCells, shared
+from .cells import DROPS, REUSE, HeightCells, shared
 
 VERTICAL = 1e-12   # |1 - |d_z|| below this: a direction is vertical
 PROBE = 1e-4       # the classification's step off an edge, as a fraction of the v range
@@ -144,11 +144,7 @@ class WallProof:
                 best = min(pz - z0, room)
                 if best >= REUSE:
                     return best
-        for drop in DROPS:
-            rho0 = self.cells.rho(p, pz - drop, self.need + drop + SEARCH)
-            if rho0 >= self.need and min(drop, rho0 - self.need) > best:
-                best = min(drop, rho0 - self.need)
-                self._proof = (px, py, pz - drop, rho0)
-                if best >= drop:
-                    break
+        best, kept, rho0 = self.cells.best_drop(px, py, pz, self.need, 1.0, 1.0, best)
+        if kept >= 0:
+            self._proof = (px, py, pz - DROPS[kept], rho0)
         return best
