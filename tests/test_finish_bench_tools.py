@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from benchmarks.finishing import finish_bench_tools as tools, freeform_slab as slab
+from benchmarks.finishing import finish_bench_tools as tools, finish_vs_ocl, freeform_slab as slab
 
 R = 3.0
 
@@ -80,3 +80,10 @@ def test_the_mesh_lies_on_the_face_and_refines_with_the_tolerance(top):
     # every triangle faces up, as the face does (orientation kept)
     n = np.cross(fine[:, 1] - fine[:, 0], fine[:, 2] - fine[:, 0])
     assert np.all(n[:, 2] > 0)
+
+
+def test_every_function_the_comparisons_stopwatch_times_exists():
+    """finish_vs_ocl's Stopwatch wraps functions by name: a renamed one would break
+    `python -m benchmarks perf` (it imports no opencamlib for this)."""
+    with finish_vs_ocl.Stopwatch() as watch:
+        assert len(watch.seconds) == len(finish_vs_ocl.Stopwatch.WATCHED)
