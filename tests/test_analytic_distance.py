@@ -21,7 +21,8 @@ from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
 
 import cadcnc
 from cadcnc.guard.analytic import AnalyticFace
-from cadcnc.geometry.part import Part, optimal_box
+from cadcnc.geometry.boxes import optimal_box
+from cadcnc.geometry.part import Part
 
 from conftest import FIXTURES
 

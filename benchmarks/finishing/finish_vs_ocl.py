@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 import cadcnc
-from cadcnc.geometry.part import optimal_box
+from cadcnc.geometry.boxes import optimal_box
 from cadcnc.verification import gate_program
 from benchmarks import ROOT
 from benchmarks.finishing import freeform_slab

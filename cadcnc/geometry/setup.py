@@ -28,7 +28,8 @@ from OCP.gp import gp_Trsf
 
 from ..errors import OutputError
 from ..job import PRINCIPAL_AXES, Job, axis_name
-from .part import Part, optimal_box
+from .boxes import optimal_box
+from .part import Part
 
 
 def rotation_for(axis) -> np.ndarray:

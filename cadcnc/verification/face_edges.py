@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
 from OCP.BRepBndLib import BRepBndLib
@@ -25,11 +24,13 @@ from OCP.TopoDS import TopoDS
 
 
 class FaceEdges:
-    """The non-degenerate edges of a face: (E, 6) boxes, (E, 2, 3) ends, a projector per
-    edge with a 3-D curve (None without), and whether every edge is straight."""
+    """The non-degenerate edges of a face: per edge its box (x0, y0, z0, x1, y1, z1), its
+    two ends, and a projector (None without a 3-D curve); whether every edge is straight."""
 
     def __init__(self, face):
-        boxes, ends, self.projectors = [], [], []
+        self._boxes: list[tuple] = []
+        self._ends: list[tuple] = []
+        self.projectors: list = []
         curves = []
         explorer = TopExp_Explorer(face, TopAbs_EDGE)
         while explorer.More():
@@ -38,18 +39,14 @@ class FaceEdges:
             if not box.IsVoid() and not BRep_Tool.Degenerated_s(edge):
                 t0, t1 = BRep_Tool.Range_s(edge)
                 curve = BRep_Tool.Curve_s(edge, t0, t1)
-                boxes.append(box.Get())
-                curves.append(curve)
-                ends.append([curve.Value(t).Coord() for t in (t0, t1)] if curve is not None
-                            else [(math.nan,) * 3] * 2)
+                self._boxes.append(box.Get())
+                self._ends.append(() if curve is None
+                                  else tuple(curve.Value(t).Coord() for t in (t0, t1)))
                 self.projectors.append(_projector(curve, t0, t1))
+                curves.append(curve)
             explorer.Next()
-        self.boxes = np.array(boxes, float).reshape(-1, 6)
-        self.ends = np.array(ends, float).reshape(-1, 2, 3)
         self.straight = all(c is not None and GeomAdaptor_Curve(c).GetType() == GeomAbs_Line
                             for c in curves)
-        self._boxes = self.boxes.tolist()
-        self._ends = self.ends.tolist()
         self._pnt = gp_Pnt()
 
     def gap(self, point, enough: float = math.inf) -> float:

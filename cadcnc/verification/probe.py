@@ -28,7 +28,7 @@ from OCP.GeomAbs import (GeomAbs_Cylinder, GeomAbs_Plane, GeomAbs_Sphere,
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
 
-from ..geometry.part import optimal_box
+from ..geometry.boxes import optimal_box
 from ..tolerances import DEFAULT, Tolerances
 from ..trim import BOUNDARY, INSIDE, OUTSIDE
 from .box_face import whole_box
