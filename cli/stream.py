@@ -68,7 +68,8 @@ def machine_of(args):
 
     jerk = None if args.jerk is None else parse_length(args.jerk, "jerk", allow_zero=False)
     if args.machine is not None:
-        return read_machine_ini(args.machine, jerk)
+        return read_machine_ini(args.machine, jerk,
+                                warn=lambda text: say_error(f"cadcnc: warning: {text}"))
     m = Machine.default()
     return m if jerk is None else replace(m, max_jerk=(jerk,) * 3,
                                           source=m.source.split(",")[0] + f", jerk {jerk:g}")
