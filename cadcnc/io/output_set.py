@@ -17,7 +17,7 @@ import tempfile
 from pathlib import Path
 
 from ..errors import OutputError
-from ..interrupts import sigint_deferred
+from ..signals import signals_deferred
 from .atomic import NAME_MAX, temp_prefix
 
 
@@ -93,7 +93,7 @@ class OutputSet:
                 with os.fdopen(fd, "wb") as fh:
                     fh.write(data)
                 os.chmod(tmp, 0o666 & ~_umask())
-            with sigint_deferred():
+            with signals_deferred():
                 for tmp, target, _ in temps:
                     os.replace(tmp, target)
         except OSError as e:
