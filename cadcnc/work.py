@@ -4,16 +4,22 @@ Every operation estimates what it is about to do (interpolation cycles, guide pl
 samples, points to verify) and refuses, with the estimate and the option that brings it
 down, whatever exceeds its limit (:func:`refuse_over`, an :class:`WorkLimitError`: exit 2,
 the input asks for too much). The limits are documented in docs/reliability.md. Long
-stages call a :class:`Heartbeat`, which reports at least every ``every`` seconds.
+stages call a :class:`Heartbeat`, which reports at least every ``every`` seconds (or run
+inside a :class:`Ticker`, a heartbeat from a thread). A command that makes temporary files
+or starts processes runs inside :func:`sigterm_as_interrupt`: ``kill PID`` cleans up as
+Ctrl-C does (exit 130).
 """
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import threading
 import time
 from typing import Callable
 
 from .errors import InputError
+from .interrupts import sigint_deferred
 
 MAX_CYCLES = 5_000_000
 """Interpolation cycles one command may run in all (``--max-cycles``): about 500 m of path
@@ -90,3 +96,38 @@ class Ticker:
         self._done.set()
         if self._thread is not None:
             self._thread.join()
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt():
+    """While the block runs, SIGTERM raises KeyboardInterrupt in the main thread (the
+    ``finally`` blocks and ``except KeyboardInterrupt`` of Ctrl-C then run)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextlib.contextmanager
+def signals_deferred():
+    """Hold Ctrl-C and SIGTERM until the block is done, then raise KeyboardInterrupt."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught = []
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: caught.append(signum))
+    try:
+        with sigint_deferred():
+            yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    if caught:
+        raise KeyboardInterrupt

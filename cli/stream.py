@@ -128,7 +128,7 @@ def stream_outputs(program, part, machine, out, *, feed=None, planned=True, tole
     For ``path``, ``pencil`` and ``finish --stream OUT``: call it with the program they
     computed, the part, :func:`machine_of` of the arguments and OUT, after their own
     outputs are written."""
-    from cadcnc.signals import sigterm_as_interrupt
+    from cadcnc.work import sigterm_as_interrupt
     from cadcnc.work import Ticker
 
     if hal:

@@ -17,7 +17,7 @@ import tempfile
 from pathlib import Path
 
 from ..errors import OutputError
-from ..signals import signals_deferred
+from ..work import signals_deferred
 from .atomic import NAME_MAX, temp_prefix
 
 

@@ -15,7 +15,6 @@ import secrets
 import socket
 import string
 import subprocess
-import tempfile
 import time
 from dataclasses import dataclass
 from importlib import resources
@@ -24,7 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from .session import HalError, HalInterrupted, HalSession
+from ...work import sigterm_as_interrupt
+from .session import HalError, HalInterrupted, HalSession, work_folder
 
 SAMPLE_DEPTH = 600_000  # periods the sampler FIFO holds (10 min at 1 ms)
 
@@ -159,7 +159,7 @@ def run_ngc(ngc: Path, machine: Any, *, workdir: Path | None = None,
     if not ngc.is_file():
         raise HalError(f"no such G-code file: {ngc}")
     port, cpw, epw = _free_port(), secrets.token_hex(6), secrets.token_hex(6)  # <= 15 chars
-    with tempfile.TemporaryDirectory(prefix="cadcnc-lcnc-") as tmp:
+    with sigterm_as_interrupt(), work_folder("lcnc") as tmp:
         work = Path(workdir) if workdir is not None else Path(tmp)
         ini = write_sim_config(machine, work, port=port, connectpw=cpw, enablepw=epw)
         session = HalSession("", work, start_timeout=60)
@@ -190,7 +190,7 @@ def run_ngc(ngc: Path, machine: Any, *, workdir: Path | None = None,
             _wait_exit(session.procs[0], 20)
         except KeyboardInterrupt:
             session.stop()
-            raise HalInterrupted("LinuxCNC run interrupted by Ctrl-C; LinuxCNC and HAL "
+            raise HalInterrupted("LinuxCNC run interrupted (Ctrl-C or SIGTERM); LinuxCNC and HAL "
                                  "shut down") from None
         finally:
             if rsh is not None:
