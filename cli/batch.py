@@ -45,7 +45,8 @@ def batch_command(args) -> int:
     parts = batch_parts(job, args.commands)
     report = None if args.quiet else (lambda p: say_error(f"cadcnc: batch: {p}"))
     records = cadcnc.batch(parts, job.out, scheduler=args.scheduler, workers=args.workers,
-                           force=args.force, progress=report)
+                           force=args.force, progress=report,
+                           inputs=[args.jobfile])
     code = batch_exit(records)
     if not args.quiet:
         print(summary_table(records))

@@ -3,7 +3,7 @@
 A machinist runs ``cadcnc path ... && send-to-machine``: a failed or interrupted run must
 leave no half file and never destroy an earlier good one. :class:`OutputSet` checks every
 destination up front (known suffix, existing writable folder, not a folder itself, not one
-of the run's input files, a name the file system accepts), then writes the whole set to
+of the run's input files (exit 2), a name the file system accepts), then writes the whole set to
 temporary files beside their destinations and renames them only when all are ready, with
 Ctrl-C (SIGINT) deferred during the renames. A symlink destination is followed: its target
 is replaced, the link stays.
@@ -16,7 +16,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from ..errors import OutputError
+from ..errors import OutputError, OutputIsInputError
 from ..work import signals_deferred
 from .atomic import NAME_MAX, temp_prefix
 
@@ -56,11 +56,23 @@ def check_destination(out, suffixes: tuple[str, ...], inputs=()) -> Path:
         raise OutputError(f"{out}: is a folder")
     if not os.access(folder, os.W_OK):
         raise OutputError(f"{out}: cannot write, folder {out.parent} is not writable")
-    for source in inputs:
-        if source is not None and Path(source).exists() and _same_file(target, Path(source)):
-            raise OutputError(f"{out}: is an input of this run ({source}); refusing to "
-                              "write over it")
+    check_not_inputs([out], inputs)
     return target
+
+
+def check_not_inputs(destinations, inputs) -> None:
+    """OutputIsInputError (exit 2) naming both when a destination is one of ``inputs``
+    (a path, or None), symbolic links and ``..`` resolved; a destination's folder need
+    not exist yet."""
+    sources = [Path(s) for s in inputs if s is not None and Path(s).exists()]
+    for out in destinations:
+        out = Path(out)
+        target = Path(os.path.realpath(out))
+        for source in sources:
+            if _same_file(target, source) if target.exists() else \
+                    target == Path(os.path.realpath(source)):
+                raise OutputIsInputError(f"{out}: is an input of this run ({source}); "
+                                         "refusing to write over it")
 
 
 class OutputSet:
