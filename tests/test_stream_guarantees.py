@@ -173,3 +173,54 @@ def test_stale_folders_of_dead_runs_are_removed_never_a_live_ones(tmp_path):
     finally:
         live.kill()
         live.wait()
+
+
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_a_long_stream_is_interrupted_cleanly(program, tmp_path, sig):
+    """Finding 4 and 5: a long stream (--feed 1: about 350 000 periods) says how many
+    periods it will compute before the work, and SIGINT or SIGTERM at any point gives
+    exit 130 and leaves nothing behind."""
+    import signal
+
+    out = tmp_path / "s.npy"
+    proc = subprocess.Popen([sys.executable, "-m", "cadcnc.cli", "stream", str(program),
+                             "--feed", "1", "-o", str(out)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        first = proc.stderr.readline()
+        assert "periods of 1 ms" in first and "to compute" in first, first
+        time.sleep(1.0)
+        proc.send_signal(getattr(signal, sig))
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err
+    assert "interrupted" in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_sigterm_while_an_output_set_is_written_leaves_no_temporary_file(tmp_path,
+                                                                         monkeypatch):
+    """Finding 5 for every command: SIGTERM while the temporary files are written is
+    Ctrl-C (KeyboardInterrupt, exit 130): they are removed, the old outputs intact."""
+    import signal
+
+    import cadcnc.io.output_set as output_set
+
+    old = tmp_path / "a.json"
+    old.write_text("old")
+    real = output_set.os.fdopen
+
+    def fdopen(fd, mode):
+        fh = real(fd, mode)
+        os.kill(os.getpid(), signal.SIGTERM)
+        return fh
+
+    monkeypatch.setattr(output_set.os, "fdopen", fdopen)
+    outputs = output_set.OutputSet([old, tmp_path / "b.csv"], (".json", ".csv"))
+    with pytest.raises(KeyboardInterrupt):
+        outputs.write({old: "new", tmp_path / "b.csv": "x"})
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json"]
+    assert old.read_text() == "old"
+    assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL

@@ -17,7 +17,7 @@ import tempfile
 from pathlib import Path
 
 from ..errors import OutputError, OutputIsInputError
-from ..work import signals_deferred
+from ..work import sigterm_as_interrupt, signals_deferred
 from .atomic import NAME_MAX, temp_prefix
 
 
@@ -95,19 +95,11 @@ class OutputSet:
             raise OutputError(f"no content for {', '.join(missing)}")
         temps: list[tuple[str, Path, Path]] = []
         try:
-            for d in self.destinations:
-                target = self.targets[d]
-                data = contents[d]
-                data = data.encode("utf-8") if isinstance(data, str) else data
-                fd, tmp = tempfile.mkstemp(prefix=temp_prefix(target), suffix=".tmp",
-                                           dir=target.parent)
-                temps.append((tmp, target, d))
-                with os.fdopen(fd, "wb") as fh:
-                    fh.write(data)
-                os.chmod(tmp, 0o666 & ~_umask())
-            with signals_deferred():
-                for tmp, target, _ in temps:
-                    os.replace(tmp, target)
+            with sigterm_as_interrupt():   # SIGTERM, too, leaves no temporary file
+                self._write_temps(contents, temps)
+                with signals_deferred():
+                    for tmp, target, _ in temps:
+                        os.replace(tmp, target)
         except OSError as e:
             name = temps[-1][2] if temps else self.destinations[0]
             raise OutputError(f"{name}: cannot write ({e.strerror or e})") from e
@@ -115,6 +107,19 @@ class OutputSet:
             for tmp, _, _ in temps:
                 with contextlib.suppress(OSError):
                     os.unlink(tmp)
+
+    def _write_temps(self, contents: dict, temps: list) -> None:
+        """Every destination's bytes to a temporary file beside it (listed in ``temps``)."""
+        for d in self.destinations:
+            target = self.targets[d]
+            data = contents[d]
+            data = data.encode("utf-8") if isinstance(data, str) else data
+            fd, tmp = tempfile.mkstemp(prefix=temp_prefix(target), suffix=".tmp",
+                                       dir=target.parent)
+            temps.append((tmp, target, d))
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+            os.chmod(tmp, 0o666 & ~_umask())
 
 
 def write_one(out, data, suffixes: tuple[str, ...], inputs=()) -> None:
