@@ -46,6 +46,9 @@ SLACK = 1e-6       # relative, on every limit
 OFF_PATH = 1e-3    # mm: 1 um, into the offset or off a cut
 SAMPLES = 400      # positions judged by OCCT per draw
 SILENCE_S = 5.0
+MAX_PERIODS = 300_000
+"""Each draw's ``--max-periods``: a longer stream is refused before any work (exit 2); the
+gate of a stream costs about 0.1 ms a period here, and 500 draws must end in an hour."""
 
 
 class Stderr(io.TextIOBase):
@@ -172,13 +175,14 @@ def judge_positions(x: np.ndarray, period: float, limits, program, part,
 
 
 def judged(d: dict, programs: dict, parts: dict, folder: Path, run=cli,
-           samples: int = SAMPLES) -> dict:
+           samples: int = SAMPLES, max_periods: int = MAX_PERIODS) -> dict:
     """Run one draw and judge it: {exit, stderr, silence, bad, ok}."""
     from cadcnc.io.program_json import read_program
 
     ini, out = folder / "machine.ini", folder / "s.npy"
     ini.write_text(d["ini"])
-    args = ["stream", programs[d["program"]], "--machine", ini, "-o", out]
+    args = ["stream", programs[d["program"]], "--machine", ini, "-o", out,
+            "--max-periods", str(max_periods)]
     if d["jerk"] is not None:
         args += ["--jerk", f"{d['jerk']!r}"]
     if d["feed"] is not None:
@@ -208,6 +212,7 @@ def main(argv=None) -> int:
     ap.add_argument("--trials", type=int, default=500)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", type=Path, default=Path("fuzz_stream.json"))
+    ap.add_argument("--max-periods", type=int, default=MAX_PERIODS)
     a = ap.parse_args(argv)
     rng = random.Random(a.seed)
     results = []
@@ -219,7 +224,7 @@ def main(argv=None) -> int:
             d = draw(rng, programs)
             t = time.time()
             try:
-                r = judged(d, programs, parts, Path(tmp))
+                r = judged(d, programs, parts, Path(tmp), max_periods=a.max_periods)
             except Exception as e:  # noqa: BLE001 - a traceback is a finding
                 r = dict(exit=None, stderr=f"{type(e).__name__}: {e}", bad=["traceback"],
                          ok=False)
@@ -229,6 +234,8 @@ def main(argv=None) -> int:
             print(f"{k + 1}/{a.trials} {d['program']} T {d['period'] * 1e3:.3g} ms: exit "
                   f"{r['exit']} {'ok' if r['ok'] else 'BAD ' + '; '.join(r['bad'])} "
                   f"({time.time() - t0:.0f} s)", flush=True)
+            if r["exit"] == 130:   # Ctrl-C or SIGTERM reached the command: stop here
+                break
     exits: dict = {}
     for r in results:
         exits[str(r["exit"])] = exits.get(str(r["exit"]), 0) + 1
