@@ -29,6 +29,10 @@ class InputError(CadcncError):
     exit_code = EXIT_INPUT
 
 
+class OutputIsInputError(InputError):
+    """An output of a run would be written over one of its inputs (both named): exit 2."""
+
+
 class StepFileError(InputError):
     """A STEP file is missing, unreadable, or holds no solid or no faces."""
 

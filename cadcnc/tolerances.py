@@ -10,6 +10,13 @@ from .errors import InputError
 
 STRETCH_TANGENT_MARGIN = 2.0
 """The stretch search's tangent limit over the interpolator's (``stretch_tangent_sin``)."""
+STREAM_LIMIT_SLACK = 1e-6
+"""Relative: a streamed position's finite-difference velocity, acceleration or jerk may
+exceed the machine's limit by this share (round-off), not more
+(:mod:`cadcnc.verification.stream_check`)."""
+STREAM_END = 1e-9
+"""mm: a stream's first and last positions lie this close to the program's first and last
+points (the .txt's 9 decimals)."""
 
 
 @dataclass(frozen=True)

@@ -4,15 +4,22 @@ Every operation estimates what it is about to do (interpolation cycles, guide pl
 samples, points to verify) and refuses, with the estimate and the option that brings it
 down, whatever exceeds its limit (:func:`refuse_over`, an :class:`WorkLimitError`: exit 2,
 the input asks for too much). The limits are documented in docs/reliability.md. Long
-stages call a :class:`Heartbeat`, which reports at least every ``every`` seconds.
+stages call a :class:`Heartbeat`, which reports at least every ``every`` seconds (or run
+inside a :class:`Ticker`, a heartbeat from a thread). A command that makes temporary files
+or starts processes runs inside :func:`sigterm_as_interrupt`: ``kill PID`` cleans up as
+Ctrl-C does (exit 130).
 """
 
 from __future__ import annotations
 
+import contextlib
+import signal
+import threading
 import time
 from typing import Callable
 
 from .errors import InputError
+from .interrupts import sigint_deferred
 
 MAX_CYCLES = 5_000_000
 """Interpolation cycles one command may run in all (``--max-cycles``): about 500 m of path
@@ -21,6 +28,9 @@ MAX_PLANES = 20_000
 """Guide planes of one finishing job (``--max-cycles`` does not cover them: spacing)."""
 MAX_VERIFY_POINTS = 2_000_000
 """Program points ``verify`` checks against OCCT in one run."""
+MAX_STREAM_PERIODS = 20_000_000
+"""Servo periods one stream may hold (``cadcnc stream --max-periods``): 480 MB of
+positions (N x 3 float64), about 0.9 GB more for a .txt: 5.6 h at 1 ms."""
 HEARTBEAT_S = 5.0
 """Longest silence (s) of a long stage: progress is reported at least this often."""
 
@@ -56,3 +66,68 @@ class Heartbeat:
         self.last = now
         self.report(text() if callable(text) else text)
         return True
+
+
+class Ticker:
+    """A heartbeat from a thread, for a stage that cannot report itself (a compiled loop):
+    while the ``with`` block runs, ``report(f"{label}: {stage}, N s")`` at least every
+    ``every`` seconds; set :attr:`stage` to say what runs. ``report`` None: silent."""
+
+    def __init__(self, report: Callable[[str], None] | None, label: str,
+                 every: float = HEARTBEAT_S, clock: Callable[[], float] = time.monotonic):
+        self.report, self.label, self.every, self.clock = report, label, every, clock
+        self.stage = "working"
+        self._done = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def _run(self) -> None:
+        start = self.clock()
+        while not self._done.wait(self.every):
+            self.report(f"{self.label}: {self.stage}, {self.clock() - start:.0f} s")
+
+    def __enter__(self) -> "Ticker":
+        if self.report is not None:
+            self._thread = threading.Thread(target=self._run, daemon=True,
+                                            name="cadcnc-heartbeat")
+            self._thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._done.set()
+        if self._thread is not None:
+            self._thread.join()
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt():
+    """While the block runs, SIGTERM raises KeyboardInterrupt in the main thread (the
+    ``finally`` blocks and ``except KeyboardInterrupt`` of Ctrl-C then run)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextlib.contextmanager
+def signals_deferred():
+    """Hold Ctrl-C and SIGTERM until the block is done, then raise KeyboardInterrupt."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught = []
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: caught.append(signum))
+    try:
+        with sigint_deferred():
+            yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    if caught:
+        raise KeyboardInterrupt

@@ -37,6 +37,7 @@ def add_parser(add, commands) -> None:
 def batch_command(args) -> int:
     import cadcnc
     from cadcnc.batch.records import batch_exit, summary_table
+    from cadcnc.work import sigterm_as_interrupt
 
     from . import jobfile
     from .batch_jobs import batch_parts
@@ -44,8 +45,10 @@ def batch_command(args) -> int:
     job = jobfile.read(args.jobfile)
     parts = batch_parts(job, args.commands)
     report = None if args.quiet else (lambda p: say_error(f"cadcnc: batch: {p}"))
-    records = cadcnc.batch(parts, job.out, scheduler=args.scheduler, workers=args.workers,
-                           force=args.force, progress=report)
+    with sigterm_as_interrupt():   # the local cluster shut down as after Ctrl-C
+        records = cadcnc.batch(parts, job.out, scheduler=args.scheduler,
+                               workers=args.workers, force=args.force, progress=report,
+                               inputs=[args.jobfile])
     code = batch_exit(records)
     if not args.quiet:
         print(summary_table(records))

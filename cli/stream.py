@@ -21,6 +21,7 @@ from __future__ import annotations
 import io
 
 from cadcnc.units import parse_feed, parse_length
+from cadcnc.work import MAX_STREAM_PERIODS
 
 from .feedback import say_error
 
@@ -56,6 +57,9 @@ def add_parser(add, flip, gouge) -> None:
                         "the machine's limits -> sampler; needs linuxcnc-uspace) and report "
                         "samples, underruns, executed - commanded, clipped samples (exit 6 "
                         "if any sample was clipped or underran)")
+    p.add_argument("--max-periods", type=int, default=MAX_STREAM_PERIODS, metavar="N",
+                   help=f"refuse a stream of more servo periods (default {MAX_STREAM_PERIODS}:"
+                        " 480 MB of positions; 24 bytes a period)")
     flip(p)
     gouge(p)
 
@@ -68,7 +72,8 @@ def machine_of(args):
 
     jerk = None if args.jerk is None else parse_length(args.jerk, "jerk", allow_zero=False)
     if args.machine is not None:
-        return read_machine_ini(args.machine, jerk)
+        return read_machine_ini(args.machine, jerk,
+                                warn=lambda text: say_error(f"cadcnc: warning: {text}"))
     m = Machine.default()
     return m if jerk is None else replace(m, max_jerk=(jerk,) * 3,
                                           source=m.source.split(",")[0] + f", jerk {jerk:g}")
@@ -77,12 +82,16 @@ def machine_of(args):
 def stream_command(args) -> int:
     import cadcnc
     from cadcnc.errors import InputError
+    from cadcnc.io.output_set import OutputSet
     from cadcnc.io.program_json import read_program
+    from cadcnc.verification.stream_check import check_program_on_part
 
     from .options import tolerances
 
     if not args.output and not args.hal:
         raise InputError("stream: give -o OUT (.npy or .txt), --hal, or both")
+    if args.max_periods < 1:
+        raise InputError(f"--max-periods must be at least 1, got {args.max_periods}")
     machine = machine_of(args)
     feed = None if args.feed is None else parse_feed(args.feed)
     tol = tolerances(args)
@@ -90,31 +99,37 @@ def stream_command(args) -> int:
     source = args.part or program.job.source
     if not source:
         raise InputError(f"{args.program}: the program names no part: give --part PART.step")
+    inputs = [args.program, source, args.machine]
+    if args.output:   # every destination against every input before any work
+        OutputSet(args.output, SUFFIXES, inputs=inputs)
     part = cadcnc.load_step(source, flip_material=args.flip_material)
+    check_program_on_part(program, part, str(args.program), str(source), tol.gouge)
     return stream_outputs(program, part, machine, args.output or [], feed=feed,
                           planned=not args.constant_feed, tolerances=tol,
                           allow_gouge=args.allow_gouge, hal=args.hal, quiet=args.quiet,
-                          name=str(args.program), inputs=[args.program])
+                          name=str(args.program), inputs=inputs,
+                          max_periods=args.max_periods)
 
 
 def stream_outputs(program, part, machine, out, *, feed=None, planned=True, tolerances=None,
                    allow_gouge=False, hal=False, quiet=False, name="program",
-                   inputs=()) -> int:
+                   inputs=(), max_periods=MAX_STREAM_PERIODS) -> int:
     """Stream ``program`` on ``part`` to ``machine`` and write it to ``out`` (a path or a
     list of paths, ``.npy`` / ``.txt``); optionally execute it in HAL. The exit code (see
     the module doc); raises the library's errors (InputError, GeometryError, HalError...).
 
+    Before any work: every destination checked against ``inputs`` and the machine's INI,
+    the periods estimated and refused over ``max_periods`` (exit 2). While it works: a
+    heartbeat on stderr at least every 5 s (not ``quiet``); SIGTERM as Ctrl-C (130).
+    Before anything is written: the positions about to be written checked against the
+    machine's limits and the program's ends (:mod:`cadcnc.verification.stream_check`,
+    exit 5 and nothing written or executed), then gated against the part.
+
     For ``path``, ``pencil`` and ``finish --stream OUT``: call it with the program they
     computed, the part, :func:`machine_of` of the arguments and OUT, after their own
     outputs are written."""
-    import numpy as np
-
-    from cadcnc.controller.stream import stream_program, stream_text
-    from cadcnc.errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL
-    from cadcnc.io.output_set import OutputSet
-    from cadcnc.ops.stream_steppers import stepper_factory
-    from cadcnc.tolerances import DEFAULT
-    from cadcnc.verification import gate_program
+    from cadcnc.work import sigterm_as_interrupt
+    from cadcnc.work import Ticker
 
     if hal:
         from cadcnc.controller.hal import HalError, hal_available
@@ -123,23 +138,44 @@ def stream_outputs(program, part, machine, out, *, feed=None, planned=True, tole
         if missing:
             raise HalError(f"--hal: HAL tools {missing} (install linuxcnc-uspace)")
     outs = [out] if isinstance(out, (str, bytes)) or hasattr(out, "__fspath__") else list(out)
-    outputs = OutputSet(outs, SUFFIXES, inputs=list(inputs)) if outs else None
-    stream = stream_program(program, machine, stepper_factory(part), feed=feed,
-                            planned=planned)
+    inputs = [i for i in inputs if i is not None] + [machine.source]
+    report = None if quiet else say_error
+    with sigterm_as_interrupt(), Ticker(report, "cadcnc: stream") as tick:
+        return _stream(program, part, machine, outs, tick, feed=feed, planned=planned,
+                       tolerances=tolerances, allow_gouge=allow_gouge, hal=hal, quiet=quiet,
+                       name=name, inputs=inputs, max_periods=max_periods)
+
+
+def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, allow_gouge,
+            hal, quiet, name, inputs, max_periods) -> int:
+    """:func:`stream_outputs` inside its heartbeat and SIGTERM handler."""
+    from cadcnc.errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL
+    from cadcnc.io.output_set import OutputSet
+    from cadcnc.ops.stream_steppers import stepper_factory
+    from cadcnc.tolerances import DEFAULT
+    from cadcnc.verification import gate_program
+
+    outputs = OutputSet(outs, SUFFIXES, inputs=inputs) if outs else None
+    tick.stage = "planning the feed"
+    stream = _planned_stream(program, machine, stepper_factory(part), tick, feed=feed,
+                             planned=planned, max_periods=max_periods, quiet=quiet)
+    tick.stage = "checking the stream against the machine's limits"
+    contents = _contents(stream.positions, outputs)
+    problems = _limits_broken(program, machine, stream.positions, contents)
+    if problems:
+        for line in problems[:8]:
+            say_error(f"cadcnc: stream: {line}")
+        say_error("cadcnc: stream: over the machine's limits: nothing written"
+                  + (" or executed" if hal else "") + " (exit 5)")
+        return EXIT_GOUGE
+    tick.stage = "gating the stream against the part"
     gate = gate_program(program, part, tolerances or DEFAULT,
                         moves=stream.segment_moves(program))
     if not gate.ok and not allow_gouge:
         say_error(f"cadcnc: stream: {gate.message}; nothing written (--allow-gouge writes it)")
         return EXIT_GOUGE
     if outputs is not None:
-        contents = {}
-        for dest in outputs.destinations:
-            if dest.suffix.lower() == ".npy":
-                buf = io.BytesIO()
-                np.save(buf, stream.positions)
-                contents[dest] = buf.getvalue()
-            else:
-                contents[dest] = stream_text(stream.positions)
+        tick.stage = "writing"
         outputs.write(contents)
     if not quiet:
         print(summary_text(stream, name))
@@ -149,6 +185,7 @@ def stream_outputs(program, part, machine, out, *, feed=None, planned=True, tole
     if hal:
         from cadcnc.controller.hal import run_hal_loop, summary as hal_report
 
+        tick.stage = "executing in HAL"
         result = run_hal_loop(stream.positions, machine, limits="machine")
         fell_short = result.clipped or result.underruns or result.overruns
         if not quiet or fell_short:
@@ -159,6 +196,77 @@ def stream_outputs(program, part, machine, out, *, feed=None, planned=True, tole
                       f"{result.overruns} samples lost")
             code = max(code, EXIT_PARTIAL)
     return code
+
+
+def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_periods, quiet):
+    """The stream, its periods estimated and bounded before the positions are computed,
+    progress reported (the planner's own ``max_periods`` and ``progress`` when it has
+    them; else the plan is made once more here to count the periods)."""
+    import inspect
+
+    from cadcnc.controller.stream import stream_program
+    from cadcnc.work import refuse_over
+
+    said = []
+
+    def estimate(total: int) -> None:
+        refuse_over("the stream", total, max_periods, "servo periods",
+                    "raise the feed or the machine's limits, or give --max-periods N "
+                    f"(each 24 bytes in memory)")
+        if not quiet and not said:
+            say_error(f"cadcnc: stream: {total} periods of {machine.period * 1e3:g} ms "
+                      f"(cycle {total * machine.period:.3f} s) to compute")
+        said.append(total)
+        tick.stage = f"streaming {total} periods"
+
+    kw = {"feed": feed, "planned": planned}
+    if "max_periods" in inspect.signature(stream_program).parameters:
+        def progress(done: int, total: int) -> None:
+            if not said:
+                estimate(total)
+            tick.stage = f"streaming: {done}/{total} periods"
+
+        return stream_program(program, machine, steppers, max_periods=max_periods,
+                              progress=progress, **kw)
+    from cadcnc.controller.feed_plan import plan_feed
+    from cadcnc.controller.pieces import pieces_of
+
+    estimate(plan_feed(pieces_of(program, machine, feed), machine, planned).periods)
+    return stream_program(program, machine, steppers, **kw)
+
+
+def _contents(positions, outputs) -> dict:
+    """``{destination: bytes or str}`` of every output (.npy, .txt)."""
+    import numpy as np
+
+    from cadcnc.controller.stream import stream_text
+
+    contents = {}
+    for dest in (outputs.destinations if outputs is not None else ()):
+        if dest.suffix.lower() == ".npy":
+            buf = io.BytesIO()
+            np.save(buf, positions)
+            contents[dest] = buf.getvalue()
+        else:
+            contents[dest] = stream_text(positions)
+    return contents
+
+
+def _limits_broken(program, machine, positions, contents) -> list[str]:
+    """What breaks the machine's limits or misses the program's ends: in the positions,
+    and in each .txt's numbers as written (9 decimals)."""
+    import numpy as np
+
+    from cadcnc.verification.stream_check import check_stream
+
+    limits = (machine.max_velocity, machine.max_acceleration, machine.max_jerk)
+    ends = (program.segments[0].points[0], program.segments[-1].points[-1])
+    found = check_stream(positions, machine.period, limits, *ends).problems
+    for dest, text in contents.items():
+        if isinstance(text, str) and not found:
+            rows = np.array(text.split(), dtype=np.float64).reshape(-1, 3)
+            found = check_stream(rows, machine.period, limits, *ends, what=str(dest)).problems
+    return found
 
 
 def summary_text(stream, name: str) -> str:

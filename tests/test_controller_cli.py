@@ -86,14 +86,19 @@ def test_hal_executes_the_planned_stream_unclipped(program, tmp_path):
 
 
 @needs_hal
-def test_hal_reports_clipping_of_a_constant_feed_stream_as_exit_6(program):
-    """At constant 10 000 mm/min the stream asks 167 mm/s of axes limited to 57 mm/s:
-    limit3 clips it, and the run is a failure (exit 6) saying so; no file is needed."""
+def test_a_constant_feed_stream_over_the_limits_is_refused_before_hal(program, monkeypatch):
+    """At constant 10 000 mm/min the stream asks 167 mm/s of axes limited to 57 mm/s: the
+    stream check refuses it before HAL starts (exit 5, nothing executed; limit3's clipping
+    of such a stream: tests/test_hal_loop.py)."""
+    import cadcnc.controller.hal as hal
+
+    def never(*args, **kwargs):
+        raise AssertionError("HAL must not run a stream over the limits")
+
+    monkeypatch.setattr(hal, "run_hal_loop", never)
     run = cadcnc_cli("stream", program, "--hal", "--constant-feed", "--feed", "10000")
-    assert run.returncode == 6, (run.returncode, run.stdout, run.stderr)
-    assert "HAL executed less than the stream" in run.stderr
-    clipped = int(run.stderr.split("HAL executed less than the stream: ")[1].split()[0])
-    assert clipped > 10
+    assert run.returncode == 5, (run.returncode, run.stdout, run.stderr)
+    assert "velocity of axis" in run.stderr and "nothing written or executed" in run.stderr
 
 
 def test_hal_that_cannot_start_is_exit_1_with_the_reason(program, monkeypatch, tmp_path):

@@ -13,6 +13,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -141,7 +142,9 @@ def test_a_hal_that_cannot_start_says_why_and_leaves_nothing_loaded(tmp_path):
     assert rtapi_pids() == [] and live_hal_processes() == []
 
 
-def test_ctrl_c_unloads_hal_and_exits_130(tmp_path):
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_ctrl_c_unloads_hal_and_exits_130(tmp_path, sig):
+    """Ctrl-C, and SIGTERM likewise (issue 36): HAL unloaded, exit 130, its folder gone."""
     stream = write_stream_txt(constant_feed_circle(60_000, MACHINE), tmp_path / "s.txt")
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     proc = subprocess.Popen([sys.executable, "-m", "cadcnc.controller.hal", str(stream),
@@ -150,13 +153,15 @@ def test_ctrl_c_unloads_hal_and_exits_130(tmp_path):
     try:
         assert proc.stderr.readline().strip() == "HAL running"
         time.sleep(0.3)
-        proc.send_signal(signal.SIGINT)
+        assert list(Path(tempfile.gettempdir()).glob(f"cadcnc-hal-{proc.pid}-*"))
+        proc.send_signal(sig)
         out, err = proc.communicate(timeout=40)
     finally:
         if proc.poll() is None:
             proc.kill()
     assert proc.returncode == 130, (out, err)
-    assert "interrupted by Ctrl-C" in err and "HAL unloaded" in err
+    assert "interrupted (Ctrl-C or SIGTERM" in err and "HAL unloaded" in err
+    assert not list(Path(tempfile.gettempdir()).glob(f"cadcnc-hal-{proc.pid}-*"))
     assert rtapi_pids() == [] and live_hal_processes() == []
 
 

@@ -26,7 +26,7 @@ from distributed.client import FutureCancelledError
 from distributed.scheduler import KilledWorker
 
 from ..errors import EXIT_INTERNAL, InputError, OutputError
-from ..io.output_set import OutputSet
+from ..io.output_set import OutputSet, check_not_inputs
 from ..io.outputs import SUFFIXES
 from .records import STATE, Record, job_hash, save_state, unchanged, write_summary
 from .task import EVENT_TOPIC, BatchPart, OperationResult, PartResult, run_part
@@ -64,15 +64,17 @@ class _Planned:
 
 def batch(parts: Sequence[BatchPart], out, *, scheduler: str | None = None,
           workers: int | None = None, force: bool = False,
-          progress: Callable[[Progress], None] | None = None) -> list[Record]:
+          progress: Callable[[Progress], None] | None = None, inputs=()) -> list[Record]:
     """Run every part's operations and return the summary's records (one per part and
     operation, in the parts' order); also written to OUT/summary.csv and .json. Outputs
     go to OUT/NAME/ (NAME: the part's name). ``scheduler``: an existing Dask scheduler's
     address (default: an embedded local cluster of ``workers`` processes, default one per
     core); ``force``: run unchanged parts again; ``progress``: called with a
-    :class:`Progress` whenever a part starts or ends."""
+    :class:`Progress` whenever a part starts or ends; ``inputs``: other files the batch
+    reads (its job file). No output may be an input: every part, every file of
+    ``inputs`` (OutputIsInputError naming both, exit 2, before any work)."""
     out = Path(out)
-    plans = _plan(list(parts), out)
+    plans = _plan(list(parts), out, inputs)
     state = Progress(len(plans))
     records: dict[str, list[Record]] = {}
     todo = []
@@ -94,9 +96,9 @@ def batch(parts: Sequence[BatchPart], out, *, scheduler: str | None = None,
     return result
 
 
-def _plan(parts: list[BatchPart], out: Path) -> list[_Planned]:
+def _plan(parts: list[BatchPart], out: Path, inputs=()) -> list[_Planned]:
     """Each part hashed and its destinations checked (InputError, OutputError) before any
-    work; the folders made."""
+    work, every destination against every input; the folders made."""
     if not parts:
         raise InputError("a batch needs at least one part")
     seen: dict[str, str] = {}
@@ -111,12 +113,16 @@ def _plan(parts: list[BatchPart], out: Path) -> list[_Planned]:
         if not p.operations or len(set(names)) < len(names):
             raise InputError(f"{p.path}: no operation, or two that write one file: "
                              f"{', '.join(names)}")
+    check_not_inputs([out / "summary.csv", out / "summary.json"] + [
+        out / p.label / name for p in parts
+        for name in [STATE, *(n for op in p.operations for n in op.outputs)]],
+        [p.path for p in parts] + list(inputs))
     digests = [job_hash(p) for p in parts]   # every part read before any folder is made
     plans = []
     for p, digest in zip(parts, digests):
         folder = out / p.label
         folder.mkdir(parents=True, exist_ok=True)
-        sets = [OutputSet([folder / name for name in op.outputs], SUFFIXES, inputs=[p.path])
+        sets = [OutputSet([folder / name for name in op.outputs], SUFFIXES)
                 for op in p.operations]
         plans.append(_Planned(p, folder, digest, sets))
     return plans

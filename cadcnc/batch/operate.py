@@ -11,6 +11,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import InputError, NothingToCutError
 from ..geometry.part import Part, load_step
 from ..geometry.setup import setup_in, setup_part
@@ -54,6 +56,27 @@ class Outcome:
     what: str
 
 
+MAX_ORIGIN_OFFSET = 10_000.0
+"""mm: the farthest a work zero (``--origin``) may lie from the part's bounding box along
+any axis (10 m,
+beyond any machine's travel; far enough off, the part's coordinates lose their digits)."""
+
+
+def check_origin(part: Part, job: Job, step) -> None:
+    """InputError when the job's work zero lies more than MAX_ORIGIN_OFFSET from the
+    part's bounding box along an axis (an input mistake, not a geometry without a program)."""
+    if job.origin is None:
+        return
+    lo, hi = (np.asarray(b, dtype=float) for b in part.bounding_box())
+    origin = np.asarray(job.origin, dtype=float)
+    off = float(np.max(np.maximum(0.0, np.maximum(lo - origin, origin - hi))))
+    if not off <= MAX_ORIGIN_OFFSET:
+        shown = ",".join(f"{v:g}" for v in origin)
+        raise InputError(f"--origin {shown}: {off:.3g} mm from {Path(str(step)).name}'s "
+                         f"bounding box; the work zero must lie within "
+                         f"{MAX_ORIGIN_OFFSET:g} mm of the part")
+
+
 def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progress=None,
             times: dict | None = None, gate_progress=None) -> Outcome:
     """Run ``job`` on the STEP file ``step`` and judge it (module doc). ``what``: the
@@ -63,7 +86,9 @@ def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progr
     if settings.max_cycles < 1:
         raise InputError(f"--max-cycles must be at least 1, got {settings.max_cycles}")
     t0 = time.monotonic()
-    part = setup_part(load_step(step, flip_material=job.flip_material), job)
+    loaded = load_step(step, flip_material=job.flip_material)
+    check_origin(loaded, job, step)
+    part = setup_part(loaded, job)
     if setup_in(part) is not None:
         what = f"{what} (tool axis {setup_in(part).name})"
     for n in getattr(job.operation, "faces", None) or ():

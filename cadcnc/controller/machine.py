@@ -7,13 +7,14 @@ user already has. Units inside: mm, s.
 
 from __future__ import annotations
 
-import configparser
 import math
 import numbers
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError
+from .ini_file import IniFile, leading_number
 
 AXES = ("X", "Y", "Z")
 INCH = 25.4  # mm
@@ -25,8 +26,16 @@ DEFAULT_JERK_RAMP = 0.05
 """s: the default jerk reaches an axis's acceleration in this time (jerk = A / 0.05 s)."""
 
 
-def _triple(name: str, value, unit: str) -> tuple[float, float, float]:
-    """Three finite numbers > 0 (X, Y, Z), or InputError naming the field and the axis."""
+MAX_VELOCITY = 1e6      # mm/s: 1 km/s
+MAX_ACCELERATION = 1e9  # mm/s^2: 10^5 g
+MAX_JERK = 1e15         # mm/s^3
+"""The largest limits a Machine takes: far beyond any machine tool, and small enough that
+the planner's powers of them (v^3, A^2 / J...) stay finite."""
+
+
+def _triple(name: str, value, unit: str, most: float) -> tuple[float, float, float]:
+    """Three finite numbers in (0, most] (X, Y, Z), or InputError naming the field and the
+    axis."""
     try:
         items = tuple(value)
     except TypeError:
@@ -38,9 +47,9 @@ def _triple(name: str, value, unit: str) -> tuple[float, float, float]:
     out = []
     for axis, v in zip(AXES, items):
         if (not isinstance(v, numbers.Real) or isinstance(v, bool)
-                or not math.isfinite(float(v)) or v <= 0):
-            raise InputError(f"machine {name} of axis {axis} must be a number > 0 {unit}, "
-                             f"got {v!r}")
+                or not math.isfinite(float(v)) or not 0 < v <= most):
+            raise InputError(f"machine {name} of axis {axis} must be a number > 0 {unit} "
+                             f"and at most {most:g}, got {v!r}")
         out.append(float(v))
     return tuple(out)
 
@@ -63,9 +72,10 @@ class Machine:
             raise InputError(f"machine period must be a number of seconds in [1e-6, 0.1] "
                              f"(1 us .. 100 ms), got {p!r}")
         object.__setattr__(self, "period", float(p))
-        for name, unit in (("max_velocity", "mm/s"), ("max_acceleration", "mm/s^2"),
-                           ("max_jerk", "mm/s^3")):
-            object.__setattr__(self, name, _triple(name, getattr(self, name), unit))
+        for name, unit, most in (("max_velocity", "mm/s", MAX_VELOCITY),
+                                 ("max_acceleration", "mm/s^2", MAX_ACCELERATION),
+                                 ("max_jerk", "mm/s^3", MAX_JERK)):
+            object.__setattr__(self, name, _triple(name, getattr(self, name), unit, most))
         object.__setattr__(self, "source", str(self.source))
 
     @classmethod
@@ -86,75 +96,99 @@ class Machine:
         return f"period {self.period * 1e3:g} ms; {axes}"
 
 
-def _parser(path: Path) -> configparser.ConfigParser:
-    ini = configparser.ConfigParser(strict=False, interpolation=None,
-                                    comment_prefixes=("#", ";"), inline_comment_prefixes=None)
-    ini.optionxform = str   # LinuxCNC's keys are case-sensitive upper case
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as e:
-        raise InputError(f"{path}: cannot read the machine INI file ({e.strerror or e})") \
-            from None
-    try:
-        ini.read_string(text, source=str(path))
-    except configparser.Error as e:
-        first = str(e).splitlines()[0]
-        raise InputError(f"{path}: not a LinuxCNC INI file ({first})") from None
-    return ini
-
-
-def _number(ini, path: Path, section: str, key: str, unit: str) -> float:
-    """[section] key as a finite number > 0, or InputError naming file, section and key."""
+def _number(ini: IniFile, section: str, key: str, unit: str, warn) -> float:
+    """[section] key as LinuxCNC reads it, a finite number > 0, or InputError naming file,
+    section and key; what LinuxCNC ignores around it goes to ``warn``."""
+    path = ini.path
     if not ini.has_section(section):
         raise InputError(f"{path}: section [{section}] is missing (needed for {key})")
-    raw = ini.get(section, key, fallback=None)
-    if raw is None or not raw.strip():
+    for text in ini.repeats(section, key):
+        warn(text)
+    raw, line = ini.find(section, key)
+    if raw is None:
         raise InputError(f"{path}: [{section}] {key} is missing ({unit})")
-    try:
-        value = float(raw.strip())
-    except ValueError:
-        raise InputError(f"{path}: [{section}] {key} = {raw.strip()!r} is not a number "
-                         f"({unit})") from None
+    value, rest = leading_number(raw)
+    if value is None:
+        raise InputError(f"{line.where}: [{section}] {key} = {raw!r} is not a number ({unit})")
+    if rest:
+        warn(f"{line.where}: [{section}] {key} = {raw}: LinuxCNC reads the number {value:g} "
+             f"and ignores {rest!r}, and so does cadcnc")
     if not math.isfinite(value) or value <= 0:
-        raise InputError(f"{path}: [{section}] {key} = {raw.strip()} must be a number > 0 "
+        raise InputError(f"{line.where}: [{section}] {key} = {raw} must be a number > 0 "
                          f"({unit})")
     return value
 
 
-def read_machine_ini(path, jerk: float | None = None) -> Machine:
-    """The :class:`Machine` of a LinuxCNC INI file.
+LIMITS = {"MAX_VELOCITY": ("units/s", MAX_VELOCITY, "mm/s"),
+          "MAX_ACCELERATION": ("units/s^2", MAX_ACCELERATION, "mm/s^2"),
+          "MAX_JERK": ("units/s^3", MAX_JERK, "mm/s^3")}
+
+
+def _limit(ini: IniFile, section: str, key: str, scale: float, warn) -> float:
+    """An axis limit in mm (``scale`` mm per unit), at most its bound (InputError)."""
+    unit, most, mm = LIMITS[key]
+    value = scale * _number(ini, section, key, unit, warn)
+    if value > most:
+        raise InputError(f"{ini.path}: [{section}] {key} = {value / scale:g} {unit} is over "
+                         f"{most:g} {mm}, far beyond any machine: check the value")
+    return value
+
+
+def _warn(text: str) -> None:
+    warnings.warn(text, IniWarning, stacklevel=3)
+
+
+class IniWarning(UserWarning):
+    """Something in a machine INI file LinuxCNC ignores (a repeated key or section, text
+    after a number); cadcnc reads the value LinuxCNC reads."""
+
+
+def read_machine_ini(path, jerk: float | None = None, warn=None) -> Machine:
+    """The :class:`Machine` of a LinuxCNC INI file, every value read as LinuxCNC reads it
+    (:mod:`.ini_file`: the first section and the first key win, ``#INCLUDE`` expanded).
 
     ``[EMCMOT] SERVO_PERIOD`` (ns), ``[TRAJ] LINEAR_UNITS`` (mm or inch), and per axis
     ``[AXIS_X]``, ``[AXIS_Y]``, ``[AXIS_Z]`` ``MAX_VELOCITY`` (units/s),
     ``MAX_ACCELERATION`` (units/s²) and ``MAX_JERK`` (units/s³) where present, else
     ``jerk`` (mm/s³, every axis). LinuxCNC 2.9 has no jerk key: without ``jerk`` that is
     an error naming the key. Missing or bad values: InputError naming file, section, key.
+    What LinuxCNC ignores (a repeated key or section, text after a number) is reported to
+    ``warn(text)`` (default: an :class:`IniWarning`), naming both lines.
     """
     path = Path(path)
-    ini = _parser(path)
-    period_ns = _number(ini, path, "EMCMOT", "SERVO_PERIOD", "ns")
-    units = ini.get("TRAJ", "LINEAR_UNITS", fallback=None) if ini.has_section("TRAJ") else None
+    warn = _warn if warn is None else warn
+    ini = IniFile(path)
+    period_ns = _number(ini, "EMCMOT", "SERVO_PERIOD", "ns", warn)
+    if not ini.has_section("TRAJ"):
+        raise InputError(f"{path}: section [TRAJ] is missing (needed for LINEAR_UNITS)")
+    for text in ini.repeats("TRAJ", "LINEAR_UNITS"):
+        warn(text)
+    units, line = ini.find("TRAJ", "LINEAR_UNITS")
     if units is None:
         raise InputError(f"{path}: [TRAJ] LINEAR_UNITS is missing (mm or inch)")
-    scale = UNITS.get(units.strip().lower())
+    scale = UNITS.get(units.lower())
     if scale is None:
-        raise InputError(f"{path}: [TRAJ] LINEAR_UNITS = {units.strip()!r} is not a length "
+        raise InputError(f"{line.where}: [TRAJ] LINEAR_UNITS = {units!r} is not a length "
                          f"unit LinuxCNC knows (one of {', '.join(UNITS)})")
     if jerk is not None:
-        jerk = _triple("jerk (--jerk)", (jerk,) * 3, "mm/s^3")[0]
+        jerk = _triple("jerk (--jerk)", (jerk,) * 3, "mm/s^3", MAX_JERK)[0]
     v, a, j = [], [], []
     for axis in AXES:
         section = f"AXIS_{axis}"
-        v.append(scale * _number(ini, path, section, "MAX_VELOCITY", "units/s"))
-        a.append(scale * _number(ini, path, section, "MAX_ACCELERATION", "units/s^2"))
-        if ini.has_option(section, "MAX_JERK"):
-            j.append(scale * _number(ini, path, section, "MAX_JERK", "units/s^3"))
+        v.append(_limit(ini, section, "MAX_VELOCITY", scale, warn))
+        a.append(_limit(ini, section, "MAX_ACCELERATION", scale, warn))
+        if ini.find(section, "MAX_JERK")[0] is not None:
+            j.append(_limit(ini, section, "MAX_JERK", scale, warn))
         elif jerk is not None:
             j.append(jerk)
         else:
             raise InputError(f"{path}: [{section}] MAX_JERK is missing (LinuxCNC 2.9 has "
                              "none): give the jerk with --jerk MM/S3")
     try:
-        return Machine(period_ns * 1e-9, tuple(v), tuple(a), tuple(j), str(path))
+        period = Machine(period_ns * 1e-9, (1.0,) * 3, (1.0,) * 3, (1.0,) * 3).period
     except InputError as e:
         raise InputError(f"{path}: [EMCMOT] SERVO_PERIOD = {period_ns:g} ns: {e}") from None
+    try:
+        return Machine(period, tuple(v), tuple(a), tuple(j), str(path))
+    except InputError as e:
+        raise InputError(f"{path}: {e} (the INI's values in mm)") from None

@@ -3,7 +3,7 @@
 A machinist runs ``cadcnc path ... && send-to-machine``: a failed or interrupted run must
 leave no half file and never destroy an earlier good one. :class:`OutputSet` checks every
 destination up front (known suffix, existing writable folder, not a folder itself, not one
-of the run's input files, a name the file system accepts), then writes the whole set to
+of the run's input files (exit 2), a name the file system accepts), then writes the whole set to
 temporary files beside their destinations and renames them only when all are ready, with
 Ctrl-C (SIGINT) deferred during the renames. A symlink destination is followed: its target
 is replaced, the link stays.
@@ -16,8 +16,8 @@ import os
 import tempfile
 from pathlib import Path
 
-from ..errors import OutputError
-from ..interrupts import sigint_deferred
+from ..errors import OutputError, OutputIsInputError
+from ..work import sigterm_as_interrupt, signals_deferred
 from .atomic import NAME_MAX, temp_prefix
 
 
@@ -56,11 +56,23 @@ def check_destination(out, suffixes: tuple[str, ...], inputs=()) -> Path:
         raise OutputError(f"{out}: is a folder")
     if not os.access(folder, os.W_OK):
         raise OutputError(f"{out}: cannot write, folder {out.parent} is not writable")
-    for source in inputs:
-        if source is not None and Path(source).exists() and _same_file(target, Path(source)):
-            raise OutputError(f"{out}: is an input of this run ({source}); refusing to "
-                              "write over it")
+    check_not_inputs([out], inputs)
     return target
+
+
+def check_not_inputs(destinations, inputs) -> None:
+    """OutputIsInputError (exit 2) naming both when a destination is one of ``inputs``
+    (a path, or None), symbolic links and ``..`` resolved; a destination's folder need
+    not exist yet."""
+    sources = [Path(s) for s in inputs if s is not None and Path(s).exists()]
+    for out in destinations:
+        out = Path(out)
+        target = Path(os.path.realpath(out))
+        for source in sources:
+            if _same_file(target, source) if target.exists() else \
+                    target == Path(os.path.realpath(source)):
+                raise OutputIsInputError(f"{out}: is an input of this run ({source}); "
+                                         "refusing to write over it")
 
 
 class OutputSet:
@@ -83,19 +95,11 @@ class OutputSet:
             raise OutputError(f"no content for {', '.join(missing)}")
         temps: list[tuple[str, Path, Path]] = []
         try:
-            for d in self.destinations:
-                target = self.targets[d]
-                data = contents[d]
-                data = data.encode("utf-8") if isinstance(data, str) else data
-                fd, tmp = tempfile.mkstemp(prefix=temp_prefix(target), suffix=".tmp",
-                                           dir=target.parent)
-                temps.append((tmp, target, d))
-                with os.fdopen(fd, "wb") as fh:
-                    fh.write(data)
-                os.chmod(tmp, 0o666 & ~_umask())
-            with sigint_deferred():
-                for tmp, target, _ in temps:
-                    os.replace(tmp, target)
+            with sigterm_as_interrupt():   # SIGTERM, too, leaves no temporary file
+                self._write_temps(contents, temps)
+                with signals_deferred():
+                    for tmp, target, _ in temps:
+                        os.replace(tmp, target)
         except OSError as e:
             name = temps[-1][2] if temps else self.destinations[0]
             raise OutputError(f"{name}: cannot write ({e.strerror or e})") from e
@@ -103,6 +107,19 @@ class OutputSet:
             for tmp, _, _ in temps:
                 with contextlib.suppress(OSError):
                     os.unlink(tmp)
+
+    def _write_temps(self, contents: dict, temps: list) -> None:
+        """Every destination's bytes to a temporary file beside it (listed in ``temps``)."""
+        for d in self.destinations:
+            target = self.targets[d]
+            data = contents[d]
+            data = data.encode("utf-8") if isinstance(data, str) else data
+            fd, tmp = tempfile.mkstemp(prefix=temp_prefix(target), suffix=".tmp",
+                                       dir=target.parent)
+            temps.append((tmp, target, d))
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+            os.chmod(tmp, 0o666 & ~_umask())
 
 
 def write_one(out, data, suffixes: tuple[str, ...], inputs=()) -> None:

@@ -68,7 +68,7 @@ def test_an_output_never_overwrites_the_input(tmp_path):
         if out == step:
             assert run.returncode == 0, run.stderr
         else:
-            one_line(run, 4, "input of this run")
+            one_line(run, 2, "input of this run")
         assert step.read_bytes() == before
 
 

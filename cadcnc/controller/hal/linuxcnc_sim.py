@@ -3,7 +3,9 @@
 ``run_ngc(ngc, machine)`` writes a simulator configuration (``linuxcnc_sim.ini``: trivkins
 X Y Z, the machine's per-axis velocity and acceleration, its servo period; the display is
 ``linuxcncrsh``) and ``linuxcnc_sampler.hal`` (a ``sampler`` on the joint position commands
-and ``motion.program-line``), starts ``linuxcnc``, drives it over linuxcncrsh on 127.0.0.1
+and ``motion.program-line``), starts ``linuxcnc`` (as root: in a network namespace of its
+own, ``unshare --net`` with ``lo`` up, since linuxcncrsh listens on every interface),
+drives it over linuxcncrsh on that namespace's 127.0.0.1
 (login, estop off, machine on, auto, open, run), waits for the program to end, reads the
 samples and shuts everything down. LinuxCNC 2.9's planner is trapezoidal: it has no jerk
 limit, so ``machine.max_jerk`` is not used. Units: mm, s.
@@ -11,11 +13,14 @@ limit, so ``machine.max_jerk`` is not used. Units: mm, s.
 
 from __future__ import annotations
 
+import ctypes
+import os
 import secrets
+import shutil
 import socket
 import string
 import subprocess
-import tempfile
+import threading
 import time
 from dataclasses import dataclass
 from importlib import resources
@@ -24,7 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from .session import HalError, HalInterrupted, HalSession
+from ...work import sigterm_as_interrupt
+from .session import HalError, HalInterrupted, HalSession, work_folder
 
 SAMPLE_DEPTH = 600_000  # periods the sampler FIFO holds (10 min at 1 ms)
 
@@ -77,11 +83,58 @@ def write_sim_config(machine: Any, workdir: Path, *, port: int, connectpw: str,
     return path
 
 
-class Rsh:
-    """A linuxcncrsh client on 127.0.0.1 (echo off, verbose on: every ``set`` is ACKed)."""
+CLONE_NEWNET = 0x40000000
+NAMESPACED = 'ip link set lo up && exec "$@"'
+"""Run inside ``unshare --net``: the new network namespace's loopback up, then LinuxCNC."""
 
-    def __init__(self, port: int, connectpw: str, enablepw: str, timeout: float = 10.0):
-        self.sock = socket.create_connection(("127.0.0.1", port), timeout=timeout)
+
+def loopback_argv(argv: list[str]) -> tuple[list[str], bool]:
+    """``argv`` run in a network namespace of its own (``unshare --net``, ``lo`` up), so
+    that linuxcncrsh, which listens on every interface, is reachable from this machine
+    only through that namespace; (argv, True). Without root, ``unshare`` or ``ip``:
+    (argv unchanged, False)."""
+    if os.geteuid() != 0 or not shutil.which("unshare") or not shutil.which("ip"):
+        return argv, False
+    return ["unshare", "--net", "sh", "-c", NAMESPACED, "sh", *argv], True
+
+
+def _connect_in(pid: int | None, port: int, timeout: float) -> socket.socket:
+    """A TCP connection to 127.0.0.1:``port`` in the network namespace of process ``pid``
+    (None: this process's): made by a thread that enters the namespace (``setns``), the
+    rest of the process staying where it is."""
+    if pid is None:
+        return socket.create_connection(("127.0.0.1", port), timeout=timeout)
+    got: dict = {}
+
+    def enter_and_connect() -> None:
+        try:
+            fd = os.open(f"/proc/{pid}/ns/net", os.O_RDONLY)
+            try:
+                libc = ctypes.CDLL(None, use_errno=True)
+                if libc.setns(fd, CLONE_NEWNET) != 0:
+                    err = ctypes.get_errno()
+                    raise OSError(err, f"setns: {os.strerror(err)}")
+            finally:
+                os.close(fd)
+            got["sock"] = socket.create_connection(("127.0.0.1", port), timeout=timeout)
+        except OSError as e:
+            got["error"] = e
+
+    worker = threading.Thread(target=enter_and_connect, name="cadcnc-netns")
+    worker.start()
+    worker.join()
+    if "error" in got:
+        raise got["error"]
+    return got["sock"]
+
+
+class Rsh:
+    """A linuxcncrsh client on 127.0.0.1 (echo off, verbose on: every ``set`` is ACKed);
+    ``netns_pid``: a process in the network namespace linuxcncrsh runs in (None: ours)."""
+
+    def __init__(self, port: int, connectpw: str, enablepw: str, timeout: float = 10.0,
+                 netns_pid: int | None = None):
+        self.sock = _connect_in(netns_pid, port, timeout)
         self.buf = b""
         self.ask(f"hello {connectpw} cadcnc 1.0", expect="HELLO ACK")
         self.send(f"set enable {enablepw}")
@@ -129,13 +182,15 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-def _connect(session: HalSession, port: int, cpw: str, epw: str, deadline: float) -> Rsh:
-    """Wait until linuxcncrsh answers (or linuxcnc has died), then log in."""
+def _connect(session: HalSession, port: int, cpw: str, epw: str, deadline: float,
+             namespaced: bool = False) -> Rsh:
+    """Wait until linuxcncrsh answers (or linuxcnc has died), then log in (in linuxcnc's
+    network namespace when ``namespaced``)."""
     while True:
         if session.procs[0].poll() is not None:
             raise HalError("linuxcnc exited during start-up:\n" + _log_tail(session))
         try:
-            return Rsh(port, cpw, epw)
+            return Rsh(port, cpw, epw, netns_pid=session.procs[0].pid if namespaced else None)
         except OSError:
             if time.monotonic() > deadline:
                 raise HalError(f"linuxcncrsh not answering on port {port}:\n"
@@ -159,14 +214,15 @@ def run_ngc(ngc: Path, machine: Any, *, workdir: Path | None = None,
     if not ngc.is_file():
         raise HalError(f"no such G-code file: {ngc}")
     port, cpw, epw = _free_port(), secrets.token_hex(6), secrets.token_hex(6)  # <= 15 chars
-    with tempfile.TemporaryDirectory(prefix="cadcnc-lcnc-") as tmp:
+    with sigterm_as_interrupt(), work_folder("lcnc") as tmp:
         work = Path(workdir) if workdir is not None else Path(tmp)
         ini = write_sim_config(machine, work, port=port, connectpw=cpw, enablepw=epw)
         session = HalSession("", work, start_timeout=60)
         rsh = None
         try:
-            session.start(argv=["linuxcnc", str(ini)])
-            rsh = _connect(session, port, cpw, epw, time.monotonic() + 60)
+            argv, namespaced = loopback_argv(["linuxcnc", str(ini)])
+            session.start(argv=argv)
+            rsh = _connect(session, port, cpw, epw, time.monotonic() + 60, namespaced)
             for cmd in ("estop off", "machine on", "mode auto", f"open {ngc}"):
                 rsh.ask(f"set {cmd}", expect=f"SET {cmd.split()[0].upper()} ACK")
             session.halcmd("sets", "cadcnc-run", "TRUE")
@@ -190,7 +246,7 @@ def run_ngc(ngc: Path, machine: Any, *, workdir: Path | None = None,
             _wait_exit(session.procs[0], 20)
         except KeyboardInterrupt:
             session.stop()
-            raise HalInterrupted("LinuxCNC run interrupted by Ctrl-C; LinuxCNC and HAL "
+            raise HalInterrupted("LinuxCNC run interrupted (Ctrl-C or SIGTERM); LinuxCNC and HAL "
                                  "shut down") from None
         finally:
             if rsh is not None:

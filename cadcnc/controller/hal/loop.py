@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import string
 import subprocess
-import tempfile
 import time
 from dataclasses import dataclass
 from importlib import resources
@@ -21,7 +20,8 @@ from typing import Any
 import numpy as np
 
 from ...errors import InputError
-from .session import HalError, HalInterrupted, HalSession
+from ...work import sigterm_as_interrupt
+from .session import HalError, HalInterrupted, HalSession, work_folder
 
 SAMPLE_RES = 1e-9  # mm: halsampler prints 6 decimals of the µm the sampler holds
 WIDE = 1e20  # limit3's own "no limit"
@@ -116,7 +116,7 @@ def run_hal_loop(stream: Any, machine: Any, *, limits: str = "machine",
     total = n + tail
     timeout = 3 * total * machine.period + 30 if timeout is None else timeout
     text = hal_text(machine, n, limits=limits, tail=tail)
-    with tempfile.TemporaryDirectory(prefix="cadcnc-hal-") as tmp:
+    with sigterm_as_interrupt(), work_folder("hal") as tmp:
         work = Path(workdir) if workdir is not None else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
         txt = write_stream_txt(rows, work / "stream.txt")
@@ -142,7 +142,7 @@ def run_hal_loop(stream: Any, machine: Any, *, limits: str = "machine",
         except KeyboardInterrupt:
             session.stop()
             done = int((time.monotonic() - started) / machine.period) if started else 0
-            raise HalInterrupted(f"HAL run interrupted by Ctrl-C (about {min(done, n)} of {n} "
+            raise HalInterrupted(f"HAL run interrupted (Ctrl-C or SIGTERM; about {min(done, n)} of {n} "
                                  "periods executed); HAL unloaded") from None
         finally:
             problems = session.stop()

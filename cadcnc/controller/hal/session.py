@@ -25,6 +25,46 @@ from ...errors import EXIT_INTERNAL, EXIT_INTERRUPTED, CadcncError
 
 LOCK_PATH = Path(tempfile.gettempdir()) / "cadcnc-hal.lock"
 NOBODY_UID = 65534
+FOLDER = re.compile(r"^cadcnc-(hal|lcnc)-(\d+)-")
+"""A run's temporary folder: ``cadcnc-hal-PID-XXXX`` (HAL loop) or ``cadcnc-lcnc-PID-XXXX``
+(LinuxCNC baseline), PID the process that made it."""
+
+
+def work_folder(kind: str) -> tempfile.TemporaryDirectory:
+    """A temporary folder for one run, named by ``kind`` ("hal", "lcnc") and this
+    process's id; stale folders of dead runs are removed first (:func:`remove_stale`)."""
+    remove_stale()
+    return tempfile.TemporaryDirectory(prefix=f"cadcnc-{kind}-{os.getpid()}-")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def remove_stale(root=None) -> list[Path]:
+    """Remove the temporary folders of cadcnc runs whose process is gone (killed by
+    SIGKILL, which leaves no time to clean up); a live process's folder is never touched,
+    nor a folder without a process id in its name. Returns what was removed."""
+    root = Path(tempfile.gettempdir() if root is None else root)
+    removed = []
+    try:
+        entries = list(root.iterdir())
+    except OSError:
+        return removed
+    for entry in entries:
+        found = FOLDER.match(entry.name)
+        if found is None or int(found.group(2)) == os.getpid() or _alive(int(found.group(2))):
+            continue
+        if entry.is_dir() and not entry.is_symlink():
+            shutil.rmtree(entry, ignore_errors=True)
+            removed.append(entry)
+    return removed
 
 
 class HalError(CadcncError):
@@ -191,15 +231,16 @@ class HalSession:
     def stop(self) -> list[str]:
         """Stop helpers, close halrun's stdin, ``halrun -U``; returns problems (never raises).
 
-        A Ctrl-C during teardown is ignored: the teardown is what the user asked for.
+        A Ctrl-C or SIGTERM during teardown is ignored: the teardown is what the user asked for.
         """
         main = threading.current_thread() is threading.main_thread()
-        previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+        signals = (signal.SIGINT, signal.SIGTERM) if main else ()
+        previous = [signal.signal(sig, signal.SIG_IGN) for sig in signals]
         try:
             return self._stop()
         finally:
-            if main:
-                signal.signal(signal.SIGINT, previous)
+            for sig, handler in zip(signals, previous):
+                signal.signal(sig, handler)
 
     def _stop(self) -> list[str]:
         """The teardown itself (see :meth:`stop`)."""
