@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from ..tolerances import DEFAULT
 from .box_tree import BoxTree
-from .cells import BOUNDED_KINDS, HeightCells, shared
+from .cells import HeightCells, bounded, shared
 from .clearance import BOX_SLACK, ClearanceGuard, distance
 from .walls import WallProof, hangs_from
 
@@ -50,7 +50,7 @@ class OperationGuard(ClearanceGuard):
                  reach: float | None = None, own_tol: float = DEFAULT.gouge):
         super().__init__(part, pair, offset, shank, tol, reach, own_tol)
         self._cells = {k: shared(HeightCells, part.face(k)) for k in self.pair
-                       if self._own_rule[k] and part.face(k).kind in BOUNDED_KINDS}
+                       if self._own_rule[k] and bounded(part.face(k))}
         self._trees: dict = {}
         self._walls: dict = {}
         self.proven_calls = 0
@@ -78,7 +78,7 @@ class OperationGuard(ClearanceGuard):
     def _segment_distance(self, k: int, p, length: float | None = None):
         """As ClearanceGuard's, with a third face's box tree between its closed forms
         (first: exact and cheaper) and OCCT's distance."""
-        if k not in self.pair and self._faces[k - 1].kind in BOUNDED_KINDS:
+        if k not in self.pair and bounded(self._faces[k - 1]):
             d = self._closed_segment_distance(k, p, self.shank if length is None else length)
             if d is not None:
                 return d, False
