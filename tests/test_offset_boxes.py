@@ -92,7 +92,8 @@ def test_offset_cells_never_clear_a_hit(offset_boss):
         p = (r * np.cos(t), r * np.sin(t), z)
         if cells.budget(p) >= 0.0:
             proven += 1
-            d_seg, _ = exact._segment_distance(4, p)
-            assert d_seg - (exact._point_distance(4, p) - exact.tol) >= 0.0
+            d_p = exact._point_distance(4, p)
+            d_seg, _ = exact._segment_distance(4, p, None, d_p)
+            assert d_seg - (d_p - exact.tol) >= 0.0
         assert (fast.margin(p)[0] >= 0.0) == (exact.margin(p)[0] >= 0.0)
     assert proven >= 4

@@ -75,7 +75,8 @@ class OperationGuard(ClearanceGuard):
                 return 0.0, "tool"
         return super()._exact(k, p)
 
-    def _segment_distance(self, k: int, p, length: float | None = None):
+    def _segment_distance(self, k: int, p, length: float | None = None,
+                          cap: float | None = None):
         """As ClearanceGuard's, with a third face's box tree between its closed forms
         (first: exact and cheaper) and OCCT's distance."""
         if k not in self.pair and bounded(self._faces[k - 1]):
@@ -89,7 +90,7 @@ class OperationGuard(ClearanceGuard):
             if lb is not None:
                 self.proven_calls += 1
                 return lb, False
-        return super()._segment_distance(k, p, length)
+        return super()._segment_distance(k, p, length, cap)
 
     def _own_bound(self, k: int, p) -> float | None:
         m = super()._own_bound(k, p)
