@@ -53,11 +53,13 @@ class Report:
         self.imports = 0.0
         self.occt: dict[str, list] = {}      # "module:class @ stage": [calls, seconds]
         self.slow: list[tuple] = []          # (seconds, where, detail)
+        self.callers: dict[str, list] = {}   # "function face K kind": [calls, seconds]
         self.stack: list[str] = []
         self._importing = 0
 
     def as_dict(self) -> dict:
-        return dict(stages=self.stages, imports=self.imports, occt=self.occt,
+        top = sorted(self.callers.items(), key=lambda kv: -kv[1][1])[:12]
+        return dict(stages=self.stages, imports=self.imports, occt=self.occt, callers=dict(top),
                     slow=sorted(self.slow, reverse=True)[:MAX_SLOW], slow_count=len(self.slow),
                     slow_seconds=sum(s[0] for s in self.slow))
 
@@ -92,8 +94,12 @@ def _occt(module: str, cls_name: str, cls):
                                      [0, 0.0])
         rec[0] += 1
         rec[1] += dt
+        who = _caller()
+        rec = REPORT.callers.setdefault(who, [0, 0.0])
+        rec[0] += 1
+        rec[1] += dt
         if dt > SLOW_S:
-            REPORT.slow.append((dt, where, _caller()))
+            REPORT.slow.append((dt, where, who))
         return out
     return timed
 

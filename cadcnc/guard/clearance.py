@@ -189,18 +189,22 @@ class ClearanceGuard:
         distance (a lower bound: the margin stays >= 0); else OCCT's, of the segment
         clipped to the face box's heights widened by ``cap`` (default R'): a point of
         the segment further than ``cap`` above or below the box is further than ``cap``
-        from the face, so the distance is exact when it is at most ``cap``, and ``cap`` (a
-        lower bound) otherwise. The own-face rule passes cap = d(p, face), which the
-        segment's own foot p reaches: exact there."""
+        (its box distance, ``cut``) from the face, so the distance is exact when it is at
+        most ``cut``, and ``cut`` (a lower bound) otherwise. The own-face rule passes cap =
+        d(p, face), which the segment's own foot p reaches: exact there."""
         length = self.shank if length is None else length
         d = self._closed_segment_distance(k, p, length)
         if d is not None:
             return d, False
         cap = self.offset if cap is None else cap
-        z0, z1 = max(p[2], self._lo[k - 1][2] - cap), min(p[2] + length, self._hi[k - 1][2] + cap)
-        clipped = z0 > p[2] or z1 < p[2] + length
+        lo, hi = self._lo[k - 1], self._hi[k - 1]
+        z0, z1 = max(p[2], lo[2] - cap), min(p[2] + length, hi[2] + cap)
+        # the part cut off is at least cap from the box's heights: its box distance
+        cut = math.hypot(cap, math.hypot(max(lo[0] - p[0], p[0] - hi[0], 0.0),
+                                         max(lo[1] - p[1], p[1] - hi[1], 0.0))) \
+            if z0 > p[2] or z1 < p[2] + length else math.inf
         if z1 < z0:   # the whole segment is further than cap from the face
-            return cap, False
+            return cut, False
         self.exact_calls += 1
         face = self._faces[k - 1].topods
         if self._analytic[k - 1].kind == "plane" and k not in self.pair:
@@ -216,8 +220,8 @@ class ClearanceGuard:
         ext = BRepExtrema_DistShapeShape(shape, face)
         if not ext.IsDone() or ext.NbSolution() == 0:
             return -math.inf, False  # fail closed: an unknown distance is a hit
-        if clipped and ext.Value() > cap:
-            return cap, False
+        if ext.Value() > cut:
+            return cut, False
         own = all(ext.SupportTypeShape2(n) != BRepExtrema_IsInFace
                   and self._own_shapes.Contains(ext.SupportOnShape2(n))
                   for n in range(1, ext.NbSolution() + 1))
