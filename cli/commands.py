@@ -105,6 +105,8 @@ def _output_names(requested, entries) -> dict[str, list[str]]:
 def _stream(args, checked, source: str) -> int:
     """Print each period's increment. Each path is computed and gated first (partial,
     gouge), then streamed from a fresh stepper: nothing unchecked reaches the axes."""
+    from cadcnc import apt  # noqa: PLC0415 - as in run
+
     write, status = sys.stdout.write, 0
     for entry, part in checked:
         tp = apt.run_job(entry, part, None, source)

@@ -32,7 +32,7 @@ def test_clipped_distance_is_exact_below_cap(face, cap):
         whole = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeEdge(
             gp_Pnt(*p), gp_Pnt(p[0], p[1], p[2] + g.shank)).Edge(),
             part.face(face).topods).Value()
-        limit = g.offset if cap is None else cap
+        limit = g.offset + g.reach if cap is None else cap
         if whole <= limit:
             assert abs(d - whole) <= 1e-7
             exact += 1

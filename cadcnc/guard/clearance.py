@@ -187,7 +187,9 @@ class ClearanceGuard:
         closed form for an analytic face whose foot is inside it (then not on an edge);
         for a third face whose distance to its whole surface already clears R' - tol, that
         distance (a lower bound: the margin stays >= 0); else OCCT's, of the segment
-        clipped to the face box's heights widened by ``cap`` (default R'): a point of
+        clipped to the face box's heights widened by ``cap`` (default R' + reach: a
+        larger distance is only ever compared with R' - tol, or cached for moves shorter
+        than reach, after which the broad phase runs again): a point of
         the segment further than ``cap`` above or below the box is further than ``cap``
         (its box distance, ``cut``) from the face, so the distance is exact when it is at
         most ``cut``, and ``cut`` (a lower bound) otherwise. The own-face rule passes cap =
@@ -196,7 +198,7 @@ class ClearanceGuard:
         d = self._closed_segment_distance(k, p, length)
         if d is not None:
             return d, False
-        cap = self.offset if cap is None else cap
+        cap = self.offset + self.reach if cap is None else cap
         lo, hi = self._lo[k - 1], self._hi[k - 1]
         z0, z1 = max(p[2], lo[2] - cap), min(p[2] + length, hi[2] + cap)
         # the part cut off is at least cap from the box's heights: its box distance
