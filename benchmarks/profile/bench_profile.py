@@ -10,7 +10,7 @@ Cases (``--part`` and ``--radius`` change a case's part and ball radius):
   4 and 5, R 2;
 - ``pencil``: ``cadcnc pencil`` on a real part with B-spline faces and edges
   (``../shared/parts/bug32596_abc_0_13.step``, 99 faces), R 3;
-- ``setups``: ``cadcnc pencil --setups auto`` (``../shared/parts/bm2_ec_lever-A.stp``), R 3.
+- ``setups``: ``cadcnc pencil --setups auto`` on the same part, R 3 (six candidate axes).
 
 ``--base DIR``: a checkout of the previous code (``git worktree add DIR COMMIT``); every
 case is then run alternately with it and with this tree, ``--rounds`` times each, and
@@ -33,7 +33,7 @@ PARTS = ROOT.parent / "shared" / "parts"
 CASES = {   # name: (command, default part, extra options, radius)
     "corner": ("path", "offset_boss", ["--faces", "4", "5"], "2"),
     "pencil": ("pencil", str(PARTS / "bug32596_abc_0_13.step"), [], "3"),
-    "setups": ("pencil", str(PARTS / "bm2_ec_lever-A.stp"), ["--setups", "auto"], "3"),
+    "setups": ("pencil", str(PARTS / "bug32596_abc_0_13.step"), ["--setups", "auto"], "3"),
 }
 OFFSET_MM = 1.0
 
