@@ -200,10 +200,7 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
 
 def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_periods, quiet):
     """The stream, its periods estimated and bounded before the positions are computed,
-    progress reported (the planner's own ``max_periods`` and ``progress`` when it has
-    them; else the plan is made once more here to count the periods)."""
-    import inspect
-
+    progress reported (the plan is made once here to count the periods first)."""
     from cadcnc.controller.stream import stream_program
     from cadcnc.work import refuse_over
 
@@ -212,27 +209,23 @@ def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_peri
     def estimate(total: int) -> None:
         refuse_over("the stream", total, max_periods, "servo periods",
                     "raise the feed or the machine's limits, or give --max-periods N "
-                    f"(each 24 bytes in memory)")
+                    "(each 24 bytes in memory)")
         if not quiet and not said:
             say_error(f"cadcnc: stream: {total} periods of {machine.period * 1e3:g} ms "
                       f"(cycle {total * machine.period:.3f} s) to compute")
         said.append(total)
         tick.stage = f"streaming {total} periods"
 
-    kw = {"feed": feed, "planned": planned}
-    if "max_periods" in inspect.signature(stream_program).parameters:
-        def progress(done: int, total: int) -> None:
-            if not said:
-                estimate(total)
-            tick.stage = f"streaming: {done}/{total} periods"
-
-        return stream_program(program, machine, steppers, max_periods=max_periods,
-                              progress=progress, **kw)
     from cadcnc.controller.feed_plan import plan_feed
     from cadcnc.controller.pieces import pieces_of
 
     estimate(plan_feed(pieces_of(program, machine, feed), machine, planned).periods)
-    return stream_program(program, machine, steppers, **kw)
+
+    def progress(done: int, total: int) -> None:
+        tick.stage = f"streaming: {done}/{total} periods"
+
+    return stream_program(program, machine, steppers, feed=feed, planned=planned,
+                          max_periods=max_periods, progress=progress)
 
 
 def _contents(positions, outputs) -> dict:

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ..errors import InputError
+from ..errors import EXIT_GOUGE, CadcncError, InputError
 from . import topp
 from .machine import Machine
 from .pieces import Piece, constant_speed
@@ -51,8 +51,11 @@ FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
 MAX_PERIODS = 50_000_000
 
 
-class PlanError(InputError):
-    """The machine's limits admit no plan of this program (names the run and the limit)."""
+class PlanError(CadcncError):
+    """No stream within the machine's limits: nothing is written (names the run or the
+    period and the limit; exit 5, as any stream over the limits)."""
+
+    exit_code = EXIT_GOUGE
 
 
 @dataclass

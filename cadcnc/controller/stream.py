@@ -189,7 +189,8 @@ def _refusal(over: list[tuple[float, int, int]], machine: Machine) -> PlanError:
     q = max(range(3), key=lambda i: over[i][0])
     share, row, axis = over[q]
     return PlanError(
-        f"the planned stream would reach {100 * share:.1f} % of axis {AXES[axis]}'s "
+        "the stream is over the machine's limits: nothing written: it would reach "
+        f"{100 * share:.1f} % of axis {AXES[axis]}'s "
         f"{names[q]} limit at period {row} (the positions' own noise at a "
         f"{machine.period * 1e6:g} us period, or limits the path cannot meet): refused; "
         "a longer servo period or a lower jerk limit may stream")
@@ -205,7 +206,7 @@ def _cut_rows(stepper, piece: Piece, s: np.ndarray, what: str, done: int, total:
         out[a:b] = follow(stepper, plan[a:b], piece.points[-1], float(piece.kappa[-1]),
                           LANDING)
         if progress is not None:
-            progress(done + b, total)
+            progress(min(done + b, total), total)
     return _landed(stepper, piece, out, what)
 
 
@@ -243,8 +244,8 @@ def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
     """One plan (limits scaled by ``derate``) and its positions."""
     plan = plan_feed(pieces, machine, planned, tuple(derate))
     rows, s = plan.targets(max_periods)
-    total = len(s)
-    positions = np.empty((total, 3))
+    total = len(s) - 1   # periods: the rows after the start
+    positions = np.empty((len(s), 3))
     cuts = program.cuts
     kernel = hermite = 0
     for j, piece in enumerate(pieces):
