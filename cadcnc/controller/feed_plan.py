@@ -14,7 +14,7 @@ from rest to rest:
 1. the speed limits: the feed, V_i / |T_i|, the jerk's D_i v^3 term (D_SHARE of J_i), and
    the one-period jolt of a curvature jump or a join (``runs.JOIN_SHARE``);
 2. the time-optimal profile under the acceleration limits (:func:`.topp.passes`), with
-   the jerk's Coriolis term 3 K_i v s'' within CORIOLIS_SHARE of J_i;
+   the jerk's Coriolis term 3 K_i v s'' within a share of J_i (CORIOLIS_SHARES);
 3. that s(t) averaged over a moving window W: its jerk T_i (s''(t) - s''(t - W)) / W,
    W the shortest that leaves every axis the room the curvature terms do not take
    (:func:`.topp.window_needed`; about A / J on a straight run, once per rest);
@@ -44,10 +44,13 @@ MARGIN = 0.995
 """Share of every limit the plan uses; the rest covers the path's derivatives between the
 kernel's points, the averaged squared speed (v² of the mean is at most the mean of v²)
 and the kernel's step landing within a few nm of the plan."""
-CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most
+CORIOLIS_SHARES = (0.25, 0.5, 0.75)   # of J_i: 3 K_i v s'' at most, the fastest kept
+CURVED = 1e-3           # a run turning less (max |K| times its length, rad) is straight
 D_SHARE = 0.25          # of J_i: D_i v^3 at most
 WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window grown
 FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
+TIGHTEN_ROUNDS = 4      # plans with the derivatives taken where the motion goes
+TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened this much
 MAX_PERIODS = 50_000_000
 
 
@@ -89,30 +92,10 @@ class Profile:
 
 
 @njit(cache=True, error_model="numpy")
-def _integral(t, s, v, a, S, tau: float) -> float:
-    """S(tau) = integral of s from 0 to tau (s = 0 before 0, L after the end)."""
-    if tau <= 0.0:
-        return 0.0
-    end = t[-1]
-    k = min(max(np.searchsorted(t, tau, side="right") - 1, 0), len(t) - 2)
-    x = min(tau, end) - t[k]
-    return (S[k] + s[k] * x + v[k] * x * x / 2.0 + a[k] * x ** 3 / 6.0
-            + s[-1] * max(tau - end, 0.0))
-
-
-@njit(cache=True, error_model="numpy")
 def _positions(t, s, v, a, S, window: float, tau, out) -> None:
     """Profile.position into ``out``: s(t) averaged over ``window`` (or s(t) if 0)."""
-    L = s[-1]
     for i in range(len(tau)):
-        if window > 0.0:
-            x = (_integral(t, s, v, a, S, tau[i])
-                 - _integral(t, s, v, a, S, tau[i] - window)) / window
-        else:
-            k = min(max(np.searchsorted(t, tau[i], side="right") - 1, 0), len(t) - 2)
-            y = min(max(tau[i], 0.0), t[-1]) - t[k]
-            x = s[k] + v[k] * y + a[k] * y * y / 2.0
-        out[i] = min(max(x, 0.0), L)
+        out[i] = topp.averaged(t, s, v, a, S, window, tau[i])
 
 
 def _limits(machine: Machine, derate=(1.0, 1.0, 1.0)):
@@ -134,39 +117,71 @@ def _speed_limits(run: Run, V, J, period: float) -> np.ndarray:
     return np.nan_to_num(np.min(terms, axis=0), nan=math.inf, posinf=math.inf)
 
 
-def _plan_once(run: Run, wl: np.ndarray, V, A, J, period: float, window: float):
-    """One plan of the run with averaging ``window``: t, w, u, v, a, S and per knot the
-    window needed."""
+def _plan_once(run: Run, wl: np.ndarray, V, A, J, period: float, window: float,
+               coriolis: float, reach=None):
+    """One plan of the run with averaging ``window`` and the Coriolis term's share
+    ``coriolis`` of J, the path's derivatives taken over ``reach`` ((lo, hi) (n,) arc
+    lengths around each point; None: +- the top speed times the window): t, w, u, v, a,
+    S and per knot the window needed."""
     s = run.s
     wl_e = topp.erode(s, wl, window)
     top = float(np.sqrt(np.max(wl_e[np.isfinite(wl_e)], initial=0.0)))
-    reach = top * window
-    t_lo, t_hi = topp.boxes(s, run.T, reach)
-    k_lo, k_hi = topp.boxes(s, run.K, reach)
+    if reach is None:
+        reach = (s - top * window, s + top * window)
+    t_lo, t_hi = topp.boxes(s, run.T, *reach)
+    k_lo, k_hi = topp.boxes(s, run.K, *reach)
     Tc, Tr = 0.5 * (t_lo + t_hi), 0.5 * (t_hi - t_lo)
     Kc, Kr = 0.5 * (k_lo + k_hi), 0.5 * (k_hi - k_lo)
     Kmax = np.maximum(np.abs(k_lo), np.abs(k_hi))
-    C = CORIOLIS_SHARE * J
+    C = coriolis * J
     w, u = topp.passes(s, wl_e, Tc, Tr, Kc, Kr, Kmax, A, C)
     t, v, a, S = topp.time_law(s, w, u)
+    cap = np.minimum(wl_e, top * top)[:, None]
     with np.errstate(invalid="ignore", over="ignore"):
-        static = (run.D * np.minimum(wl_e, top * top)[:, None] ** 1.5
-                  + run.jump * np.minimum(wl_e, top * top)[:, None] / period
-                  + run.kink * np.sqrt(np.minimum(wl_e, top * top))[:, None] / period ** 2)
-    static = topp.boxes(s, np.nan_to_num(static, nan=0.0), reach)[1]
+        static = (run.D * cap ** 1.5 + run.jump * cap / period
+                  + run.kink * np.sqrt(cap) / period ** 2)
+    static = topp.boxes(s, np.nan_to_num(static, nan=0.0), *reach)[1]
     Tabs = np.maximum(np.abs(t_lo), np.abs(t_hi))
     need = topp.window_needed(t, v, a, Tabs, Kmax, static, J, C, window)
     return t, w, u, v, a, S, need
 
 
-def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
-    """The jerk-limited, near time-optimal profile of one run (see the module doc);
-    ``derate`` (3,) scales the velocity, acceleration and jerk used."""
-    V, A, J = _limits(machine, derate)
+def _tightened(run: Run, wl, limits, period: float, window: float, coriolis: float, first):
+    """The plan again with the derivatives taken only where the averaged motion goes
+    (the first plan assumed the top speed everywhere); kept if its own ranges lie within
+    the ranges it assumed and its window suffices, else ``first`` (sound as it is)."""
+    V, A, J = limits
+    s = run.s
+    lo, hi = topp.ranges(first[0], s, first[3], first[4], first[5], window)
+    for _ in range(TIGHTEN_ROUNDS):
+        grow = TIGHTEN_SLACK * (hi - lo)
+        assumed = (lo - grow, hi + grow)
+        plan = _plan_once(run, wl, V, A, J, period, window, coriolis, assumed)
+        if float(np.max(plan[6], initial=0.0)) > window:
+            return first
+        lo2, hi2 = topp.ranges(plan[0], s, plan[3], plan[4], plan[5], window)
+        if (lo2 >= assumed[0]).all() and (hi2 <= assumed[1]).all():
+            return plan
+        lo, hi = np.minimum(lo, lo2), np.maximum(hi, hi2)
+    return first
+
+
+def _first_window(run: Run, A, J) -> float:
+    """The averaging window a change of the tangential acceleration by A_i / |T_i| needs
+    on the axes the run moves (s): A_i / J_i at most; the plan lengthens it if needed."""
+    t = np.max(np.abs(run.T), axis=0)
+    return float(np.max(np.where(t > 0.0, A / J, 0.0), initial=0.0)) or float(np.min(A / J))
+
+
+def _plan_share(run: Run, machine: Machine, limits, coriolis: float) -> Profile:
+    """The run's profile with the Coriolis term's share ``coriolis`` (see the module
+    doc): turns flattened, or the window grown, until the window is long enough."""
+    V, A, J = limits
     wl = _speed_limits(run, V, J, machine.period)
-    window = float(np.max(A / J))
+    window = _first_window(run, A, J)
     for round_ in range(WINDOW_ROUNDS):
-        t, w, u, v, a, S, need = _plan_once(run, wl, V, A, J, machine.period, window)
+        plan = _plan_once(run, wl, V, A, J, machine.period, window, coriolis)
+        t, w, u, v, a, S, need = plan
         top = float(np.max(need, initial=0.0))
         if top <= window:
             break
@@ -180,8 +195,30 @@ def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
     else:
         raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: no "
                         f"averaging window keeps the jerk within {machine.summary()}")
+    t, w, u, v, a, S, need = _tightened(run, wl, limits, machine.period, window, coriolis,
+                                        plan)
     keep = np.r_[np.diff(run.s) > 0.0, True]
     return Profile(t[keep], run.s[keep], v[keep], a[keep], S[keep], window)
+
+
+def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
+    """The jerk-limited, near time-optimal profile of one run (see the module doc);
+    ``derate`` (3,) scales the velocity, acceleration and jerk used. A curved run is
+    planned with each of CORIOLIS_SHARES and the fastest kept."""
+    limits = _limits(machine, derate)
+    curved = float(np.max(np.abs(run.K), initial=0.0)) * run.length > CURVED
+    best, error = None, None
+    for share in CORIOLIS_SHARES if curved else CORIOLIS_SHARES[:1]:
+        try:
+            profile = _plan_share(run, machine, limits, share)
+        except PlanError as e:
+            error = error or e
+            continue
+        if best is None or profile.duration < best.duration:
+            best = profile
+    if best is None:
+        raise error
+    return best
 
 
 def _constant_run(first: int, piece: Piece, machine: Machine) -> tuple[Run, Profile]:

@@ -28,7 +28,9 @@ from .pieces import Piece
 LINE_KNOT = 0.25       # mm: the largest knot of a straight move (the plan's resolution)
 LINE_KNOTS_MAX = 4000  # knots of one straight move at most
 MIN_KNOT = 1e-4        # mm: the shortest knot of a cut's grid
-STOP_SPEED = 1.0       # mm/s: a join slower than this is a stop at rest (a corner)
+STOP_SPEED = 10.0      # mm/s: a join slower than this is a stop at rest (a corner, or a
+                       # curvature jump that lets the feed through at a crawl)
+STOP_SHARE = 0.5       # ... or slower than this share of the fastest the axes allow there
 JOIN_SHARE = 0.25
 """Share of an axis's jerk (and acceleration) that the one-period jolt of a join or a
 curvature jump may take; the rest stays with the smooth motion around it."""
@@ -78,8 +80,9 @@ def end_derivatives(piece: Piece, end: bool) -> tuple[np.ndarray, np.ndarray]:
 
 def join_speed(before: Piece, after: Piece, machine: Machine) -> tuple[float, np.ndarray,
                                                                        np.ndarray]:
-    """The fastest pass through the join of two pieces (mm/s; 0: a corner) and the jumps
-    of the unit tangent and of p'' there ((3,) each).
+    """The fastest pass through the join of two pieces (mm/s; 0: a stop, at a corner or
+    where the pass would crawl) and the jumps of the unit tangent and of p'' there ((3,)
+    each).
 
     In sampled time a tangent jump dt at speed v changes an axis's velocity by v |dt_i|
     within one period: acceleration v |dt_i| / Ts and jerk v |dt_i| / Ts²; a jump dK of
@@ -93,8 +96,10 @@ def join_speed(before: Piece, after: Piece, machine: Machine) -> tuple[float, np
     with np.errstate(divide="ignore"):
         v = np.min(JOIN_SHARE * np.minimum(A * ts, J * ts * ts) / np.abs(dt))
         v = min(v, float(np.min(np.sqrt(JOIN_SHARE * J * ts / np.abs(dk)))))
-    v = min(v, before.cap, after.cap)
-    return (0.0 if v < STOP_SPEED else float(v)), dt, dk
+    top = min(before.cap, after.cap, float(np.min(np.asarray(machine.max_velocity)
+                                                  / np.maximum(np.abs(t0), np.abs(t1)))))
+    v = min(v, top)
+    return (0.0 if v < max(STOP_SPEED, STOP_SHARE * top) else float(v)), dt, dk
 
 
 def _line_grid(piece: Piece) -> np.ndarray:

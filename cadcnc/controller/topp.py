@@ -122,23 +122,62 @@ def erode(s, wl, window: float):
 
 
 @njit(cache=True, error_model="numpy")
-def boxes(s, x, reach: float):
-    """(lo, hi) (n, 3): the smallest and largest x over s_k +- reach."""
+def boxes(s, x, lo_s, hi_s):
+    """(lo, hi) (n, 3): the smallest and largest x over s in [lo_s[k], hi_s[k]] (each
+    range holding s[k])."""
     n = len(s)
     lo, hi = x.copy(), x.copy()
-    a = 0
-    b = 0
     for k in range(n):
-        while s[k] - s[a] > reach:
-            a += 1
-        while b + 1 < n and s[b + 1] - s[k] <= reach:
-            b += 1
-        for i in range(3):
-            mn, mx = x[a, i], x[a, i]
-            for j in range(a + 1, b + 1):
-                mn = min(mn, x[j, i])
-                mx = max(mx, x[j, i])
-            lo[k, i], hi[k, i] = mn, mx
+        j = k - 1
+        while j >= 0 and s[j] >= lo_s[k]:
+            for i in range(3):
+                lo[k, i] = min(lo[k, i], x[j, i])
+                hi[k, i] = max(hi[k, i], x[j, i])
+            j -= 1
+        j = k + 1
+        while j < n and s[j] <= hi_s[k]:
+            for i in range(3):
+                lo[k, i] = min(lo[k, i], x[j, i])
+                hi[k, i] = max(hi[k, i], x[j, i])
+            j += 1
+    return lo, hi
+
+
+@njit(cache=True, error_model="numpy")
+def _integral(t, s, v, a, S, tau: float) -> float:
+    """The time integral of s(t) from 0 to tau (s = 0 before 0, s[-1] after the end)."""
+    if tau <= 0.0:
+        return 0.0
+    n = len(t)
+    end = t[n - 1]
+    k = min(max(np.searchsorted(t, tau, side="right") - 1, 0), n - 2)
+    x = min(tau, end) - t[k]
+    return (S[k] + s[k] * x + v[k] * x * x / 2.0 + a[k] * x ** 3 / 6.0
+            + s[n - 1] * max(tau - end, 0.0))
+
+
+@njit(cache=True, error_model="numpy")
+def averaged(t, s, v, a, S, window: float, tau: float) -> float:
+    """s(t) averaged over the ``window`` s before ``tau`` (s(tau) itself if window 0)."""
+    if window <= 0.0:
+        n = len(t)
+        k = min(max(np.searchsorted(t, tau, side="right") - 1, 0), n - 2)
+        y = min(max(tau, 0.0), t[n - 1]) - t[k]
+        return min(max(s[k] + v[k] * y + a[k] * y * y / 2.0, 0.0), s[n - 1])
+    x = (_integral(t, s, v, a, S, tau) - _integral(t, s, v, a, S, tau - window)) / window
+    return min(max(x, 0.0), s[len(s) - 1])
+
+
+@njit(cache=True, error_model="numpy")
+def ranges(t, s, v, a, S, window: float):
+    """(lo, hi) (n,): where the averaged motion is while grid point k is in its window,
+    s_f(t_k) .. s_f(t_k + window): every place whose path derivatives meet this point's
+    speed and acceleration."""
+    n = len(t)
+    lo, hi = np.empty(n), np.empty(n)
+    for k in range(n):
+        lo[k] = min(averaged(t, s, v, a, S, window, t[k]), s[k])
+        hi[k] = max(averaged(t, s, v, a, S, window, t[k] + window), s[k])
     return lo, hi
 
 
