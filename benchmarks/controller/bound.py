@@ -68,8 +68,8 @@ def stretches(program, feed_mm_min: float) -> list[list[tuple[np.ndarray, float]
     return groups
 
 
-def stretch_time(group, machine) -> float:
-    """Seconds of one stretch from rest to rest (TOPP-RA, v and a at 100 %)."""
+def _instance(group, machine):
+    """TOPP-RA's problem for one stretch from rest to rest, v and a at 100 %."""
     import toppra as ta
     import toppra.algorithm as algo
     import toppra.constraint as constraint
@@ -106,12 +106,33 @@ def stretch_time(group, machine) -> float:
     path = ta.SplineInterpolator(s, np.c_[x, s])
     acc = constraint.JointAccelerationConstraint(np.vstack([np.c_[-A, A], [[-1e8, 1e8]]]))
     n = int(min(max(L / GRID, 50), 20000))
-    inst = algo.TOPPRA([constraint.JointVelocityConstraintVarying(limits), acc], path,
+    return algo.TOPPRA([constraint.JointVelocityConstraintVarying(limits), acc], path,
                        gridpoints=np.linspace(0, L, n + 1), parametrizer="ParametrizeConstAccel")
-    traj = inst.compute_trajectory(0, 0)
+
+
+def stretch_time(group, machine) -> float:
+    """Seconds of one stretch from rest to rest (TOPP-RA, v and a at 100 %)."""
+    traj = _instance(group, machine).compute_trajectory(0, 0)
     if traj is None:
         raise RuntimeError("TOPP-RA found no profile for a stretch")
     return float(traj.duration)
+
+
+def bound_feed(program, machine, feed_mm_min: float | None = None):
+    """(s, v): the bound's speed (mm/s) against arc length along the whole program (mm),
+    on TOPP-RA's grid points, stretch after stretch."""
+    feed = program.job.feed if feed_mm_min is None else feed_mm_min
+    out_s, out_v, at = [], [], 0.0
+    for g in stretches(program, feed):
+        inst = _instance(g, machine)
+        sd = inst.compute_parameterization(0, 0)[1]
+        if sd is None:
+            raise RuntimeError("TOPP-RA found no profile for a stretch")
+        grid = np.asarray(inst.problem_data.gridpoints)
+        out_s.append(at + grid)
+        out_v.append(np.asarray(sd))
+        at += float(grid[-1])
+    return np.concatenate(out_s), np.concatenate(out_v)
 
 
 def va_bound(program, machine, feed_mm_min: float | None = None) -> float:

@@ -14,7 +14,7 @@ from rest to rest:
 1. the speed limits: the feed, V_i / |T_i|, the jerk's D_i v^3 term (D_SHARE of J_i), and
    the one-period jolt of a curvature jump or a join (``runs.JOIN_SHARE``);
 2. the time-optimal profile under the acceleration limits (:func:`.topp.passes`), with
-   the jerk's Coriolis term 3 K_i v s'' within a share of J_i (CORIOLIS_SHARES);
+   the jerk's Coriolis term 3 K_i v s'' within CORIOLIS_SHARE of J_i;
 3. that s(t) averaged over a moving window W: its jerk T_i (s''(t) - s''(t - W)) / W,
    W the shortest that leaves every axis the room the curvature terms do not take
    (:func:`.topp.window_needed`; about A / J on a straight run, once per rest);
@@ -44,12 +44,12 @@ MARGIN = 0.995
 """Share of every limit the plan uses; the rest covers the path's derivatives between the
 kernel's points, the averaged squared speed (v² of the mean is at most the mean of v²)
 and the kernel's step landing within a few nm of the plan."""
-CORIOLIS_SHARES = (0.25, 0.5, 0.75)   # of J_i: 3 K_i v s'' at most, the fastest kept
-CURVED = 1e-3           # a run turning less (max |K| times its length, rad) is straight
+CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most (0.5 and 0.75 were slower or equal
+                        # on every run of the three programs: the window grows instead)
 D_SHARE = 0.25          # of J_i: D_i v^3 at most
 WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window grown
 FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
-TIGHTEN_ROUNDS = 4      # plans with the derivatives taken where the motion goes
+TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
 TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened this much
 MAX_PERIODS = 50_000_000
 
@@ -179,13 +179,16 @@ def _plan_share(run: Run, machine: Machine, limits, coriolis: float) -> Profile:
     V, A, J = limits
     wl = _speed_limits(run, V, J, machine.period)
     window = _first_window(run, A, J)
+    flattening, last = True, math.inf
     for round_ in range(WINDOW_ROUNDS):
         plan = _plan_once(run, wl, V, A, J, machine.period, window, coriolis)
         t, w, u, v, a, S, need = plan
         top = float(np.max(need, initial=0.0))
         if top <= window:
             break
-        if round_ < FLATTEN_ROUNDS and topp.flatten(run.s, t, w, u, wl, need, window):
+        flattening = flattening and round_ < FLATTEN_ROUNDS and top < last   # progress
+        last = top
+        if flattening and topp.flatten(run.s, t, w, u, wl, need, window):
             continue
         if not math.isfinite(top):
             raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: the "
@@ -195,30 +198,17 @@ def _plan_share(run: Run, machine: Machine, limits, coriolis: float) -> Profile:
     else:
         raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: no "
                         f"averaging window keeps the jerk within {machine.summary()}")
-    t, w, u, v, a, S, need = _tightened(run, wl, limits, machine.period, window, coriolis,
-                                        plan)
+    if run.curved:   # (a straight run's derivatives are the same everywhere)
+        plan = _tightened(run, wl, limits, machine.period, window, coriolis, plan)
+    t, w, u, v, a, S, need = plan
     keep = np.r_[np.diff(run.s) > 0.0, True]
     return Profile(t[keep], run.s[keep], v[keep], a[keep], S[keep], window)
 
 
 def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
     """The jerk-limited, near time-optimal profile of one run (see the module doc);
-    ``derate`` (3,) scales the velocity, acceleration and jerk used. A curved run is
-    planned with each of CORIOLIS_SHARES and the fastest kept."""
-    limits = _limits(machine, derate)
-    curved = float(np.max(np.abs(run.K), initial=0.0)) * run.length > CURVED
-    best, error = None, None
-    for share in CORIOLIS_SHARES if curved else CORIOLIS_SHARES[:1]:
-        try:
-            profile = _plan_share(run, machine, limits, share)
-        except PlanError as e:
-            error = error or e
-            continue
-        if best is None or profile.duration < best.duration:
-            best = profile
-    if best is None:
-        raise error
-    return best
+    ``derate`` (3,) scales the velocity, acceleration and jerk used."""
+    return _plan_share(run, machine, _limits(machine, derate), CORIOLIS_SHARE)
 
 
 def _constant_run(first: int, piece: Piece, machine: Machine) -> tuple[Run, Profile]:

@@ -56,6 +56,12 @@ class Run:
     def length(self) -> float:
         return float(self.offsets[-1])
 
+    @property
+    def curved(self) -> bool:
+        """Whether the path's derivatives change along the run (curvature, jumps, joins)."""
+        return bool(np.any(self.K) or np.any(self.jump) or np.any(self.kink)
+                    or np.ptp(self.T, axis=0).max() > 0.0)
+
 
 def _lagrange(p: np.ndarray, s: np.ndarray, at: int) -> tuple[np.ndarray, np.ndarray]:
     """p' and p'' at point ``at`` (0 or 2) of the parabola through 3 points (3, 3)."""
@@ -96,8 +102,9 @@ def join_speed(before: Piece, after: Piece, machine: Machine) -> tuple[float, np
     with np.errstate(divide="ignore"):
         v = np.min(JOIN_SHARE * np.minimum(A * ts, J * ts * ts) / np.abs(dt))
         v = min(v, float(np.min(np.sqrt(JOIN_SHARE * J * ts / np.abs(dk)))))
-    top = min(before.cap, after.cap, float(np.min(np.asarray(machine.max_velocity)
-                                                  / np.maximum(np.abs(t0), np.abs(t1)))))
+    with np.errstate(divide="ignore"):
+        axes = np.asarray(machine.max_velocity) / np.maximum(np.abs(t0), np.abs(t1))
+    top = min(before.cap, after.cap, float(np.min(axes)))
     v = min(v, top)
     return (0.0 if v < max(STOP_SPEED, STOP_SHARE * top) else float(v)), dt, dk
 

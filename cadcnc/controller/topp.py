@@ -23,13 +23,14 @@ import math
 import numpy as np
 from numba import njit
 
-BISECTIONS = 48   # the top of a point's feasible speeds to 2^-48 of its limit
+BISECTIONS = 40   # the top of a point's feasible speeds to 2^-40 of its bracket
 
 
 @njit(cache=True, error_model="numpy")
-def _bounds(k: int, w: float, h: float, Tc, Tr, Kc, Kr, Kmax, A, C) -> tuple:
-    """(lo, hi): the tangential accelerations on knot k (length h > 0) feasible from w."""
-    lo, hi = -w / (2.0 * h), math.inf
+def _coefficients(k: int, h: float, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs) -> float:
+    """Knot k's acceleration constraints cu u + cw w <= rhs (24, into the buffers) for
+    the speed w at its start, and its Coriolis bound: |u| <= returned / sqrt(w)."""
+    n = 0
     for e in range(2):
         j = k + e
         reach = 2.0 * h if e == 1 else 0.0
@@ -37,26 +38,40 @@ def _bounds(k: int, w: float, h: float, Tc, Tr, Kc, Kr, Kmax, A, C) -> tuple:
             for s1 in (-1.0, 1.0):
                 kw = s1 * Kc[j, i] + Kr[j, i]
                 for s2 in (-1.0, 1.0):
-                    cu = s1 * Tc[j, i] + s2 * Tr[j, i] + kw * reach
-                    rhs = A[i] - kw * w
-                    if cu > 0.0:
-                        hi = min(hi, rhs / cu)
-                    elif cu < 0.0:
-                        lo = max(lo, rhs / cu)
-                    elif rhs < 0.0:
-                        return 1.0, -1.0
-    if w > 0.0:
-        for i in range(3):
-            km = max(Kmax[k, i], Kmax[k + 1, i])
-            if km > 0.0:
-                c = C[i] / (3.0 * km * math.sqrt(w))
-                lo, hi = max(lo, -c), min(hi, c)
+                    cu[n] = s1 * Tc[j, i] + s2 * Tr[j, i] + kw * reach
+                    cw[n] = kw
+                    rhs[n] = A[i]
+                    n += 1
+    c = math.inf
+    for i in range(3):
+        km = max(Kmax[k, i], Kmax[k + 1, i])
+        if km > 0.0:
+            c = min(c, C[i] / (3.0 * km))
+    return c
+
+
+@njit(cache=True, error_model="numpy")
+def _bounds(w: float, h: float, cu, cw, rhs, coriolis: float) -> tuple:
+    """(lo, hi): the tangential accelerations feasible from speed w on a knot of length
+    h > 0 with the constraints of :func:`_coefficients` (lo > hi: none)."""
+    lo, hi = -w / (2.0 * h), math.inf
+    for j in range(len(cu)):
+        r = rhs[j] - cw[j] * w
+        if cu[j] > 0.0:
+            hi = min(hi, r / cu[j])
+        elif cu[j] < 0.0:
+            lo = max(lo, r / cu[j])
+        elif r < 0.0:
+            return 1.0, -1.0
+    if w > 0.0 and coriolis < math.inf:
+        c = coriolis / math.sqrt(w)
+        lo, hi = max(lo, -c), min(hi, c)
     return lo, hi
 
 
 @njit(cache=True, error_model="numpy")
-def _feasible(k, w, h, w_next, Tc, Tr, Kc, Kr, Kmax, A, C) -> bool:
-    lo, hi = _bounds(k, w, h, Tc, Tr, Kc, Kr, Kmax, A, C)
+def _feasible(w, h, w_next, cu, cw, rhs, coriolis) -> bool:
+    lo, hi = _bounds(w, h, cu, cw, rhs, coriolis)
     return lo <= hi and w + 2.0 * h * lo <= w_next + 1e-12 * w   # (w - w: round-off)
 
 
@@ -65,6 +80,7 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
     """(w (n,), u (n - 1,)): the time-optimal squared speeds from rest at s[0] to rest at
     s[-1] and the accelerations between (knots of length 0, a join, keep the speed)."""
     n = len(s)
+    cu, cw, rhs = np.empty(24), np.empty(24), np.empty(24)
     wb = np.empty(n)
     wb[n - 1] = 0.0
     for k in range(n - 2, -1, -1):
@@ -73,13 +89,14 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
         if h <= 0.0:
             wb[k] = min(top, wb[k + 1])
             continue
-        if _feasible(k, top, h, wb[k + 1], Tc, Tr, Kc, Kr, Kmax, A, C):
+        cor = _coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
+        if _feasible(top, h, wb[k + 1], cu, cw, rhs, cor):
             wb[k] = top
             continue
-        a, b = 0.0, top
+        a, b = 0.0, min(top, wb[k + 1] + 2.0 * h * np.max(np.abs(A)) * 1e3)
         for _ in range(BISECTIONS):
             m = 0.5 * (a + b)
-            if _feasible(k, m, h, wb[k + 1], Tc, Tr, Kc, Kr, Kmax, A, C):
+            if _feasible(m, h, wb[k + 1], cu, cw, rhs, cor):
                 a = m
             else:
                 b = m
@@ -92,7 +109,8 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
         if h <= 0.0:
             w[k + 1] = min(w[k], wb[k + 1])
             continue
-        lo, hi = _bounds(k, w[k], h, Tc, Tr, Kc, Kr, Kmax, A, C)
+        cor = _coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
+        lo, hi = _bounds(w[k], h, cu, cw, rhs, cor)
         x = min(hi, (wb[k + 1] - w[k]) / (2.0 * h))
         x = max(x, lo)
         u[k] = x
@@ -124,22 +142,45 @@ def erode(s, wl, window: float):
 @njit(cache=True, error_model="numpy")
 def boxes(s, x, lo_s, hi_s):
     """(lo, hi) (n, 3): the smallest and largest x over s in [lo_s[k], hi_s[k]] (each
-    range holding s[k])."""
+    range holding s[k]; ranges widened to a monotone sequence, then a sliding window)."""
     n = len(s)
-    lo, hi = x.copy(), x.copy()
-    for k in range(n):
-        j = k - 1
-        while j >= 0 and s[j] >= lo_s[k]:
-            for i in range(3):
-                lo[k, i] = min(lo[k, i], x[j, i])
-                hi[k, i] = max(hi[k, i], x[j, i])
+    first = np.empty(n, dtype=np.int64)   # the ranges as index windows, monotone
+    last = np.empty(n, dtype=np.int64)
+    j = n - 1
+    for k in range(n - 1, -1, -1):
+        j = min(j, k)
+        while j > 0 and s[j - 1] >= lo_s[k]:
             j -= 1
-        j = k + 1
-        while j < n and s[j] <= hi_s[k]:
-            for i in range(3):
-                lo[k, i] = min(lo[k, i], x[j, i])
-                hi[k, i] = max(hi[k, i], x[j, i])
+        first[k] = j if k == n - 1 else min(j, first[k + 1])
+    j = 0
+    for k in range(n):
+        j = max(j, k)
+        while j + 1 < n and s[j + 1] <= hi_s[k]:
             j += 1
+        last[k] = j if k == 0 else max(j, last[k - 1])
+    lo, hi = np.empty((n, 3)), np.empty((n, 3))
+    qmin = np.empty(n, dtype=np.int64)
+    qmax = np.empty(n, dtype=np.int64)
+    for i in range(3):
+        h1 = t1 = h2 = t2 = 0   # deque heads and tails (exclusive)
+        nxt = 0
+        for k in range(n):
+            while nxt <= last[k]:
+                while t1 > h1 and x[qmin[t1 - 1], i] >= x[nxt, i]:
+                    t1 -= 1
+                qmin[t1] = nxt
+                t1 += 1
+                while t2 > h2 and x[qmax[t2 - 1], i] <= x[nxt, i]:
+                    t2 -= 1
+                qmax[t2] = nxt
+                t2 += 1
+                nxt += 1
+            while qmin[h1] < first[k]:
+                h1 += 1
+            while qmax[h2] < first[k]:
+                h2 += 1
+            lo[k, i] = x[qmin[h1], i]
+            hi[k, i] = x[qmax[h2], i]
     return lo, hi
 
 
