@@ -129,3 +129,15 @@ def test_a_huge_jerk_never_exits_over_a_limit():
     except PlanError:
         return
     assert (_shares(stream.positions, m) <= 1.0 + SLACK).all()
+
+
+def test_a_link_move_of_a_micrometre_streams():
+    """fillet_pocket's pencil has a link move of about 1e-6 mm between two corners: a run
+    of its own, from rest to rest, in finite time and within every limit."""
+    part = cadcnc.load_step(FIXTURES / "fillet_pocket.step")
+    prog = pencil(part, radius=3.0)
+    m = Machine.default()
+    stream = stream_program(prog, m, stepper_factory(part), feed=FAST)
+    assert np.isfinite(stream.cycle_time) and stream.periods > 1000
+    assert (_shares(stream.positions, m) <= 1.0 + SLACK).all()
+    assert np.array_equal(stream.positions[-1], prog.segments[-1].points[-1])

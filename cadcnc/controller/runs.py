@@ -81,6 +81,10 @@ def end_derivatives(piece: Piece, end: bool) -> tuple[np.ndarray, np.ndarray]:
         return d / np.linalg.norm(d), np.zeros(3)
     sl = slice(-3, None) if end else slice(0, 3)
     t, k = _lagrange(p[sl], s[sl] - s[sl][0], 2 if end else 0)
+    if len(p) >= 4:   # p'' of the next three points too: extrapolated onto the end (a
+        sl = slice(-4, -1) if end else slice(1, 4)   # ramp of curvature is no jump)
+        k2 = _lagrange(p[sl], s[sl] - s[sl][0], 0)[1]
+        k = 2.0 * k - k2
     return t / np.linalg.norm(t), k
 
 
@@ -110,7 +114,8 @@ def join_speed(before: Piece, after: Piece, machine: Machine) -> tuple[float, np
 
 
 def _line_grid(piece: Piece) -> np.ndarray:
-    n = int(min(max(math.ceil(piece.length / LINE_KNOT), 1), LINE_KNOTS_MAX))
+    n = int(min(max(math.ceil(piece.length / LINE_KNOT), 2), LINE_KNOTS_MAX))   # (from
+    # rest to rest needs two knots: one accelerating, one braking)
     return np.linspace(0.0, piece.length, n + 1)
 
 
@@ -146,7 +151,7 @@ def _cut_derivatives(piece: Piece) -> tuple[np.ndarray, ...]:
 
 def _piece_grid(piece: Piece, machine: Machine):
     """s, T, K, D, jump, cap at the grid points of one piece."""
-    if piece.cut is None and len(piece.points) == 2:
+    if len(piece.points) == 2:   # a straight move (or a cut of one step)
         s = _line_grid(piece)
         n = len(s)
         t = (piece.points[1] - piece.points[0]) / piece.length
