@@ -21,8 +21,9 @@ from rest to rest:
 4. the speed limits eroded (each held over +-v W) and the derivatives taken over the
    window's reach, so that the averaged motion keeps every limit where it is.
 
-The acceleration used is at most sqrt(V J) per axis: with more, the window would cost
-more time than the acceleration saves, and a looser limit could lengthen the plan. Times
+The acceleration used is at most sqrt(V J) per axis, and (J² L)^(1/3) on a run of length
+L: with more, the window would cost more time than the acceleration saves, and a looser
+limit could lengthen the plan. Times
 s, lengths mm.
 """
 
@@ -208,7 +209,10 @@ def _plan_share(run: Run, machine: Machine, limits, coriolis: float) -> Profile:
 def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
     """The jerk-limited, near time-optimal profile of one run (see the module doc);
     ``derate`` (3,) scales the velocity, acceleration and jerk used."""
-    return _plan_share(run, machine, _limits(machine, derate), CORIOLIS_SHARE)
+    V, A, J = _limits(machine, derate)
+    # a short run: the acceleration a jerk ramp up and down over its length reaches
+    A = np.minimum(A, np.cbrt(J * J * run.length))
+    return _plan_share(run, machine, (V, A, J), CORIOLIS_SHARE)
 
 
 def _constant_run(first: int, piece: Piece, machine: Machine) -> tuple[Run, Profile]:
