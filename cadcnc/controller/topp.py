@@ -271,6 +271,68 @@ def window_needed(t, v, a, Tabs, Kmax, static, J, C, window: float):
 
 
 @njit(cache=True, error_model="numpy")
+def _above(w, j: int, level: float) -> tuple:
+    """(a, b): the grid points around j where w >= level, without a gap."""
+    a = j
+    while a > 0 and w[a - 1] >= level:
+        a -= 1
+    b = j
+    while b < len(w) - 1 and w[b + 1] >= level:
+        b += 1
+    return a, b
+
+
+@njit(cache=True, error_model="numpy")
+def _turn(t, u, k: int, window: float, tiny: float) -> tuple:
+    """(p, q): knots before and after the last sign change of the acceleration in the
+    windows ending on knot k (u[p] and u[q] of opposite signs), or (-1, -1)."""
+    q = k
+    while q > 0 and abs(u[q]) <= tiny:
+        q -= 1
+    p = q
+    while p > 0 and t[p] > t[k] - 2.0 * window and not (u[p] * u[q] < 0.0
+                                                         and abs(u[p]) > tiny):
+        p -= 1
+    if u[p] * u[q] < 0.0 and abs(u[p]) > tiny:
+        return p, q
+    return -1, -1
+
+
+@njit(cache=True, error_model="numpy")
+def _flatten_at(s, w, u, wl, p: int, q: int, window: float) -> bool:
+    """Lower ``wl`` around the turn between knots p and q into a cruise of ``window`` s:
+    a peak to the highest level held that long, a valley's speed held over +-v window /
+    2. False if nothing can be done (a peak too short to cruise, a stop)."""
+    peak = u[p] > 0.0
+    j = p + 1
+    for i in range(p + 1, q + 1):
+        if (w[i] > w[j]) if peak else (w[i] < w[j]):
+            j = i
+    if peak:
+        lo, hi = 0.0, w[j]
+        for _ in range(40):
+            m = 0.5 * (lo + hi)
+            a, b = _above(w, j, m)
+            if s[b] - s[a] >= math.sqrt(m) * window:
+                lo = m
+            else:
+                hi = m
+        if lo <= 1e-6 * w[j]:
+            return False
+        a, b = _above(w, j, lo)
+        for i in range(a, b + 1):
+            wl[i] = min(wl[i], lo)
+        return True
+    if w[j] <= 0.0:
+        return False
+    r = 0.5 * math.sqrt(w[j]) * window
+    for i in range(len(s)):
+        if abs(s[i] - s[j]) <= r:
+            wl[i] = min(wl[i], w[j])
+    return True
+
+
+@njit(cache=True, error_model="numpy")
 def flatten(s, t, w, u, wl, need, window: float) -> int:
     """Lower ``wl`` (in place) so that each turn of the profile that needs a longer window
     than ``window`` (acceleration straight into deceleration at a peak, or the reverse at
@@ -280,63 +342,13 @@ def flatten(s, t, w, u, wl, need, window: float) -> int:
     tiny = 1e-9 * np.max(np.abs(u)) if len(u) else 0.0
     k = 0
     while k < n - 1:
-        if need[k] <= window:
-            k += 1
-            continue
-        q = k   # the turn in the window ending on knot k: u's last sign, then the other
-        while q > 0 and abs(u[q]) <= tiny:
-            q -= 1
-        p = q
-        while p > 0 and t[p] > t[k] - 2.0 * window and not (u[p] * u[q] < 0.0 and
-                                                             abs(u[p]) > tiny):
-            p -= 1
-        if not (u[p] * u[q] < 0.0 and abs(u[p]) > tiny):
-            k += 1
-            continue
-        j = p + 1
-        for i in range(p + 1, q + 1):
-            if (w[i] > w[j]) if u[p] > 0.0 else (w[i] < w[j]):
-                j = i
-        if u[p] > 0.0:   # a peak at j: the highest level cruising >= window
-            lo, hi = 0.0, w[j]
-            for _ in range(40):
-                m = 0.5 * (lo + hi)
-                a = j
-                while a > 0 and w[a - 1] >= m:
-                    a -= 1
-                b = j
-                while b < n - 1 and w[b + 1] >= m:
-                    b += 1
-                if s[b] - s[a] >= math.sqrt(m) * window:
-                    lo = m
-                else:
-                    hi = m
-            if lo <= 1e-6 * w[j]:   # no level cruises long enough: the window grows
-                k += 1
+        if need[k] > window:
+            p, q = _turn(t, u, k, window, tiny)
+            if p >= 0 and _flatten_at(s, w, u, wl, p, q, window):
+                done += 1
+                end = t[q] + window   # the next turn lies past this one's window
+                while k < n - 1 and t[k] <= end:
+                    k += 1
                 continue
-            a = j
-            while a > 0 and w[a - 1] >= lo:
-                a -= 1
-            b = j
-            while b < n - 1 and w[b + 1] >= lo:
-                b += 1
-            for i in range(a, b + 1):
-                wl[i] = min(wl[i], lo)
-        elif w[j] <= 0.0:    # a stop at j: nothing to hold
-            k += 1
-            continue
-        else:                # a valley at j: hold its speed over +-v window / 2
-            r = 0.5 * math.sqrt(w[j]) * window
-            i = j
-            while i >= 0 and s[j] - s[i] <= r:
-                wl[i] = min(wl[i], w[j])
-                i -= 1
-            i = j
-            while i < n and s[i] - s[j] <= r:
-                wl[i] = min(wl[i], w[j])
-                i += 1
-        done += 1
         k += 1
-        while k < n - 1 and t[k] <= t[j] + window:
-            k += 1
     return done
