@@ -168,10 +168,10 @@ def _tightened(run: Run, wl, limits, period: float, window: float, coriolis: flo
 
 
 def _first_window(run: Run, A, J) -> float:
-    """The averaging window a change of the tangential acceleration by A_i / |T_i| needs
-    on the axes the run moves (s): A_i / J_i at most; the plan lengthens it if needed."""
+    """The first averaging window (s): the shortest A_i / J_i of the axes the run moves;
+    the plan lengthens it where the profile needs more."""
     t = np.max(np.abs(run.T), axis=0)
-    return float(np.max(np.where(t > 0.0, A / J, 0.0), initial=0.0)) or float(np.min(A / J))
+    return float(np.min(np.where(t > 0.0, A / J, np.inf)))
 
 
 def _plan_share(run: Run, machine: Machine, limits, coriolis: float) -> Profile:
