@@ -171,16 +171,21 @@ NOISE = 1.5       # ... unless it is broken this much: the positions' noise, not
 
 def _over(positions: np.ndarray, machine: Machine) -> list[tuple[float, int, int]]:
     """Per quantity (velocity, acceleration, jerk): the largest finite-difference share
-    of the axis's limit, its period and its axis."""
-    ts, out = machine.period, []
-    for k, lim in enumerate((machine.max_velocity, machine.max_acceleration,
-                             machine.max_jerk), start=1):
-        if len(positions) <= k:
-            out.append((0.0, 0, 0))
-            continue
-        share = np.abs(np.diff(positions, k, axis=0)) / ts ** k / np.asarray(lim)
-        row, axis = np.unravel_index(int(np.argmax(share)), share.shape)
-        out.append((float(share[row, axis]), int(row) + k, int(axis)))
+    of the axis's limit, its period and its axis (CHUNK rows at a time: the differences'
+    temporaries stay bounded whatever the stream's length)."""
+    ts = machine.period
+    out = [(0.0, 0, 0)] * 3
+    for start in range(0, max(len(positions) - 1, 1), CHUNK):
+        block = positions[start:start + CHUNK + 3]
+        for k, lim in enumerate((machine.max_velocity, machine.max_acceleration,
+                                 machine.max_jerk), start=1):
+            if len(block) <= k:
+                continue
+            share = np.abs(np.diff(block, k, axis=0))
+            share /= ts ** k * np.asarray(lim)
+            row, axis = np.unravel_index(int(np.argmax(share)), share.shape)
+            if share[row, axis] > out[k - 1][0]:
+                out[k - 1] = (float(share[row, axis]), start + int(row) + k, int(axis))
     return out
 
 
