@@ -112,7 +112,7 @@ def _caller() -> str:
     kind = ""
     if k is not None and self is not None and hasattr(self, "_faces"):
         try:
-            kind = " " + self._faces[k - 1].kind
+            kind = " " + self._faces[k - 1].kind + (" (own)" if k in self.pair else "")
         except Exception:  # noqa: BLE001 - a description only
             kind = ""
     return f"{f.f_code.co_name} face {k}{kind}" if k is not None else f.f_code.co_name
