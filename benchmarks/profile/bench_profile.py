@@ -56,8 +56,15 @@ def offset_boss(folder: Path) -> str:
                             OFFSET_MM, 1e-6, BRepOffset_Skin, False, False,
                             GeomAbs_Intersection)
         writer = STEPControl_Writer()
-        writer.Transfer(maker.Shape(), STEPControl_AsIs)
-        writer.Write(str(out))
+        sys.stdout.flush()
+        saved = os.dup(1)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), 1)   # OCCT's writer prints its statistics
+        try:
+            writer.Transfer(maker.Shape(), STEPControl_AsIs)
+            writer.Write(str(out))
+        finally:
+            os.dup2(saved, 1)
+            os.close(saved)
     return str(out)
 
 

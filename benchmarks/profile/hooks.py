@@ -35,6 +35,8 @@ STAGES = {   # stage name: (module, attribute path)
 OCCT = {   # module: the OCCT classes whose construction computes a distance there
     "cadcnc.guard.clearance": ("BRepExtrema_DistShapeShape",),
     "cadcnc.guard.moves": ("BRepExtrema_DistShapeShape",),
+    "cadcnc.guard.face_distance": ("BRepExtrema_DistShapeShape", "BRepExtrema_ExtCF",
+                                   "BRepExtrema_ExtPF"),
     "cadcnc.verification.probe": ("BRepExtrema_DistShapeShape",),
     "cadcnc.verification.planar": ("BRepExtrema_DistShapeShape",),
 }
@@ -107,6 +109,8 @@ def _occt(module: str, cls_name: str, cls):
 def _caller() -> str:
     """The cadcnc function that made a slow call, with its face number and kind if any."""
     f = sys._getframe(2)
+    if f.f_code.co_name == "distance" and f.f_back is not None:   # guard/face_distance.py
+        f = f.f_back
     k = f.f_locals.get("k")
     self = f.f_locals.get("self")
     kind = ""

@@ -58,7 +58,7 @@ def _poles_2d(array) -> np.ndarray:
                      for i in range(array.LowerRow(), array.UpperRow() + 1)])
 
 
-def _support(flat: np.ndarray, degree: int, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def pole_support(flat: np.ndarray, degree: int, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(first, last) pole index (0-based) of the basis functions not zero on each span
     [cuts[i], cuts[i + 1]] of a B-spline with the flat knot sequence ``flat``: function j
     lives on (flat[j], flat[j + degree + 1])."""
@@ -211,8 +211,8 @@ class FaceBoxes:
                 mults.SetValue(k, degree)
             insert(knots, mults, 0.0, False)
         poles = _poles_2d(piece.Poles())
-        fu, lu = _support(_flat(piece.UKnotSequence()), piece.UDegree(), us)
-        fw, lw = _support(_flat(piece.VKnotSequence()), piece.VDegree(), ws)
+        fu, lu = pole_support(flat_knots(piece.UKnotSequence()), piece.UDegree(), us)
+        fw, lw = pole_support(flat_knots(piece.VKnotSequence()), piece.VDegree(), ws)
         out = np.empty((len(us) - 1, len(ws) - 1, 6))
         if self.offset is not None:
             for i in range(len(us) - 1):
@@ -228,7 +228,7 @@ class FaceBoxes:
         return out
 
 
-def _flat(seq) -> np.ndarray:
+def flat_knots(seq) -> np.ndarray:
     return np.array([seq.Value(k) for k in range(seq.Lower(), seq.Upper() + 1)])
 
 
