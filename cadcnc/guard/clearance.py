@@ -218,10 +218,13 @@ class ClearanceGuard:
             face = self._free_edges(k)
             if face is None:
                 return math.inf, False
-        else:   # OCCT's pieces, the edges only where they can win (guard/face_distance.py)
+        elif self._analytic[k - 1].kind is None:
+            # no closed forms (a B-spline): OCCT's pieces, its edges only where they can win
+            # (guard/face_distance.py); on r0901_ec's cylinders they rarely prune
             if k not in self._pieces:
                 self._pieces[k] = FaceDistance(face, self._own_shapes)
-            got = self._pieces[k].distance(p, z0, z1) if self._pieces[k].useful else None
+            pieces = self._pieces[k]
+            got = pieces.distance(p, z0, z1) if pieces.useful else None
             if got is not None:
                 return (cut, False) if got[0] > cut else got
         a = gp_Pnt(p[0], p[1], z0)
