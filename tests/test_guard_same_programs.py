@@ -1,9 +1,9 @@
 """The guard's cheaper proofs of issue 37 change no program: with them and without them
 (OCCT's distance of the whole shank segment to the whole face, no box-tree proof of the
-own-face rule, no cell boxes on offset faces) the programs of B-spline and surface-of-revolution fixtures
-are the same bytes (program JSON). The pencil programs and the offset corner (bspline_boss
-offset by 1 mm, whose run without the offset cells costs about 25 s) are compared in the
-slow tier."""
+own-face rule, no cell boxes on offset faces) the programs of B-spline and
+surface-of-revolution fixtures are the same bytes (program JSON). The pencil programs and
+the offset corner (bspline_boss offset by 1 mm, whose run without the offset cells costs
+about 25 s) are compared in the slow tier."""
 
 from __future__ import annotations
 

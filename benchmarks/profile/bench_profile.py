@@ -116,14 +116,16 @@ def table(name: str, runs: dict[str, list[dict]]) -> list[str]:
                                   for k in labels])
     for k in labels:
         for dt, where, what in best[k]["slow"][:5]:
-            lines.append(f"|   {k}: {dt * 1e3:.0f} ms | {where}: {what} |" + " |" * (len(labels) - 1))
+            lines.append(f"|   {k}: {dt * 1e3:.0f} ms | {where}: {what} |"
+                         + " |" * (len(labels) - 1))
     return lines + [""]
 
 
 def main(argv: list[str]) -> int:
     ap = argparse.ArgumentParser(prog="python -m benchmarks profile",
                                  description=__doc__.split("\n\n")[0])
-    ap.add_argument("cases", nargs="*", metavar="CASE", help=f"of {', '.join(CASES)} (default: all)")
+    ap.add_argument("cases", nargs="*", metavar="CASE",
+                    help=f"of {', '.join(CASES)} (default: all)")
     ap.add_argument("--part", help="the case's part instead of its default")
     ap.add_argument("--radius", help="the case's ball radius, mm")
     ap.add_argument("--base", metavar="DIR", help="a checkout of the previous code")

@@ -68,6 +68,8 @@ def pole_support(flat: np.ndarray, degree: int, cuts: np.ndarray) -> tuple[np.nd
     return first, np.maximum(last, first)
 
 
+ROUND_OFF = 1e-12
+"""Relative widening of a normal box: the round-off of its products and divisions."""
 _BOUNDED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
@@ -272,5 +274,5 @@ def normal_box(net: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return whole
     n_lo = np.where(c_lo >= 0.0, c_lo / long, c_lo / short)
     n_hi = np.where(c_hi >= 0.0, c_hi / short, c_hi / long)
-    pad = 1e-12 * (1.0 + np.abs(n_lo) + np.abs(n_hi))     # the divisions' round-off
+    pad = ROUND_OFF * (1.0 + np.abs(n_lo) + np.abs(n_hi))     # the divisions' round-off
     return np.clip(n_lo - pad, -1.0, 1.0), np.clip(n_hi + pad, -1.0, 1.0)
