@@ -14,8 +14,9 @@ Cases (``--part`` and ``--radius`` change a case's part and ball radius):
 
 ``--base DIR``: a checkout of the previous code (``git worktree add DIR COMMIT``); every
 case is then run alternately with it and with this tree, ``--rounds`` times each, and
-both are printed. CPU seconds (``time.process_time``), so other work on the machine
-changes them less than wall time.
+both are printed (the least of the rounds). A fresh checkout compiles the kernel on its
+first run (about 40 s of "stepping"): run it once before, or take two rounds. CPU seconds
+(``time.process_time``), so other work on the machine changes them less than wall time.
 """
 
 from __future__ import annotations
