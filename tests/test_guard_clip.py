@@ -69,3 +69,37 @@ def test_rho_above_bounds_the_points_above(name, face):
         if len(above):
             assert np.hypot(*(above[:, :2] - p[:2]).T).min() >= rho - 1e-9
     assert proven >= 10
+
+
+@pytest.mark.parametrize("name,pair", [("bspline_boss.step", (4, 5)), ("abc_fold.step", (7, 8))])
+def test_face_distance_is_distshapeshape(name, pair):
+    """guard/face_distance.py: OCCT's pieces, the edges only where they can win, give the
+    distance and the own-edge verdict of BRepExtrema_DistShapeShape of the whole face (to
+    1e-12 mm), for random vertical segments about every curved face of the part."""
+    from OCP.BRepExtrema import BRepExtrema_IsInFace   # noqa: PLC0415
+
+    from cadcnc.guard.face_distance import FaceDistance   # noqa: PLC0415
+
+    part = cadcnc.load_step(FIXTURES / name)
+    g = ClearanceGuard(part, pair, 3.0, 30.0)
+    rng = np.random.default_rng(11)
+    compared = 0
+    for k in range(1, len(part) + 1):
+        if part.face(k).kind == "plane":
+            continue
+        pieces = FaceDistance(part.face(k).topods, g._own_shapes)
+        for _ in range(6):
+            p = rng.uniform(g._lo[k - 1] - 3.0, g._hi[k - 1] + 3.0)
+            z0, z1 = float(p[2]), float(p[2] + rng.uniform(0.0, 10.0))
+            got = pieces.distance(p, z0, z1)
+            ext = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeEdge(
+                gp_Pnt(p[0], p[1], z0), gp_Pnt(p[0], p[1], z1)).Edge(), part.face(k).topods)
+            own = all(ext.SupportTypeShape2(n) != BRepExtrema_IsInFace
+                      and g._own_shapes.Contains(ext.SupportOnShape2(n))
+                      for n in range(1, ext.NbSolution() + 1))
+            if got is None:
+                continue
+            compared += 1
+            assert abs(got[0] - ext.Value()) <= 1e-12 * max(1.0, ext.Value())
+            assert got[1] == own
+    assert compared >= 40

@@ -1,9 +1,9 @@
 """The guard's cheaper proofs of issue 37 change no program: with them and without them
-(OCCT's distance of the whole shank segment, no box-tree proof of the own-face rule, no
-cell boxes on offset faces) the programs of B-spline and surface-of-revolution fixtures
-are the same bytes (program JSON). The pencil programs and the offset corner (bspline_boss
-offset by 1 mm, whose run without the offset cells costs about 25 s) are compared in the
-slow tier."""
+(OCCT's distance of the whole shank segment to the whole face, no box-tree proof of the
+own-face rule, no cell boxes on offset faces) the programs of B-spline and
+surface-of-revolution fixtures are the same bytes (program JSON). The pencil programs and
+the offset corner (bspline_boss offset by 1 mm, whose run without the offset cells costs
+about 25 s) are compared in the slow tier."""
 
 from __future__ import annotations
 
@@ -20,6 +20,7 @@ from cadcnc.guard import guard as guard_module
 from cadcnc.guard.box_tree import BoxTree
 from cadcnc.guard.cells import BOUNDED_KINDS
 from cadcnc.guard.clearance import ClearanceGuard
+from cadcnc.guard.face_distance import FaceDistance
 from cadcnc.io.program_json import program_json
 from cadcnc.job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
 
@@ -27,12 +28,14 @@ from conftest import FIXTURES
 
 
 def without_new_proofs(monkeypatch) -> None:
-    """The guard as before issue 37: whole segments, no rho_above, offsets unbounded."""
+    """The guard as before issue 37: whole segments, no rho_above, offsets unbounded,
+    DistShapeShape of the whole face."""
     whole = ClearanceGuard._segment_distance
     monkeypatch.setattr(ClearanceGuard, "_segment_distance",
                         lambda self, k, p, length=None, cap=None:
                         whole(self, k, p, length, math.inf))
     monkeypatch.setattr(BoxTree, "rho_above", lambda self, p, z0, need: None)
+    monkeypatch.setattr(FaceDistance, "distance", lambda self, p, z0, z1: None)
     monkeypatch.setattr(guard_module, "bounded", lambda face: face.kind in BOUNDED_KINDS)
 
 

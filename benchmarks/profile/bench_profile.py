@@ -14,8 +14,9 @@ Cases (``--part`` and ``--radius`` change a case's part and ball radius):
 
 ``--base DIR``: a checkout of the previous code (``git worktree add DIR COMMIT``); every
 case is then run alternately with it and with this tree, ``--rounds`` times each, and
-both are printed. CPU seconds (``time.process_time``), so other work on the machine
-changes them less than wall time.
+both are printed (the least of the rounds). A fresh checkout compiles the kernel on its
+first run (about 40 s of "stepping"): run it once before, or take two rounds. CPU seconds
+(``time.process_time``), so other work on the machine changes them less than wall time.
 """
 
 from __future__ import annotations
@@ -56,8 +57,15 @@ def offset_boss(folder: Path) -> str:
                             OFFSET_MM, 1e-6, BRepOffset_Skin, False, False,
                             GeomAbs_Intersection)
         writer = STEPControl_Writer()
-        writer.Transfer(maker.Shape(), STEPControl_AsIs)
-        writer.Write(str(out))
+        sys.stdout.flush()
+        saved = os.dup(1)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), 1)   # OCCT's writer prints its statistics
+        try:
+            writer.Transfer(maker.Shape(), STEPControl_AsIs)
+            writer.Write(str(out))
+        finally:
+            os.dup2(saved, 1)
+            os.close(saved)
     return str(out)
 
 
@@ -109,14 +117,16 @@ def table(name: str, runs: dict[str, list[dict]]) -> list[str]:
                                   for k in labels])
     for k in labels:
         for dt, where, what in best[k]["slow"][:5]:
-            lines.append(f"|   {k}: {dt * 1e3:.0f} ms | {where}: {what} |" + " |" * (len(labels) - 1))
+            lines.append(f"|   {k}: {dt * 1e3:.0f} ms | {where}: {what} |"
+                         + " |" * (len(labels) - 1))
     return lines + [""]
 
 
 def main(argv: list[str]) -> int:
     ap = argparse.ArgumentParser(prog="python -m benchmarks profile",
                                  description=__doc__.split("\n\n")[0])
-    ap.add_argument("cases", nargs="*", metavar="CASE", help=f"of {', '.join(CASES)} (default: all)")
+    ap.add_argument("cases", nargs="*", metavar="CASE",
+                    help=f"of {', '.join(CASES)} (default: all)")
     ap.add_argument("--part", help="the case's part instead of its default")
     ap.add_argument("--radius", help="the case's ball radius, mm")
     ap.add_argument("--base", metavar="DIR", help="a checkout of the previous code")

@@ -20,6 +20,7 @@ STAGES = {   # stage name: (module, attribute path)
     "load": ("cadcnc.geometry.part", "load_step"),
     "run": ("cadcnc.ops.run", "run"),
     "setups": ("cadcnc.ops.pencil.setups", "pencil_setups"),
+    "finish": ("cadcnc.ops.finish.finish", "finish_program"),
     "corners": ("cadcnc.ops.pencil.corners", "find_corners"),
     "stretches": ("cadcnc.ops.path.stretches", "pair_stretches"),
     "limits": ("cadcnc.ops.path.stretches", "locate_limit"),
@@ -35,6 +36,8 @@ STAGES = {   # stage name: (module, attribute path)
 OCCT = {   # module: the OCCT classes whose construction computes a distance there
     "cadcnc.guard.clearance": ("BRepExtrema_DistShapeShape",),
     "cadcnc.guard.moves": ("BRepExtrema_DistShapeShape",),
+    "cadcnc.guard.face_distance": ("BRepExtrema_DistShapeShape", "BRepExtrema_ExtCF",
+                                   "BRepExtrema_ExtPF"),
     "cadcnc.verification.probe": ("BRepExtrema_DistShapeShape",),
     "cadcnc.verification.planar": ("BRepExtrema_DistShapeShape",),
 }
@@ -107,12 +110,14 @@ def _occt(module: str, cls_name: str, cls):
 def _caller() -> str:
     """The cadcnc function that made a slow call, with its face number and kind if any."""
     f = sys._getframe(2)
+    if f.f_code.co_name == "distance" and f.f_back is not None:   # guard/face_distance.py
+        f = f.f_back
     k = f.f_locals.get("k")
     self = f.f_locals.get("self")
     kind = ""
     if k is not None and self is not None and hasattr(self, "_faces"):
         try:
-            kind = " " + self._faces[k - 1].kind
+            kind = " " + self._faces[k - 1].kind + (" (own)" if k in self.pair else "")
         except Exception:  # noqa: BLE001 - a description only
             kind = ""
     return f"{f.f_code.co_name} face {k}{kind}" if k is not None else f.f_code.co_name

@@ -45,6 +45,7 @@ from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.gp import gp_Pnt
 
 from .analytic import AnalyticFace
+from .face_distance import FaceDistance
 from ..tolerances import DEFAULT
 
 TIE = 1e-9  # mm: margins this close are the same contact
@@ -85,6 +86,7 @@ class ClearanceGuard:
         self._edges: dict = {}              # face -> compound of its free edges (planes)
         self._own_edges: dict = {}          # own face -> compound of all its edges
         self._edge_bound: dict = {}         # own face -> (p0, distance to its edges at p0)
+        self._pieces: dict = {}             # face -> its FaceDistance (OCCT's pieces)
         self._broad_at: tuple[float, float, float] | None = None
         self._near: list[int] = []          # face numbers within reach at _broad_at
         self._bound: dict[int, tuple] = {}  # face -> (p0, lower bound of the margin at p0, slope)
@@ -216,6 +218,15 @@ class ClearanceGuard:
             face = self._free_edges(k)
             if face is None:
                 return math.inf, False
+        elif self._analytic[k - 1].kind is None:
+            # no closed forms (a B-spline): OCCT's pieces, its edges only where they can win
+            # (guard/face_distance.py); on r0901_ec's cylinders they rarely prune
+            if k not in self._pieces:
+                self._pieces[k] = FaceDistance(face, self._own_shapes)
+            pieces = self._pieces[k]
+            got = pieces.distance(p, z0, z1) if pieces.useful else None
+            if got is not None:
+                return (cut, False) if got[0] > cut else got
         a = gp_Pnt(p[0], p[1], z0)
         shape = BRepBuilderAPI_MakeEdge(a, gp_Pnt(p[0], p[1], z1)).Edge() \
             if z1 > z0 else BRepBuilderAPI_MakeVertex(a).Vertex()

@@ -58,7 +58,7 @@ def _poles_2d(array) -> np.ndarray:
                      for i in range(array.LowerRow(), array.UpperRow() + 1)])
 
 
-def _support(flat: np.ndarray, degree: int, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def pole_support(flat: np.ndarray, degree: int, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(first, last) pole index (0-based) of the basis functions not zero on each span
     [cuts[i], cuts[i + 1]] of a B-spline with the flat knot sequence ``flat``: function j
     lives on (flat[j], flat[j + degree + 1])."""
@@ -68,6 +68,8 @@ def _support(flat: np.ndarray, degree: int, cuts: np.ndarray) -> tuple[np.ndarra
     return first, np.maximum(last, first)
 
 
+ROUND_OFF = 1e-12
+"""Relative widening of a normal box: the round-off of its products and divisions."""
 _BOUNDED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
@@ -211,8 +213,8 @@ class FaceBoxes:
                 mults.SetValue(k, degree)
             insert(knots, mults, 0.0, False)
         poles = _poles_2d(piece.Poles())
-        fu, lu = _support(_flat(piece.UKnotSequence()), piece.UDegree(), us)
-        fw, lw = _support(_flat(piece.VKnotSequence()), piece.VDegree(), ws)
+        fu, lu = pole_support(flat_knots(piece.UKnotSequence()), piece.UDegree(), us)
+        fw, lw = pole_support(flat_knots(piece.VKnotSequence()), piece.VDegree(), ws)
         out = np.empty((len(us) - 1, len(ws) - 1, 6))
         if self.offset is not None:
             for i in range(len(us) - 1):
@@ -228,7 +230,7 @@ class FaceBoxes:
         return out
 
 
-def _flat(seq) -> np.ndarray:
+def flat_knots(seq) -> np.ndarray:
     return np.array([seq.Value(k) for k in range(seq.Lower(), seq.Upper() + 1)])
 
 
@@ -272,5 +274,5 @@ def normal_box(net: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return whole
     n_lo = np.where(c_lo >= 0.0, c_lo / long, c_lo / short)
     n_hi = np.where(c_hi >= 0.0, c_hi / short, c_hi / long)
-    pad = 1e-12 * (1.0 + np.abs(n_lo) + np.abs(n_hi))     # the divisions' round-off
+    pad = ROUND_OFF * (1.0 + np.abs(n_lo) + np.abs(n_hi))     # the divisions' round-off
     return np.clip(n_lo - pad, -1.0, 1.0), np.clip(n_hi + pad, -1.0, 1.0)

@@ -6,9 +6,15 @@ no nearer to the followed faces than the ball) with cheap, sound proofs standing
 OCCT's distances, so that OCCT runs only where the tool really is near a face:
 
 - **The shank against a followed face**: :class:`~cadcnc.guard.cells.HeightCells` (the
-  cell boxes of the face above the centre are horizontally further from it than the face).
+  cell boxes of the face above the centre are horizontally further from it than the face),
+  then on a face without closed forms the same proof on its box tree's finer boxes
+  (:meth:`~cadcnc.guard.box_tree.BoxTree.rho_above`), then OCCT.
 - **Third faces** near the tool: closed forms (plane, cylinder, sphere) first, then a
   :class:`~cadcnc.guard.box_tree.BoxTree` lower bound, then OCCT.
+- **OCCT** gets the shank clipped to the face box's heights (widened by what can decide)
+  and, on a face with B-spline edges, only the edges whose bound can win
+  (:mod:`~cadcnc.guard.face_distance`). Offsets of B-splines have cell boxes too
+  (:mod:`~cadcnc.guard.face_boxes`).
 - **Walls hanging from a followed face's edge** (:mod:`.walls`): cleared in closed form
   where the tool rides along the edge they share with the face.
 
