@@ -116,10 +116,10 @@ def test_the_wrong_part_is_named(program, tmp_path):
 
 def test_an_origin_far_outside_the_part_is_an_input_error(tmp_path):
     """Finding 8: --origin 1e300,0,0 gave exit 3 (no feasible ball position)."""
-    run = cadcnc_cli("path", BLOCK, *SHORT[:4], "--origin", "1e300,0,0",
+    run = cadcnc_cli("path", BLOCK, *SHORT[:5], "--origin", "1e300,0,0",
                      "-o", tmp_path / "p.json")
     assert run.returncode == 2, run.stderr
-    assert "--origin" in run.stderr and "RuntimeWarning" not in run.stderr
+    assert "--origin 1e+300,0,0:" in run.stderr and "RuntimeWarning" not in run.stderr
 
 
 def test_periods_are_estimated_and_bounded_before_work(program, tmp_path, monkeypatch):
