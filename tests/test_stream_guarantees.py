@@ -224,3 +224,24 @@ def test_sigterm_while_an_output_set_is_written_leaves_no_temporary_file(tmp_pat
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json"]
     assert old.read_text() == "old"
     assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
+
+
+def test_the_txt_is_checked_as_printed(program, tmp_path, monkeypatch):
+    """The .txt's numbers, not only the array they were printed from: a text that breaks
+    the limits is refused with its name, and neither file is written."""
+    import cadcnc.controller.stream as stream
+
+    real = stream.stream_text
+
+    def bumped(positions):
+        rows = real(positions).splitlines()
+        x, y, z = map(float, rows[len(rows) // 2].split())
+        rows[len(rows) // 2] = f"{x + 0.05:.9f} {y:.9f} {z:.9f}"
+        return "\n".join(rows) + "\n"
+
+    monkeypatch.setattr(stream, "stream_text", bumped)
+    npy, txt = tmp_path / "s.npy", tmp_path / "s.txt"
+    run = cadcnc_cli("stream", program, "-o", npy, "-o", txt)
+    assert run.returncode == 5, run.stderr
+    assert f"{txt}: velocity of axis X" in run.stderr
+    assert not npy.exists() and not txt.exists()
