@@ -243,5 +243,5 @@ def test_the_txt_is_checked_as_printed(program, tmp_path, monkeypatch):
     npy, txt = tmp_path / "s.npy", tmp_path / "s.txt"
     run = cadcnc_cli("stream", program, "-o", npy, "-o", txt)
     assert run.returncode == 5, run.stderr
-    assert f"{txt}: velocity of axis X" in run.stderr
+    assert f"{txt}: acceleration of axis X" in run.stderr
     assert not npy.exists() and not txt.exists()
