@@ -175,6 +175,7 @@ def test_stale_folders_of_dead_runs_are_removed_never_a_live_ones(tmp_path):
         live.wait()
 
 
+@pytest.mark.slow   # about 7 s each: a fresh process loads OCCT
 @pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
 def test_a_long_stream_is_interrupted_cleanly(program, tmp_path, sig):
     """Finding 4 and 5: a long stream (--feed 1: about 350 000 periods) says how many
