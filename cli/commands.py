@@ -9,7 +9,6 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from cadcnc import apt
 from cadcnc.errors import InputError
 from cadcnc.errors import EXIT_PARTIAL
 from cadcnc.io.output_set import OutputSet, check_destination
@@ -35,6 +34,8 @@ def run(args) -> int:
     for out in requested:
         check_destination(out, SUFFIXES, inputs=[args.program])
     source = args.program
+    from cadcnc import apt  # noqa: PLC0415 - the APT language: only `cadcnc run` pays it
+
     entries, title = apt.read_program(source, tolerances(args), clearance(args))
     names = _output_names(requested, entries)
     outputs = OutputSet([n for group in names.values() for n in group], SUFFIXES,
@@ -104,6 +105,8 @@ def _output_names(requested, entries) -> dict[str, list[str]]:
 def _stream(args, checked, source: str) -> int:
     """Print each period's increment. Each path is computed and gated first (partial,
     gouge), then streamed from a fresh stepper: nothing unchecked reaches the axes."""
+    from cadcnc import apt  # noqa: PLC0415 - as in run
+
     write, status = sys.stdout.write, 0
     for entry, part in checked:
         tp = apt.run_job(entry, part, None, source)

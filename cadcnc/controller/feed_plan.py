@@ -1,27 +1,29 @@
-"""The feed along each piece, planned to the axes' velocity, acceleration and jerk limits.
+"""The feed along each run, planned near time-optimally to the axes' velocity,
+acceleration and jerk limits.
 
 The path p(s) is fixed; the plan chooses only s(t). Per axis i, with T = p', K = p'',
-D = p''' (derivatives in arc length, from the kernel's points):
+D = p''' (in arc length, from the kernel's points):
 
-- velocity      T_i v                                   <= m V_i
-- acceleration  T_i s'' + K_i v^2                       <= m A_i
-- jerk          T_i s''' + 3 K_i v s'' + D_i v^3        <= m J_i
+- velocity      |T_i v|                                  <= V_i
+- acceleration  |T_i s'' + K_i v^2|                      <= A_i
+- jerk          |T_i s''' + 3 K_i v s'' + D_i v^3|        <= J_i
 
-The curvature terms get the share c of A and J (none on a straight move), the tangential
-terms the rest: |s''| <= a_t, |s'''| <= j_t (the smallest share over the axes), and the
-speed limit v_lim(s) keeps |K_i| v^2 <= c m A_i and 3|K_i| v a_t + |D_i| v^3 <= c m J_i.
-Then:
+each used where it binds, at MARGIN of the limit. A run (:mod:`.runs`) is moved through
+from rest to rest:
 
-1. v_lim(s): the programmed speed, the accuracy rule's step, and the terms above;
-2. eroded: the smallest v_lim within +-v_max T_f (see 4);
-3. forward and backward passes over the whole piece (v^2 grows at most 2 a_t per mm),
-   from rest to rest: the time-optimal profile under acceleration a_t;
-4. that s(t) averaged over a moving window T_f = 2 a_t / j_t: the jerk is then at most
-   j_t, the acceleration stays within a_t, and every speed averaged comes from within
-   v_max T_f of the point reached, where the eroded limit holds.
+1. the speed limits: the feed, V_i / |T_i|, the jerk's D_i v^3 term (D_SHARE of J_i), and
+   the one-period jolt of a curvature jump or a join (``runs.JOIN_SHARE``);
+2. the time-optimal profile under the acceleration limits (:func:`.topp.passes`), with
+   the jerk's Coriolis term 3 K_i v s'' within CORIOLIS_SHARE of J_i;
+3. that s(t) averaged over a moving window W: its jerk T_i (s''(t) - s''(t - W)) / W,
+   W the shortest that leaves every axis the room the curvature terms do not take
+   (:func:`.topp.window_needed`; about A / J on a straight run, once per rest);
+4. the speed limits eroded (each held over +-v W) and the derivatives taken over the
+   window's reach, so that the averaged motion keeps every limit where it is.
 
-Every bound holds in continuous time, so it holds for the finite differences of the
-positions sampled each period too (an average of the derivative). Times s, lengths mm.
+The acceleration used is at most sqrt(V J) per axis: with more, the window would cost
+more time than the acceleration saves, and a looser limit could lengthen the plan. Times
+s, lengths mm.
 """
 
 from __future__ import annotations
@@ -33,68 +35,31 @@ import numpy as np
 from numba import njit
 
 from ..errors import InputError
+from . import topp
 from .machine import Machine
 from .pieces import Piece, constant_speed
+from .runs import JOIN_SHARE, Run, runs_of
 
-MARGIN = 0.98
-"""Share of every limit the plan uses; the rest covers the curvature sampled between
-the kernel's points and the kernel's step landing within a few nm of the plan."""
-CURVATURE_SHARE = 0.5
-"""Share of the acceleration and jerk limits left to the curvature (centripetal) terms."""
-END_KNOTS = 40  # extra knots near each end (2^-k of the first step): a start from rest
-WIDEN = 2       # samples: derivatives and limits widened to cover the points between
+MARGIN = 0.995
+"""Share of every limit the plan uses; the rest covers the path's derivatives between the
+kernel's points, the averaged squared speed (v² of the mean is at most the mean of v²)
+and the kernel's step landing within a few nm of the plan."""
+CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most
+D_SHARE = 0.25          # of J_i: D_i v^3 at most
+WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window grown
+FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
 MAX_PERIODS = 50_000_000
 
 
-def _widened(x: np.ndarray, w: int = WIDEN) -> np.ndarray:
-    """x's running maximum over +-w samples (along axis 0)."""
-    out = x.copy()
-    for k in range(1, w + 1):
-        out[k:] = np.maximum(out[k:], x[:-k])
-        out[:-k] = np.maximum(out[:-k], x[k:])
-    return out
-
-
-def derivatives(points: np.ndarray, s: np.ndarray):
-    """|T|, |K|, |D| per axis at each point ((n, 3) each): |p'|, |p''|, |p'''| in arc
-    length from finite differences, widened over +-WIDEN points."""
-    n = len(points)
-    h = np.diff(s)
-    d1 = np.diff(points, axis=0) / h[:, None]
-    T = np.abs(np.vstack([d1[:1], d1]))
-    T[1:-1] = np.maximum(T[1:-1], np.abs(d1[1:]))
-    K = np.zeros((n, 3))
-    D = np.zeros((n, 3))
-    if n >= 3:
-        K[1:-1] = 2.0 * np.diff(d1, axis=0) / (h[:-1] + h[1:])[:, None]
-        K[0], K[-1] = K[1], K[-2]
-        dk = np.abs(np.diff(K, axis=0)) / h[:, None]
-        D[:-1], D[1:] = dk, np.maximum(D[1:], dk)
-        K = np.abs(K)
-    return _widened(T), _widened(K), _widened(D)
-
-
-def _range_min(x: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """min(x[lo[i]:hi[i]]) for every i (hi > lo), by a sparse table."""
-    table = [x]
-    while (1 << len(table)) <= len(x):
-        prev, w = table[-1], 1 << (len(table) - 1)
-        table.append(np.minimum(prev[:-w], prev[w:]))
-    k = np.floor(np.log2(hi - lo)).astype(int)
-    out = np.empty(len(lo))
-    for level in np.unique(k):
-        sel = k == level
-        t = table[level]
-        out[sel] = np.minimum(t[lo[sel]], t[hi[sel] - (1 << level)])
-    return out
+class PlanError(InputError):
+    """The machine's limits admit no plan of this program (names the run and the limit)."""
 
 
 @dataclass
 class Profile:
-    """One piece's planned motion s(t), t from 0 (at rest at s = 0) to ``duration`` (at
-    rest at s = L): the accelerated profile on ``t``, ``s``, ``v``, ``a`` (the interval
-    k from t[k] has acceleration a[k]) and ``S`` = its time integral, averaged over
-    ``window`` s."""
+    """One run's planned motion s(t), t from 0 (at rest at s = 0) to ``duration`` (at
+    rest at s = L): the profile on ``t``, ``s``, ``v``, ``a`` (the interval k from t[k]
+    has acceleration a[k]) and ``S`` = its time integral, averaged over ``window`` s."""
 
     t: np.ndarray
     s: np.ndarray
@@ -102,7 +67,6 @@ class Profile:
     a: np.ndarray
     S: np.ndarray
     window: float
-    v_limit: np.ndarray | None = None   # (n,) the eroded limit at the piece's points
 
     @property
     def length(self) -> float:
@@ -148,96 +112,93 @@ def _positions(t, s, v, a, S, window: float, tau, out) -> None:
         out[i] = min(max(x, 0.0), L)
 
 
-def _knotted(piece: Piece, v_lim: np.ndarray):
-    """The arc lengths with END_KNOTS knots added inside the first and last step (their
-    limit that of the step), so that a start from rest is resolved finely."""
-    s = piece.s
-    L, n = s[-1], len(s)
-    first = s[1] * 0.5 ** np.arange(END_KNOTS + 1, 1, -1)   # up to a quarter step
-    last = L - (L - s[-2]) * 0.5 ** np.arange(2, END_KNOTS + 2)
-    eps = 4.0 * np.spacing(L)   # knots closer than this to an end are not distinct
-    first, last = first[first > eps], last[L - last > eps]
-    ss = np.concatenate([s[:1], first, s[1:-1], last, s[-1:]])
-    vv = np.concatenate([v_lim[:1], np.full(len(first), min(v_lim[0], v_lim[1])),
-                         v_lim[1:-1], np.full(len(last), min(v_lim[-2], v_lim[-1])),
-                         v_lim[-1:]])
-    return ss, vv, n
+def _limits(machine: Machine, derate=(1.0, 1.0, 1.0)):
+    """V, A, J used by the plan: MARGIN (times ``derate``) of each, the acceleration at
+    most sqrt(V J)."""
+    V = MARGIN * derate[0] * np.asarray(machine.max_velocity)
+    J = MARGIN * derate[2] * np.asarray(machine.max_jerk)
+    A = np.minimum(MARGIN * derate[1] * np.asarray(machine.max_acceleration), np.sqrt(V * J))
+    return V, A, J
 
 
-@njit(cache=True, error_model="numpy")
-def _passes(ss: np.ndarray, w: np.ndarray, a: float) -> None:
-    """Forward and backward passes on squared speeds ``w`` (in place): v^2 changes by at
-    most 2 a per mm between knots ``ss``. A loop: cumulative forms lose v^2 near the ends
-    to round-off when a L is large."""
-    for i in range(1, len(w)):
-        w[i] = min(w[i], w[i - 1] + 2.0 * a * (ss[i] - ss[i - 1]))
-    for i in range(len(w) - 2, -1, -1):
-        w[i] = min(w[i], w[i + 1] + 2.0 * a * (ss[i + 1] - ss[i]))
+def _speed_limits(run: Run, V, J, period: float) -> np.ndarray:
+    """(n,) the squared speed limit at each grid point (before erosion)."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        terms = [run.cap ** 2,
+                 np.min((V / np.abs(run.T)) ** 2, axis=1),
+                 np.min((D_SHARE * J / run.D) ** (2.0 / 3.0), axis=1),
+                 np.min(JOIN_SHARE * J * period / run.jump, axis=1)]
+    return np.nan_to_num(np.min(terms, axis=0), nan=math.inf, posinf=math.inf)
 
 
-@njit(cache=True, error_model="numpy")
-def _time_law(ss: np.ndarray, w: np.ndarray):
-    """t, v, a and the integral S on knots ``ss`` of squared speeds ``w`` (v^2 linear in s
-    between knots: constant acceleration)."""
-    n = len(ss)
-    v = np.sqrt(np.maximum(w, 0.0))
-    t, a, S = np.zeros(n), np.zeros(n), np.zeros(n)
-    for i in range(n - 1):
-        h = ss[i + 1] - ss[i]
-        dt = 2.0 * h / (v[i] + v[i + 1])
-        a[i] = (w[i + 1] - w[i]) / (2.0 * h)
-        t[i + 1] = t[i] + dt
-        S[i + 1] = S[i] + (ss[i] * dt + v[i] * dt ** 2 / 2.0 + a[i] * dt ** 3 / 6.0)
-    return t, v, a, S
+def _plan_once(run: Run, wl: np.ndarray, V, A, J, period: float, window: float):
+    """One plan of the run with averaging ``window``: t, w, u, v, a, S and per knot the
+    window needed."""
+    s = run.s
+    wl_e = topp.erode(s, wl, window)
+    top = float(np.sqrt(np.max(wl_e[np.isfinite(wl_e)], initial=0.0)))
+    reach = top * window
+    t_lo, t_hi = topp.boxes(s, run.T, reach)
+    k_lo, k_hi = topp.boxes(s, run.K, reach)
+    Tc, Tr = 0.5 * (t_lo + t_hi), 0.5 * (t_hi - t_lo)
+    Kc, Kr = 0.5 * (k_lo + k_hi), 0.5 * (k_hi - k_lo)
+    Kmax = np.maximum(np.abs(k_lo), np.abs(k_hi))
+    C = CORIOLIS_SHARE * J
+    w, u = topp.passes(s, wl_e, Tc, Tr, Kc, Kr, Kmax, A, C)
+    t, v, a, S = topp.time_law(s, w, u)
+    with np.errstate(invalid="ignore", over="ignore"):
+        static = (run.D * np.minimum(wl_e, top * top)[:, None] ** 1.5
+                  + run.jump * np.minimum(wl_e, top * top)[:, None] / period
+                  + run.kink * np.sqrt(np.minimum(wl_e, top * top))[:, None] / period ** 2)
+    static = topp.boxes(s, np.nan_to_num(static, nan=0.0), reach)[1]
+    Tabs = np.maximum(np.abs(t_lo), np.abs(t_hi))
+    need = topp.window_needed(t, v, a, Tabs, Kmax, static, J, C, window)
+    return t, w, u, v, a, S, need
 
 
-def plan_piece(piece: Piece, machine: Machine) -> Profile:
-    """The jerk-limited profile of one piece, from rest to rest (see the module doc)."""
-    A = MARGIN * np.asarray(machine.max_acceleration)
-    J = MARGIN * np.asarray(machine.max_jerk)
-    V = MARGIN * np.asarray(machine.max_velocity)
-    T, K, D = derivatives(piece.points, piece.s)
-    share = CURVATURE_SHARE if K.any() or D.any() else 0.0
-    t_max = T.max(axis=0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        a_t = float(np.min((1.0 - share) * A / t_max))
-        j_t = float(np.min((1.0 - share) * J / t_max))
-        limits = [np.full(len(T), piece.cap), np.min(V / T, axis=1)]
-        if share:
-            cA, cJ = share * A, share * J
-            limits += [np.min(np.sqrt(cA / K), axis=1), np.min(np.cbrt(cJ / (2.0 * D)), axis=1),
-                       np.min(cJ / (6.0 * K * a_t), axis=1)]
-    if piece.step_cap is not None:
-        limits.append(piece.step_cap)
-    v_lim = np.nan_to_num(np.min(limits, axis=0), nan=math.inf)
-    window = 2.0 * a_t / j_t
-    reach = float(np.max(v_lim)) * window
-    s = piece.s
-    lo = np.maximum(np.searchsorted(s, s - reach, side="left") - 1, 0)
-    hi = np.minimum(np.searchsorted(s, s + reach, side="right") + 1, len(s))
-    v_lim = _range_min(v_lim, lo, hi)
-    ss, vv, _ = _knotted(piece, v_lim)
-    w = vv ** 2
-    w[0] = w[-1] = 0.0   # from rest, to rest
-    _passes(ss, w, a_t)
-    t, v, a, S = _time_law(ss, w)
-    return Profile(t, ss, v, a, S, window, v_lim)
+def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
+    """The jerk-limited, near time-optimal profile of one run (see the module doc);
+    ``derate`` (3,) scales the velocity, acceleration and jerk used."""
+    V, A, J = _limits(machine, derate)
+    wl = _speed_limits(run, V, J, machine.period)
+    window = float(np.max(A / J))
+    for round_ in range(WINDOW_ROUNDS):
+        t, w, u, v, a, S, need = _plan_once(run, wl, V, A, J, machine.period, window)
+        top = float(np.max(need, initial=0.0))
+        if top <= window:
+            break
+        if round_ < FLATTEN_ROUNDS and topp.flatten(run.s, t, w, u, wl, need, window):
+            continue
+        if not math.isfinite(top):
+            raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: the "
+                            "curvature leaves no jerk for the feed to change (limits "
+                            f"{machine.summary()})")
+        window = top
+    else:
+        raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: no "
+                        f"averaging window keeps the jerk within {machine.summary()}")
+    keep = np.r_[np.diff(run.s) > 0.0, True]
+    return Profile(t[keep], run.s[keep], v[keep], a[keep], S[keep], window)
 
 
-def constant_piece(piece: Piece, machine: Machine) -> Profile:
-    """The piece at its programmed speed throughout (rapids at the axes' velocity), no
-    ramp, no limit: what a stream ignoring the machine does."""
+def _constant_run(first: int, piece: Piece, machine: Machine) -> tuple[Run, Profile]:
+    """The piece alone, at its programmed speed throughout (rapids at the axes' velocity),
+    no ramp, no limit: what a stream ignoring the machine does."""
     v = constant_speed(piece, machine)
-    ss = np.array([0.0, piece.length])
-    t, vv, a, S = _time_law(ss, np.array([v * v, v * v]))
-    return Profile(t, ss, vv, a, S, 0.0, np.full(len(piece.s), v))
+    s = np.array([0.0, piece.length])
+    w = np.array([v * v, v * v])
+    t, vv, a, S = topp.time_law(s, w, np.zeros(1))
+    empty = np.zeros((2, 3))
+    run = Run(first, [piece], s.copy(), s, empty, empty, empty, empty, empty, np.full(2, v))
+    return run, Profile(t, s, vv, a, S, 0.0)
 
 
 @dataclass
 class FeedPlan:
-    """Every piece's profile, back to back in time: piece k starts at ``starts[k]`` s."""
+    """Every run's profile, back to back in time: run k starts at ``starts[k]`` s."""
 
     pieces: list
+    runs: list[Run]
     profiles: list[Profile]
     machine: Machine
     planned: bool = True   # False: at the programmed feed, the limits ignored
@@ -255,26 +216,39 @@ class FeedPlan:
         """Periods to the end: the stream has periods + 1 positions (the start at t = 0)."""
         return int(math.ceil(self.duration / self.machine.period - 1e-9))
 
-    def targets(self) -> tuple[np.ndarray, np.ndarray]:
+    def targets(self, max_periods: int = MAX_PERIODS) -> tuple[np.ndarray, np.ndarray]:
         """Per position n = 0..periods (time n Ts): the piece and the arc length in it."""
         n = self.periods
-        if n > MAX_PERIODS:
-            raise InputError(f"the stream would need {n} periods (over {MAX_PERIODS}): a "
-                             "limit or the feed is far too small")
+        if n > max_periods:
+            raise InputError(f"the stream would need {n} periods ({self.duration:.1f} s at "
+                             f"{self.machine.period * 1e3:g} ms), over the limit of "
+                             f"{max_periods}: raise --max-periods, or check the feed and "
+                             "the machine's limits")
         times = np.arange(n + 1) * self.machine.period
         starts = self.starts
-        k = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, len(self.pieces) - 1)
+        r = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, len(self.runs) - 1)
+        piece = np.empty(n + 1, dtype=np.int64)
         s = np.empty(n + 1)
-        for j in np.unique(k):
-            sel = k == j
-            s[sel] = self.profiles[j].position(times[sel] - starts[j])
-        return k, s
+        for j in np.unique(r):
+            sel = np.flatnonzero(r == j)
+            run = self.runs[j]
+            at = self.profiles[j].position(times[sel] - starts[j])
+            k = np.clip(np.searchsorted(run.offsets, at, side="right") - 1, 0,
+                        len(run.pieces) - 1)
+            piece[sel] = run.first + k
+            lengths = np.diff(run.offsets)
+            s[sel] = np.clip(at - run.offsets[k], 0.0, lengths[k])
+        return piece, s
 
 
-def plan_feed(pieces: list[Piece], machine: Machine, planned: bool = True) -> FeedPlan:
-    """The plan of every piece: to the machine's limits, or (``planned=False``) at the
-    programmed feed ignoring them."""
+def plan_feed(pieces: list[Piece], machine: Machine, planned: bool = True,
+              derate=(1.0, 1.0, 1.0)) -> FeedPlan:
+    """The plan of every run: to the machine's limits (each scaled by ``derate``: v, a,
+    j), or (``planned=False``) every piece at the programmed feed ignoring them."""
     if not pieces:
         raise InputError("the program has nothing to stream (no cut or move)")
-    make = plan_piece if planned else constant_piece
-    return FeedPlan(pieces, [make(p, machine) for p in pieces], machine, planned)
+    if not planned:
+        pairs = [_constant_run(k, p, machine) for k, p in enumerate(pieces)]
+        return FeedPlan(pieces, [r for r, _ in pairs], [p for _, p in pairs], machine, False)
+    runs = runs_of(pieces, machine)
+    return FeedPlan(pieces, runs, [plan_run(r, machine, derate) for r in runs], machine, True)

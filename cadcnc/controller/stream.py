@@ -23,7 +23,7 @@ from ..errors import GeometryError
 from ..interp.cycle import CLOSED, END
 from ..interp.follow import follow
 from ..program.program import Program
-from .feed_plan import FeedPlan, plan_feed
+from .feed_plan import MAX_PERIODS, FeedPlan, PlanError, plan_feed
 from .machine import AXES, Machine
 from .pieces import Piece, pieces_of, programmed_time
 
@@ -137,20 +137,16 @@ def follow_plan(piece: Piece, s: np.ndarray) -> np.ndarray:
     return plan
 
 
-def _kernel(stepper, piece: Piece, s: np.ndarray, what: str) -> np.ndarray:
-    """Positions at arc lengths ``s`` (nondecreasing) from ``stepper`` on the piece's cut.
-
-    Each period commands the step target - travelled (the stepper follows the plan in
-    the kernel's compiled loop: :func:`cadcnc.interp.follow.follow`), the target being
-    the planned arc length as the kernel's chord sum. The kernel's path is a few 1e-7 of
-    its length longer or shorter than the program's points say: over the last BLEND mm
-    the target moves smoothly onto the distance left to the cut's last point, so the
-    stream lands on it without a jump."""
-    end = piece.points[-1]
-    out = follow(stepper, follow_plan(piece, s), end, float(piece.kappa[-1]), LANDING)
+def _landed(stepper, piece: Piece, out: np.ndarray, what: str) -> np.ndarray:
+    """``out`` once the stepper has landed on the cut's last point (GeometryError if it
+    stopped on the way or missed it): the kernel's path is a few 1e-7 of its length longer
+    or shorter than the program's points say, so over the last BLEND mm the target moves
+    smoothly onto the distance left to the end, and the rest of the cut may lie between
+    two periods."""
     if stepper.stop_reason not in (None, END, CLOSED):
         raise GeometryError(f"{what}: the stepper stopped while streaming "
                             f"({stepper.stop_reason}: {stepper.stop_detail})")
+    end = piece.points[-1]
     p = np.asarray(stepper.p)
     to_feed = 60.0 / stepper.period
     for _ in range(3):   # the rest of the cut lies between two periods: land on its end
@@ -165,16 +161,90 @@ def _kernel(stepper, piece: Piece, s: np.ndarray, what: str) -> np.ndarray:
     return out
 
 
+Progress = Callable[[int, int], None]
+"""progress(periods done, periods in all), called at least every CHUNK periods."""
+CHUNK = 100_000   # periods the kernel follows between two progress calls
+SLACK = 1e-6      # relative: the finite differences' allowance over a limit
+REPLANS = 2       # plans again with the limit that was broken lowered by as much ...
+NOISE = 1.5       # ... unless it is broken this much: the positions' noise, not the plan
+
+
+def _over(positions: np.ndarray, machine: Machine) -> list[tuple[float, int, int]]:
+    """Per quantity (velocity, acceleration, jerk): the largest finite-difference share
+    of the axis's limit, its period and its axis."""
+    ts, out = machine.period, []
+    for k, lim in enumerate((machine.max_velocity, machine.max_acceleration,
+                             machine.max_jerk), start=1):
+        if len(positions) <= k:
+            out.append((0.0, 0, 0))
+            continue
+        share = np.abs(np.diff(positions, k, axis=0)) / ts ** k / np.asarray(lim)
+        row, axis = np.unravel_index(int(np.argmax(share)), share.shape)
+        out.append((float(share[row, axis]), int(row) + k, int(axis)))
+    return out
+
+
+def _refusal(over: list[tuple[float, int, int]], machine: Machine) -> PlanError:
+    names = ("velocity", "acceleration", "jerk")
+    q = max(range(3), key=lambda i: over[i][0])
+    share, row, axis = over[q]
+    return PlanError(
+        f"the planned stream would reach {100 * share:.1f} % of axis {AXES[axis]}'s "
+        f"{names[q]} limit at period {row} (the positions' own noise at a "
+        f"{machine.period * 1e6:g} us period, or limits the path cannot meet): refused; "
+        "a longer servo period or a lower jerk limit may stream")
+
+
+def _cut_rows(stepper, piece: Piece, s: np.ndarray, what: str, done: int, total: int,
+              progress: Progress | None) -> np.ndarray:
+    """The kernel's positions of one cut, CHUNK periods at a time (progress between)."""
+    plan = follow_plan(piece, s)
+    out = np.empty((len(s), 3))
+    for a in range(0, len(s), CHUNK):
+        b = min(a + CHUNK, len(s))
+        out[a:b] = follow(stepper, plan[a:b], piece.points[-1], float(piece.kappa[-1]),
+                          LANDING)
+        if progress is not None:
+            progress(done + b, total)
+    return _landed(stepper, piece, out, what)
+
+
 def stream_program(program: Program, machine: Machine, steppers: StepperFactory | None = None,
-                   *, feed: float | None = None, planned: bool = True) -> Stream:
+                   *, feed: float | None = None, planned: bool = True,
+                   max_periods: int = MAX_PERIODS, progress: Progress | None = None) -> Stream:
     """Every period's position of ``program`` on ``machine`` (see the module doc).
 
     ``feed`` (mm/min) replaces the program's feed; ``planned=False`` streams at the
-    programmed feed ignoring the limits (a comparison, not for a machine)."""
+    programmed feed ignoring the limits (a comparison, not for a machine). A plan over
+    ``max_periods`` periods is refused before any position is computed (InputError);
+    ``progress(done, total)`` hears of the work at least every CHUNK periods. A planned
+    stream whose finite differences break a limit is planned again with that limit
+    lowered by as much (REPLANS times at most), then refused (PlanError)."""
     pieces = pieces_of(program, machine, feed)
-    plan = plan_feed(pieces, machine, planned)
-    rows, s = plan.targets()
-    positions = np.empty((len(s), 3))
+    derate = np.ones(3)
+    for _ in range(REPLANS + 1):
+        stream = _stream(program, machine, pieces, steppers, planned, derate, max_periods,
+                         progress)
+        if not planned:
+            return stream
+        over = _over(stream.positions, machine)
+        shares = np.array([o[0] for o in over])
+        if (shares <= 1.0 + SLACK).all():
+            return stream
+        if shares.max() > NOISE:
+            break
+        # the path's derivatives between coarse points: plan again with less of the limit
+        derate = np.where(shares > 1.0, derate / (shares * (1.0 + 1e-3)), derate)
+    raise _refusal(over, machine)
+
+
+def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
+            progress) -> Stream:
+    """One plan (limits scaled by ``derate``) and its positions."""
+    plan = plan_feed(pieces, machine, planned, tuple(derate))
+    rows, s = plan.targets(max_periods)
+    total = len(s)
+    positions = np.empty((total, 3))
     cuts = program.cuts
     kernel = hermite = 0
     for j, piece in enumerate(pieces):
@@ -188,10 +258,14 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
             positions[sel] = _hermite(piece, s[sel])
             hermite += 1
             continue
-        positions[sel] = _kernel(stepper, piece, s[sel], f"cut {piece.cut + 1}")
+        done = int(sel[0]) if len(sel) else 0
+        positions[sel] = _cut_rows(stepper, piece, s[sel], f"cut {piece.cut + 1}", done,
+                                   total, progress)
         kernel += 1
     positions[0] = pieces[0].points[0]
     positions[-1] = pieces[-1].points[-1]
+    if progress is not None:
+        progress(total, total)
     return Stream(positions, plan, programmed_time(pieces, machine), rows, kernel, hermite)
 
 

@@ -84,3 +84,37 @@ class BoxTree:
                 else:
                     stack.append((kid, dist))
         return best
+
+    def rho_above(self, p, z0: float, need: float) -> float | None:
+        """A lower bound >= ``need`` (mm) of the horizontal distance from ``p`` to the
+        face's points above the height ``z0``, or None when the boxes cannot prove one
+        (math.inf when no box reaches above z0). Boxes whose top is at most z0 drop out;
+        the others nearer than ``need`` horizontally are halved (at most ``DEPTH`` times,
+        ``VISITS`` boxes): the height cells' proof (:mod:`.cells`) on finer boxes."""
+        px, py = float(p[0]), float(p[1])
+        lo, hi = self.top[:, 0:3], self.top[:, 3:6]
+        gap = np.maximum(np.maximum(lo[:, :2] - (px, py), (px, py) - hi[:, :2]), 0.0)
+        d = np.sqrt((gap * gap).sum(axis=1))
+        above = hi[:, 2] > z0
+        far = above & (d >= need)
+        best = float(d[far].min()) if far.any() else math.inf
+        nw = len(self.ws) - 1
+        stack = [(self.us[i // nw], self.us[i // nw + 1], self.ws[i % nw], self.ws[i % nw + 1], 0)
+                 for i in np.nonzero(above & ~far)[0].tolist()]
+        visits = 0
+        while stack:
+            node = stack.pop()
+            if node[4] == DEPTH or visits > VISITS:
+                return None
+            for kid, b in self._children(node):
+                visits += 1
+                if b[5] <= z0:
+                    continue
+                dx = max(b[0] - px, px - b[3], 0.0)
+                dy = max(b[1] - py, py - b[4], 0.0)
+                dist = math.sqrt(dx * dx + dy * dy)
+                if dist >= need:
+                    best = min(best, dist)
+                else:
+                    stack.append(kid)
+        return best

@@ -37,23 +37,15 @@ import weakref
 
 import numba
 import numpy as np
-from OCP.Bnd import Bnd_Box
-from OCP.BndLib import BndLib_AddSurface
-from OCP.GeomAbs import GeomAbs_BSplineCurve
 from scipy.spatial import cKDTree
 
 from ..trim import OUTSIDE
 from .clearance import distance
+from .face_boxes import BOUNDED_KINDS, CELL_MM, MAX_CELLS, SLACK, FaceBoxes, bounded, face_cells
 
-CELL_MM = 1.0
-"""About this many mm of surface per cell side (at most ``MAX_CELLS`` cells)."""
-MAX_CELLS = 20_000
-SLACK = 1e-4
-"""mm added to every cell box (OCCT's boxes are computed in floating point)."""
-BOUNDED_KINDS = ("bspline", "bezier", "plane", "cylinder", "cone", "sphere", "torus",
-                 "extrusion")
-"""Surface kinds whose cell boxes OCCT computes from control points or closed forms (an
-extrusion: from its curve's)."""
+__all__ = ["BOUNDED_KINDS", "CELL_MM", "MAX_CELLS", "SLACK", "FaceBoxes", "bounded",
+           "face_cells", "HeightCells", "shared", "DROPS", "SEARCH", "REUSE"]
+
 DROPS = (2.0, 1.0, 0.5, 0.2, 0.0)
 """mm: a proof cached at p0 counts the cells above p0_z - drop (it holds for centres down
 to that height); the drop that gives the largest budget is kept."""
@@ -64,149 +56,6 @@ REUSE = 0.3
 give more)."""
 MAX_BUCKETS = 200_000
 _DROPS = np.array(DROPS)
-
-
-def face_cells(face, cell_mm: float) -> tuple[np.ndarray, np.ndarray]:
-    """The (u, w) grid lines of about ``cell_mm`` cells over a face's box (at most
-    ``MAX_CELLS`` cells): (us, ws)."""
-    (u0, u1), (w0, w1) = face.u_range, face.w_range
-    lu, lw = face.parameter_lengths()
-    nu = max(1, math.ceil(lu / cell_mm))
-    nw = max(1, math.ceil(lw / cell_mm))
-    if nu * nw > MAX_CELLS:
-        f = math.sqrt(nu * nw / MAX_CELLS)
-        nu, nw = max(1, int(nu / f)), max(1, int(nw / f))
-    return np.linspace(u0, u1, nu + 1), np.linspace(w0, w1, nw + 1)
-
-
-def _poles_2d(array) -> np.ndarray:
-    """(rows, cols, 3) of an OCCT TColgp_Array2OfPnt."""
-    return np.array([[array.Value(i, j).Coord() for j in range(array.LowerCol(),
-                                                             array.UpperCol() + 1)]
-                     for i in range(array.LowerRow(), array.UpperRow() + 1)])
-
-
-def _support(flat: np.ndarray, degree: int, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(first, last) pole index (0-based) of the basis functions not zero on each span
-    [cuts[i], cuts[i + 1]] of a B-spline with the flat knot sequence ``flat``: function j
-    lives on (flat[j], flat[j + degree + 1])."""
-    n_poles = len(flat) - degree - 1
-    first = np.searchsorted(flat[degree + 1:degree + 1 + n_poles], cuts[:-1], side="right")
-    last = np.searchsorted(flat[:n_poles], cuts[1:], side="left") - 1
-    return first, np.maximum(last, first)
-
-
-class FaceBoxes:
-    """Boxes of a face's surface over (u, w) ranges, widened by SLACK. A B-spline surface
-    (or an extrusion of a B-spline curve) is cut to the range (``Segment``, exact knot
-    insertion) and boxed by the control points of that piece: the convex hull property,
-    tight as the range shrinks. Other kinds: OCCT's ``BndLib_AddSurface.Add``."""
-
-    def __init__(self, face):
-        self.face, self.surface, self.curve = face, None, None
-        try:
-            if face.kind == "bspline":
-                self.surface = face._adaptor.BSpline()
-            elif face.kind == "extrusion" and face._adaptor.BasisCurve().GetType() == \
-                    GeomAbs_BSplineCurve:
-                self.curve = face._adaptor.BasisCurve().BSpline()
-                self.axis = np.array(face._adaptor.Direction().Coord())
-        except Exception:   # noqa: BLE001 - any trouble: OCCT's generic boxes
-            self.surface = self.curve = None
-        if not self._agrees():
-            self.surface = self.curve = None
-
-    def _agrees(self) -> bool:
-        """Whether the B-spline evaluates as the face (no placement left out)."""
-        if self.surface is None and self.curve is None:
-            return True
-        (u0, u1), (w0, w1) = self.face.u_range, self.face.w_range
-        for u in np.linspace(u0, u1, 3):
-            for w in np.linspace(w0, w1, 3):
-                got = np.array(self.surface.Value(u, w).Coord()) if self.surface is not None \
-                    else np.array(self.curve.Value(u).Coord()) + w * self.axis
-                if np.linalg.norm(got - self.face.point(u, w)) > 1e-9:
-                    return False
-        return True
-
-    def box(self, u0: float, u1: float, w0: float, w1: float) -> tuple:
-        """(xmin, ymin, zmin, xmax, ymax, zmax) containing the surface over the range."""
-        try:
-            return self._box(u0, u1, w0, w1)
-        except Exception:   # noqa: BLE001 - OCCT refused the cut (a range past the knots)
-            return self._generic_box(u0, u1, w0, w1)
-
-    def _generic_box(self, u0: float, u1: float, w0: float, w1: float) -> tuple:
-        """OCCT's box of the face's surface over the range (any kind), widened by SLACK."""
-        b = Bnd_Box()
-        BndLib_AddSurface.Add_s(self.face._adaptor, u0, u1, w0, w1, 0.0, b)
-        x0, y0, z0, x1, y1, z1 = b.Get()    # floats: numpy's overhead was 4/5 of a cell's time
-        return (min(x0, x1) - SLACK, min(y0, y1) - SLACK, min(z0, z1) - SLACK,
-                max(x0, x1) + SLACK, max(y0, y1) + SLACK, max(z0, z1) + SLACK)
-
-    def _box(self, u0: float, u1: float, w0: float, w1: float) -> tuple:
-        if self.surface is None and self.curve is None:
-            return self._generic_box(u0, u1, w0, w1)
-        if self.surface is not None:
-            piece = self.surface.Copy()
-            piece.Segment(u0, u1, w0, w1)
-            pts = _poles_2d(piece.Poles()).reshape(-1, 3)
-        elif self.curve is not None:
-            piece = self.curve.Copy()
-            piece.Segment(u0, u1)
-            poles = piece.Poles()
-            base = np.array([poles.Value(i).Coord()
-                             for i in range(poles.Lower(), poles.Upper() + 1)])
-            pts = np.vstack([base + w0 * self.axis, base + w1 * self.axis])
-        lo, hi = pts.min(axis=0) - SLACK, pts.max(axis=0) + SLACK
-        return (*lo.tolist(), *hi.tolist())
-
-    def grid(self, us: np.ndarray, ws: np.ndarray) -> np.ndarray:
-        """(len(us) - 1, len(ws) - 1, 6) the boxes of every cell of the grid: for a
-        B-spline surface, one refinement (every grid line inserted as a knot, then the
-        control points that live on each cell: the same as ``box`` cell by cell); else
-        ``box`` per cell."""
-        if self.surface is None or self.surface.IsUPeriodic() or self.surface.IsVPeriodic():
-            return self._cell_by_cell(us, ws)
-        try:
-            return self._refined(us, ws)
-        except Exception:   # noqa: BLE001 - OCCT refused a knot: box cell by cell
-            return self._cell_by_cell(us, ws)
-
-    def _cell_by_cell(self, us: np.ndarray, ws: np.ndarray) -> np.ndarray:
-        return np.array([[self.box(us[i], us[i + 1], ws[j], ws[j + 1])
-                          for j in range(len(ws) - 1)] for i in range(len(us) - 1)])
-
-    def _refined(self, us: np.ndarray, ws: np.ndarray) -> np.ndarray:
-        from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
-        piece = self.surface.Copy()
-        # a face's range can pass its surface's knots by round-off (a relative 2e-16):
-        # OCCT refuses a knot outside them
-        u_lo, u_hi, w_lo, w_hi = piece.Bounds()
-        us, ws = np.clip(us, u_lo, u_hi), np.clip(ws, w_lo, w_hi)
-        for cuts, insert, degree in ((us, piece.InsertUKnots, piece.UDegree()),
-                                     (ws, piece.InsertVKnots, piece.VDegree())):
-            knots, mults = TColStd_Array1OfReal(1, len(cuts)), TColStd_Array1OfInteger(
-                1, len(cuts))
-            for k, c in enumerate(cuts, start=1):
-                knots.SetValue(k, float(c))
-                mults.SetValue(k, degree)
-            insert(knots, mults, 0.0, False)
-        poles = _poles_2d(piece.Poles())
-        fu, lu = _support(_flat(piece.UKnotSequence()), piece.UDegree(), us)
-        fw, lw = _support(_flat(piece.VKnotSequence()), piece.VDegree(), ws)
-        out = np.empty((len(us) - 1, len(ws) - 1, 6))
-        for i in range(len(us) - 1):
-            strip = poles[fu[i]:lu[i] + 1]
-            lo_i, hi_i = strip.min(axis=0), strip.max(axis=0)      # (cols, 3)
-            for j in range(len(ws) - 1):
-                out[i, j, :3] = lo_i[fw[j]:lw[j] + 1].min(axis=0) - SLACK
-                out[i, j, 3:] = hi_i[fw[j]:lw[j] + 1].max(axis=0) + SLACK
-        return out
-
-
-def _flat(seq) -> np.ndarray:
-    return np.array([seq.Value(k) for k in range(seq.Lower(), seq.Upper() + 1)])
 
 
 @numba.njit(cache=True, nogil=True)

@@ -161,7 +161,8 @@ class ClearanceGuard:
             else:
                 m = self._own_bound(k, p)
                 if m is None or m < 0.0:
-                    d_seg, d_p = self._segment_distance(k, p)[0], self._point_distance(k, p)
+                    d_p = self._point_distance(k, p)
+                    d_seg = self._segment_distance(k, p, None, d_p)[0]   # cap: d_p
                     # an unknown distance fails closed (-inf is a hit, never an inf margin)
                     m = d_seg - (d_p - self.tol) if math.isfinite(d_seg + d_p) else -math.inf
             m_edge = self._own_edge_margin(k, p)
@@ -179,16 +180,33 @@ class ClearanceGuard:
         return m, "ball" if below or self._point_distance(k, p) < self.threshold \
             else "shank"
 
-    def _segment_distance(self, k: int, p, length: float | None = None) -> tuple[float, bool]:
+    def _segment_distance(self, k: int, p, length: float | None = None,
+                          cap: float | None = None) -> tuple[float, bool]:
         """(distance mm from the segment p .. p + length z (default L) to face k, whether
         every nearest point of the face lies on an edge or vertex of face i or j): in
         closed form for an analytic face whose foot is inside it (then not on an edge);
         for a third face whose distance to its whole surface already clears R' - tol, that
-        distance (a lower bound: the margin stays >= 0); else OCCT's."""
+        distance (a lower bound: the margin stays >= 0); else OCCT's, of the segment
+        clipped to the face box's heights widened by ``cap`` (default R' + reach: a
+        larger distance is only ever compared with R' - tol, or cached for moves shorter
+        than reach, after which the broad phase runs again): a point of
+        the segment further than ``cap`` above or below the box is further than ``cap``
+        (its box distance, ``cut``) from the face, so the distance is exact when it is at
+        most ``cut``, and ``cut`` (a lower bound) otherwise. The own-face rule passes cap =
+        d(p, face), which the segment's own foot p reaches: exact there."""
         length = self.shank if length is None else length
         d = self._closed_segment_distance(k, p, length)
         if d is not None:
             return d, False
+        cap = self.offset + self.reach if cap is None else cap
+        lo, hi = self._lo[k - 1], self._hi[k - 1]
+        z0, z1 = max(p[2], lo[2] - cap), min(p[2] + length, hi[2] + cap)
+        # the part cut off is at least cap from the box's heights: its box distance
+        cut = math.hypot(cap, math.hypot(max(lo[0] - p[0], p[0] - hi[0], 0.0),
+                                         max(lo[1] - p[1], p[1] - hi[1], 0.0))) \
+            if z0 > p[2] or z1 < p[2] + length else math.inf
+        if z1 < z0:   # the whole segment is further than cap from the face
+            return cut, False
         self.exact_calls += 1
         face = self._faces[k - 1].topods
         if self._analytic[k - 1].kind == "plane" and k not in self.pair:
@@ -198,12 +216,14 @@ class ClearanceGuard:
             face = self._free_edges(k)
             if face is None:
                 return math.inf, False
-        a = gp_Pnt(*p)
-        shape = BRepBuilderAPI_MakeEdge(a, gp_Pnt(p[0], p[1], p[2] + length)).Edge() \
-            if length > 0.0 else BRepBuilderAPI_MakeVertex(a).Vertex()
+        a = gp_Pnt(p[0], p[1], z0)
+        shape = BRepBuilderAPI_MakeEdge(a, gp_Pnt(p[0], p[1], z1)).Edge() \
+            if z1 > z0 else BRepBuilderAPI_MakeVertex(a).Vertex()
         ext = BRepExtrema_DistShapeShape(shape, face)
         if not ext.IsDone() or ext.NbSolution() == 0:
             return -math.inf, False  # fail closed: an unknown distance is a hit
+        if ext.Value() > cut:
+            return cut, False
         own = all(ext.SupportTypeShape2(n) != BRepExtrema_IsInFace
                   and self._own_shapes.Contains(ext.SupportOnShape2(n))
                   for n in range(1, ext.NbSolution() + 1))

@@ -336,7 +336,9 @@ class Stepper:
     def _landing(self, f: float) -> Vec | None:
         """Land exactly on the end point when it is within this step (shortened last step)."""
         end = self.end
-        if end is None or self.travelled < 2.0 * f:
+        # not before twice the step and twice the end tolerance: steps of a few nm (a
+        # short servo period from rest) would otherwise find a closed path's end at once
+        if end is None or self.travelled < 2.0 * max(f, self.tol.end_reached):
             return None
         d = sub(end.p, self.p)
         dist = norm(d)

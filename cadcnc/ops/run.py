@@ -9,7 +9,6 @@ from ..job import Finish, Job, PairPath, Pencil
 from ..program.program import Program
 from ..work import MAX_CYCLES
 from ..workers import start
-from .finish.finish import JOIN, finish_program
 from .path.pair_program import program_for_job
 from .pencil.pencil import CHAIN_GAP, pencil_program
 
@@ -41,6 +40,9 @@ def run(part, job: Job, *, progress=None, times: dict | None = None,
         return pencil_program(part, job, progress=progress, times=times,
                               max_cycles=max_cycles, jobs=jobs)
     if isinstance(op, Finish):
+        # finishing's modules and scipy.optimize: about 0.5 s CPU a path or pencil doesn't pay
+        from .finish.finish import finish_program  # noqa: PLC0415
+
         return finish_program(part, job, progress=progress, jobs=jobs)
     raise InputError(f"unknown operation {type(op).__name__}")
 
@@ -50,7 +52,11 @@ def cut_back_gap(job: Job) -> float | None:
     are cut back to their last verified point (pencil, finish), or None: a path follows
     the pair the user named and is judged whole."""
     op = job.operation
-    return CHAIN_GAP if isinstance(op, Pencil) else JOIN if isinstance(op, Finish) else None
+    if isinstance(op, Finish):
+        from .finish.finish import JOIN  # noqa: PLC0415 - as in run: finishing's modules
+
+        return JOIN
+    return CHAIN_GAP if isinstance(op, Pencil) else None
 
 
 def check_clearance(part: Part, job: Job) -> None:

@@ -324,7 +324,7 @@ def begin(F: np.ndarray, I: np.ndarray, S: np.ndarray, R: np.ndarray, n_rec: int
     failure = track(S)
     f = f_cmd if S[TR_OK] == 0.0 else accurate(S, f_cmd)
     S[F_TRIAL] = f
-    if S[HAS_END] != 0.0 and S[TRAVELLED] >= 2.0 * f:
+    if S[HAS_END] != 0.0 and S[TRAVELLED] >= 2.0 * max(f, S[TOL_END]):   # see stepper
         d = sub(vec(S, END_P), vec(S, P))
         dist = norm(d)
         if dist <= S[TOL_END]:

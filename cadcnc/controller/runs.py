@@ -1,0 +1,192 @@
+"""A program's pieces grouped into runs: the stretches the planner moves through without
+stopping, and the path's derivatives along each run (no OCCT).
+
+Pieces meet at rest only where the path needs it: at a corner, where the tangent turns so
+much that passing it at any speed worth having would jolt an axis in one servo period.
+Tangent-continuous joins (a collinear rapid and plunge, a cut flowing into the next cut)
+stay inside one run, at the speed the sampled jerk and acceleration allow there.
+
+A run's grid is its pieces' points end to end in arc length (a straight move cut into
+knots of at most LINE_KNOT mm); each join is a zero-length interval between the two
+pieces' own derivatives at it. Arrays per grid point: ``s`` (n,) mm from the run's start,
+``T``, ``K`` (n, 3) the signed path derivatives p', p'' in arc length, ``D`` (n, 3) |p'''|,
+``jump`` (n, 3) the curvature change (1/mm) taken in less than one knot (a curvature
+jump, apart from the smooth change ``D`` accounts for), ``kink`` (n, 3) the change of the
+unit tangent at a join; ``cap`` (n,) mm/s the programmed speed and the accuracy rule's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .machine import Machine
+from .pieces import Piece
+
+LINE_KNOT = 0.25       # mm: the largest knot of a straight move (the plan's resolution)
+LINE_KNOTS_MAX = 4000  # knots of one straight move at most
+MIN_KNOT = 1e-4        # mm: the shortest knot of a cut's grid
+STOP_SPEED = 1.0       # mm/s: a join slower than this is a stop at rest (a corner)
+JOIN_SHARE = 0.25
+"""Share of an axis's jerk (and acceleration) that the one-period jolt of a join or a
+curvature jump may take; the rest stays with the smooth motion around it."""
+
+
+@dataclass
+class Run:
+    """Pieces ``first``..``first + len(pieces) - 1`` of the program, moved through from
+    rest to rest; ``offsets`` (len(pieces) + 1,) where each starts in the run (mm)."""
+
+    first: int
+    pieces: list[Piece]
+    offsets: np.ndarray
+    s: np.ndarray
+    T: np.ndarray
+    K: np.ndarray
+    D: np.ndarray
+    jump: np.ndarray
+    kink: np.ndarray
+    cap: np.ndarray
+
+    @property
+    def length(self) -> float:
+        return float(self.offsets[-1])
+
+
+def _lagrange(p: np.ndarray, s: np.ndarray, at: int) -> tuple[np.ndarray, np.ndarray]:
+    """p' and p'' at point ``at`` (0 or 2) of the parabola through 3 points (3, 3)."""
+    s0, s1, s2 = s
+    x = s[at]
+    d0, d1, d2 = (s0 - s1) * (s0 - s2), (s1 - s0) * (s1 - s2), (s2 - s0) * (s2 - s1)
+    first = (p[0] * (2 * x - s1 - s2) / d0 + p[1] * (2 * x - s0 - s2) / d1
+             + p[2] * (2 * x - s0 - s1) / d2)
+    return first, 2.0 * (p[0] / d0 + p[1] / d1 + p[2] / d2)
+
+
+def end_derivatives(piece: Piece, end: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Unit tangent and p'' (1/mm) at the piece's start (``end`` False) or end."""
+    p, s = piece.points, piece.s
+    if len(p) < 3:
+        d = p[-1] - p[0]
+        return d / np.linalg.norm(d), np.zeros(3)
+    sl = slice(-3, None) if end else slice(0, 3)
+    t, k = _lagrange(p[sl], s[sl] - s[sl][0], 2 if end else 0)
+    return t / np.linalg.norm(t), k
+
+
+def join_speed(before: Piece, after: Piece, machine: Machine) -> tuple[float, np.ndarray,
+                                                                       np.ndarray]:
+    """The fastest pass through the join of two pieces (mm/s; 0: a corner) and the jumps
+    of the unit tangent and of p'' there ((3,) each).
+
+    In sampled time a tangent jump dt at speed v changes an axis's velocity by v |dt_i|
+    within one period: acceleration v |dt_i| / Ts and jerk v |dt_i| / Ts²; a jump dK of
+    p'' changes its acceleration by v² |dK_i|: jerk v² |dK_i| / Ts. Each stays within
+    JOIN_SHARE of the axis's limit."""
+    t0, k0 = end_derivatives(before, True)
+    t1, k1 = end_derivatives(after, False)
+    dt, dk = t1 - t0, k1 - k0
+    ts = machine.period
+    A, J = np.asarray(machine.max_acceleration), np.asarray(machine.max_jerk)
+    with np.errstate(divide="ignore"):
+        v = np.min(JOIN_SHARE * np.minimum(A * ts, J * ts * ts) / np.abs(dt))
+        v = min(v, float(np.min(np.sqrt(JOIN_SHARE * J * ts / np.abs(dk)))))
+    v = min(v, before.cap, after.cap)
+    return (0.0 if v < STOP_SPEED else float(v)), dt, dk
+
+
+def _line_grid(piece: Piece) -> np.ndarray:
+    n = int(min(max(math.ceil(piece.length / LINE_KNOT), 1), LINE_KNOTS_MAX))
+    return np.linspace(0.0, piece.length, n + 1)
+
+
+def _cut_derivatives(piece: Piece) -> tuple[np.ndarray, ...]:
+    """T, K (signed), D = |p'''| and the curvature jumps at the piece's points."""
+    p, s = piece.points, piece.s
+    n = len(p)
+    h = np.diff(s)
+    d1 = np.diff(p, axis=0) / h[:, None]
+    T = np.empty((n, 3))
+    T[1:-1] = (d1[:-1] * h[1:, None] + d1[1:] * h[:-1, None]) / (h[:-1] + h[1:])[:, None]
+    T[0], _ = end_derivatives(piece, False)
+    T[-1], _ = end_derivatives(piece, True)
+    T /= np.linalg.norm(T, axis=1)[:, None]
+    K = np.zeros((n, 3))
+    D = np.zeros((n, 3))
+    jump = np.zeros((n, 3))
+    if n >= 3:
+        K[1:-1] = 2.0 * np.diff(d1, axis=0) / (h[:-1] + h[1:])[:, None]
+        K[0], K[-1] = K[1], K[-2]
+        dk = np.abs(np.diff(K, axis=0))             # (n - 1, 3) per knot
+        D[:-1] = dk / h[:, None]
+        D[1:] = np.maximum(D[1:], D[:-1])
+        # a jump: a knot's change beyond both neighbours' (a smooth change is D's)
+        nb = np.zeros_like(dk)
+        nb[1:] = dk[:-1]
+        nb[:-1] = np.maximum(nb[:-1], dk[1:])
+        excess = np.maximum(dk - nb, 0.0)
+        jump[:-1] = excess
+        jump[1:] = np.maximum(jump[1:], excess)
+    return T, K, D, jump
+
+
+def _piece_grid(piece: Piece, machine: Machine):
+    """s, T, K, D, jump, cap at the grid points of one piece."""
+    if piece.cut is None and len(piece.points) == 2:
+        s = _line_grid(piece)
+        n = len(s)
+        t = (piece.points[1] - piece.points[0]) / piece.length
+        zero = np.zeros((n, 3))
+        return s, np.tile(t, (n, 1)), zero, zero.copy(), zero.copy(), np.full(n, piece.cap)
+    T, K, D, jump = _cut_derivatives(piece)
+    cap = np.full(len(piece.s), piece.cap)
+    if piece.step_cap is not None:
+        cap = np.minimum(cap, piece.step_cap)
+    keep = _knots(piece.s)
+    return piece.s[keep], T[keep], K[keep], D[keep], jump[keep], cap[keep]
+
+
+def _knots(s: np.ndarray) -> np.ndarray:
+    """Indices of the points kept as knots: none closer than MIN_KNOT to the one before
+    (a cut's last step may be a few nm: from rest to rest over it takes no finite time
+    on the grid), the first and the last always."""
+    keep = [0]
+    for i in range(1, len(s) - 1):
+        if s[i] - s[keep[-1]] >= MIN_KNOT:
+            keep.append(i)
+    if len(keep) > 1 and s[-1] - s[keep[-1]] < MIN_KNOT:
+        keep.pop()
+    keep.append(len(s) - 1)
+    return np.asarray(keep)
+
+
+def _run(first: int, pieces: list[Piece], machine: Machine, joins: list) -> Run:
+    grids = [_piece_grid(p, machine) for p in pieces]
+    offsets = np.r_[0.0, np.cumsum([p.length for p in pieces])]
+    s = np.concatenate([g[0] + o for g, o in zip(grids, offsets)])
+    T, K, D, jump, cap = (np.concatenate([g[i] for g in grids]) for i in range(1, 6))
+    kink = np.zeros_like(T)
+    at = 0
+    for g, join in zip(grids[:-1], joins):   # the join: last point of one, first of next
+        at += len(g[0])
+        v, dt, dk = join
+        kink[at - 1] = kink[at] = np.abs(dt)
+        jump[at - 1] = np.maximum(jump[at - 1], np.abs(dk))
+        jump[at] = np.maximum(jump[at], np.abs(dk))
+        cap[at - 1] = cap[at] = min(cap[at - 1], cap[at], v)
+    return Run(first, pieces, offsets, s, T, K, D, jump, kink, cap)
+
+
+def runs_of(pieces: list[Piece], machine: Machine) -> list[Run]:
+    """The pieces grouped into runs, each from rest to rest (see the module doc)."""
+    out, start, joins = [], 0, []
+    for k in range(1, len(pieces) + 1):
+        join = None if k == len(pieces) else join_speed(pieces[k - 1], pieces[k], machine)
+        if join is None or join[0] <= 0.0:
+            out.append(_run(start, pieces[start:k], machine, joins))
+            start, joins = k, []
+        else:
+            joins.append(join)
+    return out
