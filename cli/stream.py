@@ -156,7 +156,6 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
     from cadcnc.verification import gate_program
 
     outputs = OutputSet(outs, SUFFIXES, inputs=inputs) if outs else None
-    tick.stage = "planning the feed"
     stream = _planned_stream(program, machine, stepper_factory(part), tick, feed=feed,
                              planned=planned, max_periods=max_periods, quiet=quiet)
     tick.stage = "checking the stream against the machine's limits"
@@ -199,40 +198,23 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
 
 
 def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_periods, quiet):
-    """The stream, its periods estimated and bounded before the positions are computed,
-    progress reported (the planner's own ``max_periods`` and ``progress`` when it has
-    them; else the plan is made once more here to count the periods)."""
-    import inspect
-
+    """The stream: the planner refuses a plan over ``max_periods`` before computing any
+    position (exit 2); the periods and cycle time are said at its first progress call,
+    the progress then carried by the heartbeat."""
     from cadcnc.controller.stream import stream_program
-    from cadcnc.work import refuse_over
 
     said = []
 
-    def estimate(total: int) -> None:
-        refuse_over("the stream", total, max_periods, "servo periods",
-                    "raise the feed or the machine's limits, or give --max-periods N "
-                    f"(each 24 bytes in memory)")
-        if not quiet and not said:
-            say_error(f"cadcnc: stream: {total} periods of {machine.period * 1e3:g} ms "
-                      f"(cycle {total * machine.period:.3f} s) to compute")
+    def progress(done: int, total: int) -> None:   # total: positions, periods + 1
+        if not said and not quiet:
+            say_error(f"cadcnc: stream: {total - 1} periods of {machine.period * 1e3:g} ms "
+                      f"(cycle {(total - 1) * machine.period:.3f} s) to compute")
         said.append(total)
-        tick.stage = f"streaming {total} periods"
+        tick.stage = f"streaming: {done}/{total} positions"
 
-    kw = {"feed": feed, "planned": planned}
-    if "max_periods" in inspect.signature(stream_program).parameters:
-        def progress(done: int, total: int) -> None:
-            if not said:
-                estimate(total)
-            tick.stage = f"streaming: {done}/{total} periods"
-
-        return stream_program(program, machine, steppers, max_periods=max_periods,
-                              progress=progress, **kw)
-    from cadcnc.controller.feed_plan import plan_feed
-    from cadcnc.controller.pieces import pieces_of
-
-    estimate(plan_feed(pieces_of(program, machine, feed), machine, planned).periods)
-    return stream_program(program, machine, steppers, **kw)
+    tick.stage = "planning the feed"
+    return stream_program(program, machine, steppers, feed=feed, planned=planned,
+                          max_periods=max_periods, progress=progress)
 
 
 def _contents(positions, outputs) -> dict:
