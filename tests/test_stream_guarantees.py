@@ -247,3 +247,18 @@ def test_the_txt_is_checked_as_printed(program, tmp_path, monkeypatch):
     assert run.returncode == 5, run.stderr
     assert f"{txt}: acceleration of axis X" in run.stderr
     assert not npy.exists() and not txt.exists()
+
+
+@pytest.mark.slow   # about 10 s: the pocket's pencil program
+@pytest.mark.xfail(strict=True, raises=OverflowError,
+                   reason="planner (issue 35): a 1.4e-6 mm link move of the pocket's pencil "
+                          "program with allowance 0.5 plans an infinite duration")
+def test_a_tiny_link_move_streams(tmp_path):
+    """Found by issue 36's stream tests: `cadcnc stream` of this program ended in a
+    traceback (OverflowError in FeedPlan.periods). Remove the xfail once fixed."""
+    from cadcnc.cli.app import main
+
+    prog = tmp_path / "pk.json"
+    cadcnc_cli("pencil", FIXTURES / "pocket.step", "--radius", "2", "--allowance", "0.5",
+               "-o", prog, "-q", check=0)
+    assert main(["stream", str(prog), "-o", str(tmp_path / "pk.npy"), "-q", "--debug"]) == 0
