@@ -156,6 +156,7 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
     from cadcnc.verification import gate_program
 
     outputs = OutputSet(outs, SUFFIXES, inputs=inputs) if outs else None
+    tick.stage = "planning the feed"
     stream = _planned_stream(program, machine, stepper_factory(part), tick, feed=feed,
                              planned=planned, max_periods=max_periods, quiet=quiet)
     tick.stage = "checking the stream against the machine's limits"
@@ -198,21 +199,31 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
 
 
 def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_periods, quiet):
-    """The stream: the planner refuses a plan over ``max_periods`` before computing any
-    position (exit 2); the periods and cycle time are said at its first progress call,
-    the progress then carried by the heartbeat."""
+    """The stream, its periods estimated and bounded before the positions are computed,
+    progress reported (the plan is made once here to count the periods first)."""
     from cadcnc.controller.stream import stream_program
+    from cadcnc.work import refuse_over
 
     said = []
 
-    def progress(done: int, total: int) -> None:   # total: positions, periods + 1
-        if not said and not quiet:
-            say_error(f"cadcnc: stream: {total - 1} periods of {machine.period * 1e3:g} ms "
-                      f"(cycle {(total - 1) * machine.period:.3f} s) to compute")
+    def estimate(total: int) -> None:
+        refuse_over("the stream", total, max_periods, "servo periods",
+                    "raise the feed or the machine's limits, or give --max-periods N "
+                    "(each 24 bytes in memory)")
+        if not quiet and not said:
+            say_error(f"cadcnc: stream: {total} periods of {machine.period * 1e3:g} ms "
+                      f"(cycle {total * machine.period:.3f} s) to compute")
         said.append(total)
-        tick.stage = f"streaming: {done}/{total} positions"
+        tick.stage = f"streaming {total} periods"
 
-    tick.stage = "planning the feed"
+    from cadcnc.controller.feed_plan import plan_feed
+    from cadcnc.controller.pieces import pieces_of
+
+    estimate(plan_feed(pieces_of(program, machine, feed), machine, planned).periods)
+
+    def progress(done: int, total: int) -> None:
+        tick.stage = f"streaming: {done}/{total} periods"
+
     return stream_program(program, machine, steppers, feed=feed, planned=planned,
                           max_periods=max_periods, progress=progress)
 

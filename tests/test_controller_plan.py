@@ -27,6 +27,7 @@ pytestmark = pytest.mark.slow
 SLACK = 1e-6
 FAST = 10_000.0
 BOUND_RATIO = 1.15   # issue 35: at most 1.15x the bound on the corner and the pencil
+FINISH_RATIO = 1.26  # the finish today (the target is 1.15)
 CUSTOM = Machine(0.0005, (100.0, 80.0, 50.0), (1000.0, 800.0, 500.0),
                  (20_000.0, 16_000.0, 10_000.0), "custom INI-like machine, 0.5 ms")
 
@@ -66,18 +67,12 @@ def test_within_limits_and_near_the_bound(program, machine, request):
     part, prog = program
     stream = stream_program(prog, machine, stepper_factory(part), feed=FAST)
     assert (_shares(stream.positions, machine) <= 1.0 + SLACK).all()
-    case = request.node.callspec.id
-    try:
-        bound = va_bound(prog, machine, FAST)
-    except RuntimeError as e:   # known: TOPP-RA finds the pencil's custom case uncontrollable
-        pytest.xfail(f"the reference failed: {e}")
+    bound = va_bound(prog, machine, FAST)
     ratio = stream.cycle_time / bound
     assert ratio >= 1.0 - 1e-3   # nothing stopping where the bound stops beats it
-    if case == "finish-custom" and ratio > 1.35:
-        pytest.xfail(f"known shortfall (issue 35 open): {ratio:.3f}x the bound, the jerk's "
-                     "curvature terms on the R 9 arcs")
-    # the finish's R 9 arcs: the jerk's curvature terms hold the feed back (1.31x today)
-    assert ratio <= (1.35 if "finish" in case else BOUND_RATIO)
+    # the finish's R 9 arcs: the jerk's curvature terms hold the feed back (1.15x on the
+    # default machine, 1.25x on the custom one: short of issue 35's 1.15, docs/controller.md)
+    assert ratio <= (FINISH_RATIO if "finish" in request.node.callspec.id else BOUND_RATIO)
 
 
 @pytest.mark.parametrize("limit", ["max_velocity", "max_acceleration", "max_jerk"])
@@ -107,7 +102,7 @@ def test_short_period_never_drops_the_cut():
     try:
         stream = stream_program(prog, m, stepper_factory(part), feed=FAST)
     except PlanError as e:
-        assert "noise" in str(e)
+        assert "noise" in str(e) and e.exit_code == 5
         return
     rows = stream.positions[stream.rows == 2]
     assert np.ptp(rows[:, 0]) > 10.0 and np.ptp(rows[:, 1]) > 10.0
@@ -134,3 +129,15 @@ def test_a_huge_jerk_never_exits_over_a_limit():
     except PlanError:
         return
     assert (_shares(stream.positions, m) <= 1.0 + SLACK).all()
+
+
+def test_a_link_move_of_a_micrometre_streams():
+    """fillet_pocket's pencil has a link move of about 1e-6 mm between two corners: a run
+    of its own, from rest to rest, in finite time and within every limit."""
+    part = cadcnc.load_step(FIXTURES / "fillet_pocket.step")
+    prog = pencil(part, radius=3.0)
+    m = Machine.default()
+    stream = stream_program(prog, m, stepper_factory(part), feed=FAST)
+    assert np.isfinite(stream.cycle_time) and stream.periods > 1000
+    assert (_shares(stream.positions, m) <= 1.0 + SLACK).all()
+    assert np.array_equal(stream.positions[-1], prog.segments[-1].points[-1])

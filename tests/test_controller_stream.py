@@ -116,8 +116,8 @@ def test_no_cost_where_nothing_limits(program):
     """With limits far above what the program asks, the planned stream ends within one
     period of the time at the programmed feed (rapids then take no time)."""
     part, prog = program
-    fast = 1e6   # mm/s: rapids at this speed, reached in 1e-8 s
-    m = Machine(0.001, (fast,) * 3, (fast * 1e8,) * 3, (fast * 1e14,) * 3)
+    fast = 1e5   # mm/s: rapids at this speed, reached in 1e-4 s (the largest limits a
+    m = Machine(0.001, (fast,) * 3, (1e9,) * 3, (1e15,) * 3)   # Machine accepts)
     stream = stream_program(prog, m, stepper_factory(part))
     feed = prog.job.feed / 60.0
     at_feed = (prog.cut_length + sum(s.feed_length for s in prog.links)) / feed

@@ -19,6 +19,8 @@ import numpy as np
 CORNER_DEG = 1.0
 JUMP = 1e-3     # 1/mm
 GRID = 0.05     # mm between TOPP-RA's grid points (at most 20 000 per stretch)
+MIN_GAP = 1e-3  # mm: the closest two points of a stretch's spline
+RAPID = 1e6     # mm/s: a rapid's feed bound (TOPP-RA takes no infinite bound)
 
 
 def _curvature(p: np.ndarray) -> np.ndarray:
@@ -66,8 +68,8 @@ def stretches(program, feed_mm_min: float) -> list[list[tuple[np.ndarray, float]
     return groups
 
 
-def stretch_time(group, machine) -> float:
-    """Seconds of one stretch from rest to rest (TOPP-RA, v and a at 100 %)."""
+def _instance(group, machine):
+    """TOPP-RA's problem for one stretch from rest to rest, v and a at 100 %."""
     import toppra as ta
     import toppra.algorithm as algo
     import toppra.constraint as constraint
@@ -81,8 +83,14 @@ def stretch_time(group, machine) -> float:
         ends.append(ends[-1] + float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()))
     x = np.vstack(dense)
     s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))]
-    keep = np.r_[True, np.diff(s) > 1e-12]
-    x, s = x[keep], s[keep]
+    keep = [0]   # points at least MIN_GAP apart (a cut's last step may be a few nm, where
+    for i in range(1, len(s)):   # a spline through them turns wild)
+        if s[i] - s[keep[-1]] >= MIN_GAP:
+            keep.append(i)
+        elif i == len(s) - 1:
+            keep[-1] = i if len(keep) > 1 else keep[-1]
+    x = x[keep]
+    s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))]
     L = float(s[-1])
     ends, caps = np.asarray(ends) * (L / ends[-1]), np.asarray(caps)
     V, A = np.asarray(machine.max_velocity), np.asarray(machine.max_acceleration)
@@ -92,17 +100,39 @@ def stretch_time(group, machine) -> float:
         k = min(max(int(np.searchsorted(ends, si, side="right")) - 1, 0), len(caps) - 1)
         cap = caps[k] if not (k > 0 and abs(si - ends[k]) < 1e-9) else min(caps[k],
                                                                             caps[k - 1])
+        cap = min(cap, RAPID)
         return np.vstack([np.c_[-V, V], [[-cap, cap]]])
 
     path = ta.SplineInterpolator(s, np.c_[x, s])
-    acc = constraint.JointAccelerationConstraint(np.vstack([np.c_[-A, A], [[-1e12, 1e12]]]))
+    acc = constraint.JointAccelerationConstraint(np.vstack([np.c_[-A, A], [[-1e8, 1e8]]]))
     n = int(min(max(L / GRID, 50), 20000))
-    inst = algo.TOPPRA([constraint.JointVelocityConstraintVarying(limits), acc], path,
+    return algo.TOPPRA([constraint.JointVelocityConstraintVarying(limits), acc], path,
                        gridpoints=np.linspace(0, L, n + 1), parametrizer="ParametrizeConstAccel")
-    traj = inst.compute_trajectory(0, 0)
+
+
+def stretch_time(group, machine) -> float:
+    """Seconds of one stretch from rest to rest (TOPP-RA, v and a at 100 %)."""
+    traj = _instance(group, machine).compute_trajectory(0, 0)
     if traj is None:
         raise RuntimeError("TOPP-RA found no profile for a stretch")
     return float(traj.duration)
+
+
+def bound_feed(program, machine, feed_mm_min: float | None = None):
+    """(s, v): the bound's speed (mm/s) against arc length along the whole program (mm),
+    on TOPP-RA's grid points, stretch after stretch."""
+    feed = program.job.feed if feed_mm_min is None else feed_mm_min
+    out_s, out_v, at = [], [], 0.0
+    for g in stretches(program, feed):
+        inst = _instance(g, machine)
+        sd = inst.compute_parameterization(0, 0)[1]
+        if sd is None:
+            raise RuntimeError("TOPP-RA found no profile for a stretch")
+        grid = np.asarray(inst.problem_data.gridpoints)
+        out_s.append(at + grid)
+        out_v.append(np.asarray(sd))
+        at += float(grid[-1])
+    return np.concatenate(out_s), np.concatenate(out_v)
 
 
 def va_bound(program, machine, feed_mm_min: float | None = None) -> float:

@@ -1,97 +1,81 @@
-"""The direct stream in HAL against LinuxCNC's own planner, on the project's programs (issue 22).
+"""The race: the direct stream in HAL against LinuxCNC 2.9's planner, on fair terms (issue 35).
 
 Three programs (stream_cost.programs(): the corner bspline_boss faces 4 5 R 3, the pencil
 program of step_block R 3, the finishing program of finish_fillet faces 6 3 R 3 stepover
-10), each at its feed (1500 mm/min) and at 10 000 mm/min, on one machine
-(``Machine.default()``: the Tormach PCNC 770, 1 ms servo period). Columns:
+10) at FEED mm/min on two machines (``MACHINES``): ``Machine.default()`` (the Tormach
+PCNC 770) and a high-speed mill (``high_speed_mill``). Per machine and program:
 
-- ``stream``: ``stream_program`` (feed planned to v, a, j), executed by HAL: streamer into
-  one ``limit3`` per axis at the machine's v and a, read back by halsampler;
-- ``LinuxCNC P``: the program's own G-code (``program_ngc`` with ``tolerance`` 1e-5 mm:
-  the kernel's points, dropped only within 10 nm of a chord, 6 decimals; the F words replaced by the feed; a 1 ms dwell after the writer's rapid to
-  the first point, so that the run starts at rest there as the stream does) with
-  ``G64 P`` 0.0001, 0.001, 0.01 mm,
-  run by LinuxCNC 2.9 headless (``run_ngc``: trapezoidal planner, same per-axis v and a,
-  no jerk limit), its joint commands sampled per period;
-- ``constant``: the stream at the programmed feed ignoring the limits (positions as
-  computed, not executed: what the program asks for);
-- ``const+limit3``: that constant-feed stream executed by HAL through ``limit3``.
+- ``stream``: ``stream_program`` (feed planned to v, a, j), executed by HAL (streamer into
+  one ``limit3`` per axis at the machine's v and a, read back by halsampler);
+- ``LinuxCNC P``: the program's own G-code (``program_ngc``, tolerance 1e-5 mm, 6 decimals,
+  every F word the feed, a 1 ms dwell at the first point so that the run starts at rest
+  there as the stream does) at ``G64 P`` for P in PS, run by LinuxCNC 2.9 headless
+  (``run_ngc``: trapezoidal planner, same v and a, no jerk limit), sampled per period;
+- ``LinuxCNC equal``: G-code dense enough for the stream's accuracy: lines by their ends,
+  arcs and corner paths as polylines within EQUAL_TOL of the exact path (arcs from their
+  fitted circle; corner paths from the kernel re-run at 2.5 µm steps, Douglas-Peucker),
+  7 decimals, at ``G64 P`` EQUAL_TOL.
 
 Measured on the sampled positions, all the same way:
 
-- cycle time: from the last period at the program's first point to the last period the
-  position changes;
-- contour error: distance of each sample to the exact path, i.e. the program re-run by the
-  kernel at 1 µm steps (``stream_program`` at constant feed with a 50 µs period; chord sag
-  of that reference under 1e-7 mm), links as their straight moves; max and p99;
-- violations: samples over each axis's v, a, j (backward differences of the samples;
-  slack 1e-6 relative plus the 1e-9 mm sampling quantum), and the largest share of each.
+- cycle time: from the last period at rest at the program's first point to the last
+  period the position changes; ``last`` the time on the final move (the retract):
+  LinuxCNC 2.9 plans a lone or last segment at half the acceleration (LinuxCNC issue
+  #4220, fixed upstream after 2.9), and ``last_full_s`` is that move at full acceleration;
+- bound: ``bound.va_bound`` (TOPP-RA, 100 % of v and a, no jerk, stops at corners);
+- true contour error: ``contour.PathReference`` (closed-form lines and arcs, the two offset
+  surfaces by OCCT for corner paths), each sample against the nearest piece; the stream's
+  planned rows also against their own piece (``own_max_mm``); max and p99;
+- violations: samples over each axis's v, a, j (backward differences; 1e-6 relative slack
+  plus the 1e-9 mm sampling quantum), and the largest share of each.
 
-Runs every case once (several minutes: LinuxCNC starts in ~4 s, HAL runs in real time);
-writes ``results.json`` and each run's positions to ``--out``; ``--plot`` only redraws
-``docs/img/controller_compare.png`` from ``--out``.
+Writes ``results.json`` and each run's positions to ``--out``.
 
-    .venv/bin/python benchmarks/controller/compare.py [--out DIR] [--plot]
+    .venv/bin/python benchmarks/controller/compare.py [--out DIR] [--machines default hsm]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import re
 import time
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import cKDTree
 
+from benchmarks.controller.bound import va_bound
+from benchmarks.controller.contour import Arc, Offsets, PathReference
+from benchmarks.controller.linuxcnc_baseline import violations
+from benchmarks.controller.stream_cost import programs
 from cadcnc.controller import Machine, stream_program
 from cadcnc.controller.hal import HalError, run_hal_loop
 from cadcnc.controller.hal.linuxcnc_sim import run_ngc
+from cadcnc.io.gcode import simplify
 from cadcnc.io.program_gcode import program_ngc
 from cadcnc.ops.stream_steppers import stepper_factory
 
-from benchmarks.controller.linuxcnc_baseline import violations
-from benchmarks.controller.stream_cost import programs
-
-QUANTUM = 1e-9          # mm: the samples' resolution (µm printed with 6 decimals)
-REF_PERIOD = 5e-5       # s: the reference's period ...
-REF_FEED = 1200.0       # mm/min: ... and feed: 1 µm steps
-FEEDS = (1500.0, 10_000.0)
-PS = (0.0001, 0.001, 0.01)
+QUANTUM = 1e-9          # mm: the samples' resolution
+FEED = 10_000.0         # mm/min
+PS = (0.0001, 0.01)     # mm: LinuxCNC on the program's own G-code
 NGC_TOLERANCE = 1e-5    # mm: cadcnc's writer with --tolerance 0.00001 (6 decimals)
-IMG = Path(__file__).resolve().parents[2] / "docs" / "img" / "controller_compare.png"
+EQUAL_TOL = 1e-6        # mm: the dense G-code's polyline and its P
+DENSE_PERIOD, DENSE_FEED = 5e-5, 3000.0   # s, mm/min: the kernel's 2.5 µm steps
 
 
-class Reference:
-    """The exact path as a dense polyline (1 µm steps on cuts; links exact lines)."""
-
-    def __init__(self, program, part, machine: Machine):
-        fine = replace(machine, period=REF_PERIOD)
-        s = stream_program(program, fine, stepper_factory(part), feed=REF_FEED, planned=False)
-        self.pts = s.positions
-        self.tree = cKDTree(self.pts)
-        self.hermite_cuts = s.hermite_cuts
-
-    def distance(self, p: np.ndarray, k: int = 32) -> np.ndarray:
-        """Distance of each point to the reference polyline (segments next to the k
-        nearest vertices: k large, since a cut's ends meet links at one point), mm."""
-        _, idx = self.tree.query(p, k=k)
-        best = np.full(len(p), np.inf)
-        n = len(self.pts)
-        for c in range(k):
-            for a_i in (idx[:, c] - 1, idx[:, c]):
-                a_i = np.clip(a_i, 0, n - 2)
-                a, b = self.pts[a_i], self.pts[a_i + 1]
-                ab = b - a
-                den = np.maximum((ab * ab).sum(1), 1e-300)
-                t = np.clip(((p - a) * ab).sum(1) / den, 0, 1)
-                best = np.minimum(best, np.linalg.norm(p - (a + t[:, None] * ab), axis=1))
-        return best
+def high_speed_mill() -> Machine:
+    """A high-speed mill: Hermle C 22 U's published rapid traverse (35 m/min) and linear
+    acceleration (5 m/s²) on every axis; jerk ours (50 000 mm/s³: a in 0.1 s); 1 ms."""
+    return Machine(0.001, (35_000 / 60,) * 3, (5000.0,) * 3, (50_000.0,) * 3,
+                   source="high-speed mill: Hermle C 22 U datasheet v, a; jerk ours")
 
 
-def window(pos: np.ndarray, first: np.ndarray, near: float = 2e-4) -> tuple[int, int]:
+MACHINES = {"default": Machine.default, "hsm": high_speed_mill}
+
+
+def window(pos: np.ndarray, first: np.ndarray, near: float = 2e-6) -> tuple[int, int]:
     """(start, end): the last period at rest at the program's first point, the last
     period the position changes."""
     moving = np.abs(np.diff(pos, axis=0)).max(1) > QUANTUM
@@ -101,20 +85,34 @@ def window(pos: np.ndarray, first: np.ndarray, near: float = 2e-4) -> tuple[int,
     start = int(at[0])
     while start < len(moving) and not moving[start]:
         start += 1
-    end = int(np.flatnonzero(moving)[-1]) + 1
-    return start, end
+    return start, int(np.flatnonzero(moving)[-1]) + 1
 
 
-def measure(pos: np.ndarray, first: np.ndarray, ref: Reference, m: Machine) -> dict:
-    """Cycle time, contour error and limit violations of sampled positions (mm, s)."""
+def last_move(program) -> tuple[np.ndarray, np.ndarray]:
+    """The ends (3,) of the program's final move (the last link's last move)."""
+    pts = np.asarray(program.segments[-1].points, float)
+    return pts[-2], pts[-1]
+
+
+def trapezoid(length: float, v: float, a: float) -> float:
+    """Seconds of a straight move of ``length`` mm from rest to rest at v, a."""
+    return 2 * math.sqrt(length / a) if length < v * v / a else length / v + v / a
+
+
+def measure(pos, first, ref: PathReference, m: Machine, last) -> dict:
+    """Cycle time, time on the last move, true contour error and violations (mm, s)."""
     start, end = window(pos, first)
     run = pos[start:end + 1]
     err = ref.distance(run)
+    a, b = last
+    ab = b - a
+    t = np.clip(((run - a) @ ab) / (ab @ ab), 0, 1)
+    off = np.linalg.norm(run - (a + t[:, None] * ab), axis=1) > 1e-3
+    on_last = len(run) - 1 - int(np.flatnonzero(off)[-1])
+    out = {"cycle_time_s": (end - start) * m.period, "last_s": on_last * m.period,
+           "contour_max_mm": float(err.max()),
+           "contour_p99_mm": float(np.percentile(err, 99))}
     w = pos[max(start - 3, 0):end + 4]
-    dt = m.period
-    out = {"cycle_time_s": (end - start) * dt, "contour_max_mm": float(err.max()),
-           "contour_p99_mm": float(np.percentile(err, 99)),
-           "contour_p50_mm": float(np.percentile(err, 50))}
     out.update({k.replace("_peak_share", "_share"): x for k, x in violations(w, m).items()})
     return out
 
@@ -128,159 +126,143 @@ def ngc_text(program, feed: float, p: float) -> str:
     return re.sub(r"^(G0 X[^\n]*)$", r"\1\nG4 P0.001", text, count=1, flags=re.MULTILINE)
 
 
-def ngc_floor(program, ref: Reference) -> float:
-    """The largest distance of the written G-code polyline (8 points per chord) from the
-    exact path: the contour error LinuxCNC would have with P = 0."""
-    from cadcnc.io.program_gcode import segment_moves
+def dense_cut(piece, ref, program, part, machine: Machine) -> np.ndarray:
+    """(n, 3) a cut's points within EQUAL_TOL of its exact path (see the module doc)."""
+    if isinstance(ref, Arc):
+        h = 2 * math.acos(1 - EQUAL_TOL / ref.r)   # rad per chord: sag = EQUAL_TOL
+        t = np.linspace(0, ref.span, math.ceil(ref.span / h) + 1)
+        return ref.c + ref.r * (np.cos(t)[:, None] * ref.e1 + np.sin(t)[:, None] * ref.e2)
+    if not isinstance(ref, Offsets):
+        return np.asarray(piece.points)[[0, -1]]
+    one = replace(program, segments=[program.cuts[piece.cut]])
+    fine = stream_program(one, replace(machine, period=DENSE_PERIOD), stepper_factory(part),
+                          feed=DENSE_FEED, planned=False).positions
+    pts = fine[simplify(fine, EQUAL_TOL / 2)]
+    off = ref.distance(pts) > EQUAL_TOL / 4   # the kernel's few points off its path
+    if off.any():
+        pts[off] = [ref.on_path(p) for p in pts[off]]
+    return pts
 
-    worst = 0.0
-    for pts in segment_moves(program_ngc(program, tolerance=NGC_TOLERANCE)):
-        if len(pts) < 2:
+
+def dense_ngc(program, part, ref: PathReference, machine: Machine, feed: float) -> str:
+    """G-code at the stream's accuracy: cuts by ``dense_cut``, links' moves as written
+    (G0 for a rapid), every feed ``feed``, ``G64 P`` EQUAL_TOL, 7 decimals."""
+    xyz = lambda p: "X{:.7f} Y{:.7f} Z{:.7f}".format(*p)
+    first = program.segments[0].points[0]
+    lines = ["%", "G17 G21 G40 G90 G94", f"G64 P{EQUAL_TOL:.7f}", f"G0 Z{first[2]:.7f}",
+             f"G0 X{first[0]:.7f} Y{first[1]:.7f}", "G4 P0.001", f"F{feed:.3f}"]
+    dense = {pc.cut: dense_cut(pc, r, program, part, machine)
+             for pc, r in zip(ref.pieces, ref.refs) if pc.cut is not None}
+    k = 0
+    for seg in program.segments:
+        if seg.kind == "cut":
+            lines += [f"G1 {xyz(p)}" for p in dense[k][1:]]
+            k += 1
             continue
-        t = np.linspace(0, 1, 9)[:, None, None]
-        q = (pts[:-1][None] * (1 - t) + pts[1:][None] * t).reshape(-1, 3)
-        worst = max(worst, float(ref.distance(q).max()))
-    return worst
+        for rapid, p in zip(seg.rapid, seg.points[1:]):
+            lines.append(f"{'G0' if rapid else 'G1'} {xyz(p)}")
+    return "\n".join(lines + ["M2", "%", ""])
 
 
-def run_all(out: Path, only: list[str] | None = None) -> list[dict]:
-    machine = Machine.default()
+def run_all(out: Path, machines: list[str], only: list[str] | None = None) -> list[dict]:
+    """Every case (``only``: these programs, the other rows of results.json kept)."""
     done = out / "results.json"
-    rows = [r for r in json.loads(done.read_text()) if only and not
-            r["program"].startswith(tuple(only))] if only and done.exists() else []
+    rows = [r for r in json.loads(done.read_text()) if not r["program"].startswith(
+        tuple(only)) or r["machine"] not in machines] if only and done.exists() else []
     for name, part, program in programs():
         if only and not name.startswith(tuple(only)):
             continue
-        t0 = time.monotonic()
-        ref = Reference(program, part, machine)
-        first = program.segments[0].points[0]
-        print(f"{name}: reference {len(ref.pts)} points in {time.monotonic() - t0:.1f} s "
-              f"({ref.hermite_cuts} roll-over cuts from their points)", flush=True)
-        tag = name.split()[0]
-        floor = ngc_floor(program, ref)
-        print(f"  the G-code polyline itself: max {floor:.2e} mm from the exact path", flush=True)
-        for feed in FEEDS:
-            fset = None if feed == program.job.feed else feed
-            cases, failed = [], []
-            s = stream_program(program, machine, stepper_factory(part), feed=fset)
-            h = run_hal_loop(s.positions, machine, limits="machine")
-            cases.append(("stream", h.executed, {"clipped": h.clipped, "underruns":
-                                                 h.underruns, "planned_s": s.cycle_time}))
-            for p in PS:
-                ngc = out / f"{tag}_F{feed:g}_P{p:g}.ngc"
-                ngc.write_text(ngc_text(program, feed, p))
+        tag, first, last = name.split()[0], program.segments[0].points[0], last_move(program)
+        for mname in machines:
+            m = MACHINES[mname]()
+            t0 = time.monotonic()
+            s = stream_program(program, m, stepper_factory(part), feed=FEED)
+            ref = PathReference(s.plan.pieces, program, part)
+            own = ref.stream_error(s.positions, s.rows)
+            bound = va_bound(program, m, FEED)
+            L = float(np.linalg.norm(last[1] - last[0]))
+            d = (last[1] - last[0]) / L
+            v = min(np.asarray(m.max_velocity) / np.maximum(np.abs(d), 1e-300))
+            a = min(np.asarray(m.max_acceleration) / np.maximum(np.abs(d), 1e-300))
+            full = trapezoid(L, v, a)
+            print(f"{name} on {mname}: {ref.kinds()}, bound {bound:.3f} s, last move "
+                  f"{L:.2f} mm: {full:.3f} s at a, {trapezoid(L, v, a / 2):.3f} s at a/2 "
+                  f"({time.monotonic() - t0:.1f} s)", flush=True)
+            base = {"program": name, "machine": mname, "feed": FEED, "bound_s": bound,
+                    "last_full_s": full, "last_half_a_s": trapezoid(L, v, a / 2)}
+            h = run_hal_loop(s.positions, m, limits="machine")
+            cases = [("stream", h.executed, {"clipped": h.clipped, "underruns": h.underruns,
+                                             "planned_s": s.cycle_time,
+                                             "own_max_mm": float(own.max()),
+                                             "own_p99_mm": float(np.percentile(own, 99))})]
+            texts = [(f"LinuxCNC P{p:g}", ngc_text(program, FEED, p)) for p in PS]
+            texts.append(("LinuxCNC equal", dense_ngc(program, part, ref, m, FEED)))
+            for method, text in texts:
+                ngc = out / f"{tag}_{mname}_{method.split()[1]}.ngc"
+                ngc.write_text(text)
                 try:
-                    r = run_ngc(ngc, machine, timeout=120)
+                    r = run_ngc(ngc, m, timeout=600)
                 except HalError as e:   # recorded, not hidden: the row says why
-                    print(f"  LinuxCNC P{p:g} failed: {e}", flush=True)
-                    failed.append({"program": name, "feed": feed, "method": f"LinuxCNC P{p:g}",
-                                   "error": str(e).splitlines()[0]})
+                    print(f"  {method} failed: {e}", flush=True)
+                    rows.append({**base, "method": method, "error": str(e).splitlines()[0]})
                     continue
-                cases.append((f"LinuxCNC P{p:g}", r.positions, {"error": r.error}))
-            c = stream_program(program, machine, stepper_factory(part), feed=fset,
-                               planned=False)
-            cases.append(("constant", np.vstack([c.positions, c.positions[-1:]]), {}))
-            hc = run_hal_loop(c.positions, machine, limits="machine")
-            cases.append(("const+limit3", hc.executed, {"clipped": hc.clipped,
-                                                        "underruns": hc.underruns}))
+                cases.append((method, r.positions, {"error": r.error,
+                                                    "lines": text.count("\n")}))
             for method, pos, extra in cases:
-                np.save(out / f"{tag}_F{feed:g}_{method.replace(' ', '_')}.npy", pos)
-                row = {"program": name, "feed": feed, "method": method, "ngc_floor_mm": floor,
-                       **measure(pos, first, ref, machine), **extra}
+                np.save(out / f"{tag}_{mname}_{method.replace(' ', '_')}.npy", pos)
+                row = {**base, "method": method, **measure(pos, first, ref, m, last), **extra}
                 rows.append(row)
                 print(line(row), flush=True)
-            rows += failed
-        (out / "results.json").write_text(json.dumps(rows, indent=1))
+            (out / "results.json").write_text(json.dumps(rows, indent=1))
     return rows
 
 
 def remeasure(out: Path) -> list[dict]:
     """The rows of ``results.json`` measured again from the saved positions (no run)."""
-    machine = Machine.default()
     rows = json.loads((out / "results.json").read_text())
     for name, part, program in programs():
-        ref = Reference(program, part, machine)
-        first = program.segments[0].points[0]
-        floor = ngc_floor(program, ref)
-        for row in rows:
-            if row["program"] != name or "cycle_time_s" not in row:
+        first, last = program.segments[0].points[0], last_move(program)
+        for mname, make in MACHINES.items():
+            todo = [r for r in rows if r["program"] == name and r["machine"] == mname
+                    and "cycle_time_s" in r]
+            if not todo:
                 continue
-            pos = np.load(out / f"{name.split()[0]}_F{row['feed']:g}_"
-                                f"{row['method'].replace(' ', '_')}.npy")
-            row.update(ngc_floor_mm=floor, **measure(pos, first, ref, machine))
-            print(line(row), flush=True)
+            m = make()
+            s = stream_program(program, m, stepper_factory(part), feed=FEED)
+            ref = PathReference(s.plan.pieces, program, part)
+            for r in todo:
+                pos = np.load(out / f"{name.split()[0]}_{mname}_"
+                                    f"{r['method'].replace(' ', '_')}.npy")
+                r.update(measure(pos, first, ref, m, last))
+                print(line(r), flush=True)
     (out / "results.json").write_text(json.dumps(rows, indent=1))
     return rows
 
 
 def line(r: dict) -> str:
-    return (f"{r['program'][:8]:8s} F{r['feed']:<6g} {r['method']:16s} T {r['cycle_time_s']:7.3f}"
-            f" s  err max {r['contour_max_mm']:.2e} p99 {r['contour_p99_mm']:.2e} mm  over "
+    return (f"{r['program'][:8]:8s} {r['machine']:7s} {r['method']:16s} T {r['cycle_time_s']:7.3f}"
+            f" s (bound {r['bound_s']:.3f}, last {r['last_s']:.3f}, full-a {r['last_full_s']:.3f})"
+            f"  err max {r['contour_max_mm']:.2e} p99 {r['contour_p99_mm']:.2e} mm  over "
             f"v/a/j {r['v_over']}/{r['a_over']}/{r['j_over']} (peak {r['v_share']:.2f}/"
             f"{r['a_share']:.2f}/{r['j_share']:.1f}) "
             + " ".join(f"{k}={v}" for k, v in r.items() if k in
-                       ("clipped", "underruns", "error", "planned_s")))
-
-
-def plot(out: Path) -> None:
-    """Executed feed against arc length, the three programs at 10 000 mm/min."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    machine = Machine.default()
-    names = {"corner": "corner bspline_boss 4 5", "pencil": "pencil step_block",
-             "finish": "finish finish_fillet 6 3"}
-    rows = json.loads((out / "results.json").read_text())
-    fig, axes = plt.subplots(3, 1, figsize=(11, 9))
-    for ax, (tag, title) in zip(axes, names.items()):
-        for method, style in (("constant", dict(color="0.6", lw=0.8, ls=":")),
-                              ("LinuxCNC P0.01", dict(color="tab:orange", lw=0.7)),
-                              ("LinuxCNC P0.0001", dict(color="tab:red", lw=0.7)),
-                              ("stream", dict(color="tab:blue", lw=1.0))):
-            f = out / f"{tag}_F10000_{method.replace(' ', '_')}.npy"
-            if not f.exists():
-                continue
-            pos = np.load(f)
-            first = np.load(out / f"{tag}_F10000_stream.npy")[0]
-            start, end = window(pos, first)   # from rest at the first point, as measured
-            pos = pos[start:end + 1]
-            row = next(r for r in rows if r["program"] == title and r["feed"] == 10000
-                       and r["method"] == method)
-            step = np.linalg.norm(np.diff(pos, axis=0), axis=1)
-            moving = np.flatnonzero(step > QUANTUM)
-            step = step[moving[0]:moving[-1] + 1]
-            arc = np.cumsum(step)
-            ax.plot(arc, 60 * step / machine.period, label=f"{method}: "
-                    f"{row['cycle_time_s']:.2f} s, contour max {row['contour_max_mm']:.1e} mm",
-                    **style)
-        ax.set_title(f"{title}, F 10 000 mm/min", fontsize=9)
-        ax.set_ylabel("executed feed, mm/min")
-        ax.legend(fontsize=7, loc="upper right")
-    axes[-1].set_xlabel("arc length executed (cuts and links), mm")
-    fig.suptitle(f"Executed feed: the planned stream in HAL vs LinuxCNC 2.9's planner; "
-                 f"{machine.source}", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(IMG, dpi=100)
-    print(f"wrote {IMG}")
+                       ("clipped", "underruns", "error", "planned_s", "own_max_mm", "lines")))
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", type=Path, default=Path("/tmp/cadcnc-compare"))
-    ap.add_argument("--plot", action="store_true", help="only redraw the plot from --out")
+    ap.add_argument("--machines", nargs="+", choices=list(MACHINES), default=list(MACHINES))
     ap.add_argument("--only", nargs="+", metavar="PROGRAM",
-                    help="run only these programs (corner, pencil, finish), keeping the "
-                         "other rows of --out/results.json")
+                    help="run only these programs (corner, pencil, finish)")
     ap.add_argument("--remeasure", action="store_true",
                     help="measure the positions saved in --out again (no HAL, no LinuxCNC)")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     if args.remeasure:
         remeasure(args.out)
-    elif not args.plot:
-        run_all(args.out, args.only)
-    plot(args.out)
+    else:
+        run_all(args.out, args.machines, args.only)
 
 
 if __name__ == "__main__":

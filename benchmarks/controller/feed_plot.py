@@ -1,5 +1,6 @@
-"""docs/img/controller_feed.png: programmed and planned feed against arc length, and the
-figures of docs/controller.md (cycle time, periods, largest share of each limit).
+"""docs/img/controller_feed.png: programmed and planned feed against arc length beside the
+time-optimal v/a bound (TOPP-RA, benchmarks/controller/bound.py), and the figures of
+docs/controller.md (cycle time, bound, ratio, periods, largest share of each limit).
 
     .venv/bin/python benchmarks/controller/feed_plot.py
 """
@@ -18,6 +19,7 @@ from cadcnc.controller import Machine, stream_program  # noqa: E402
 from cadcnc.controller.pieces import constant_speed  # noqa: E402
 from cadcnc.ops.stream_steppers import stepper_factory  # noqa: E402
 
+from benchmarks.controller.bound import bound_feed, va_bound
 from benchmarks.controller.stream_cost import programs
 
 OUT = Path(__file__).resolve().parents[2] / "docs" / "img" / "controller_feed.png"
@@ -40,20 +42,26 @@ def main() -> None:
                 at += p.length
             prog = np.array(prog)
             ax.plot(prog[:, 0], prog[:, 1], lw=0.8, ls="--", label="programmed")
+            bs, bv = bound_feed(program, machine, feed or program.job.feed)
+            ax.plot(bs, 60.0 * bv, lw=0.8, ls=":", color="k",
+                    label="time-optimal v/a bound (TOPP-RA)")
             sm = s.summary()
             worst = {k: max(sm[f"max_{k}_share"].values()) for k in
                      ("velocity", "acceleration", "jerk")}
             f = feed or program.job.feed
-            ax.set_title(f"{name}, F {f:g}: {sm['cycle_time_s']:.2f} s "
+            bound = va_bound(program, machine, f)
+            ax.set_title(f"{name}, F {f:g}: {sm['cycle_time_s']:.2f} s = "
+                         f"{sm['cycle_time_s'] / bound:.3f} x the bound {bound:.2f} s "
                          f"(programmed {sm['programmed_time_s']:.2f} s)", fontsize=8)
             ax.set_ylim(0, 1.15 * 60 * np.linalg.norm(machine.max_velocity[:2]))
-            print(f"| {name} | {f:g} | {sm['cycle_time_s']:.3f} | {sm['programmed_time_s']:.3f} "
+            ax.legend(fontsize=7, loc="upper right")
+            print(f"| {name} | {f:g} | {sm['cycle_time_s']:.3f} | {bound:.3f} "
+                  f"| {sm['cycle_time_s'] / bound:.3f} | {sm['programmed_time_s']:.3f} "
                   f"| {sm['periods']} | {worst['velocity']:.3f} | {worst['acceleration']:.3f} "
                   f"| {worst['jerk']:.3f} |")
         row[0].set_ylabel("feed mm/min")
     for ax in axes[-1]:
         ax.set_xlabel("arc length along the program (cuts and links), mm")
-    axes[0][0].legend(fontsize=8)
     fig.suptitle(f"Feed planned to {machine.source}", fontsize=9)
     fig.tight_layout()
     OUT.parent.mkdir(exist_ok=True)

@@ -1,6 +1,6 @@
 """Planning + stream cost per servo period, as a ratio to the bare step (same process).
 
-    .venv/bin/python benchmarks/controller/stream_cost.py
+    .venv/bin/python benchmarks/controller/stream_cost.py [--long]
 
 Per program and feed, µs per period (best of 5, interleaved; steppers built outside
 every timing):
@@ -15,6 +15,9 @@ every timing):
 - ``stream``: ``stream_program`` end to end (plan, kernel, links, landing), per period
   of the whole stream (links need no step: lower than plan + drive);
 - ``py step``: the bare step from Python, one ``step(feed)`` call per period (for scale).
+
+``--long``: one stream of about 1e6 periods (the corner at a crawl): its time per period
+and its peak memory per period.
 """
 
 from __future__ import annotations
@@ -110,6 +113,28 @@ def whole(program, factory, machine, feed) -> float:
     return time.perf_counter() - t
 
 
+def long_stream(periods: int = 1_000_000) -> None:
+    """The corner at the feed that makes its stream ``periods`` long: time per period and
+    the peak memory the stream takes (tracemalloc: numpy's arrays included), per period."""
+    import tracemalloc
+
+    machine = Machine.default()
+    name, part, program = next(iter(programs()))
+    factory = stepper_factory(part)
+    length = program.cut_length + sum(s.feed_length for s in program.links)
+    feed = 60.0 * length / (periods * machine.period)
+    tracemalloc.start()
+    t = time.perf_counter()
+    stream = stream_program(program, machine, factory, feed=feed)
+    seconds = time.perf_counter() - t
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    n = stream.periods
+    print(f"long stream: {name} at F {feed:.3g}: {n} periods in {seconds:.1f} s "
+          f"({1e6 * seconds / n:.2f} us per period), peak memory {peak / 1e6:.0f} MB "
+          f"({peak / n:.0f} bytes per period; the positions alone take 24)")
+
+
 def main() -> None:
     machine = Machine.default()
     print(f"machine: {machine.summary()}")
@@ -136,4 +161,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    import sys
+
+    long_stream() if "--long" in sys.argv else main()

@@ -21,8 +21,9 @@ from rest to rest:
 4. the speed limits eroded (each held over +-v W) and the derivatives taken over the
    window's reach, so that the averaged motion keeps every limit where it is.
 
-The acceleration used is at most sqrt(V J) per axis: with more, the window would cost
-more time than the acceleration saves, and a looser limit could lengthen the plan. Times
+The acceleration used is at most sqrt(V J) per axis, and (J² L)^(1/3) on a run of length
+L: with more, the window would cost more time than the acceleration saves, and a looser
+limit could lengthen the plan. Times
 s, lengths mm.
 """
 
@@ -34,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ..errors import InputError
+from ..errors import EXIT_GOUGE, CadcncError, InputError
 from . import topp
 from .machine import Machine
 from .pieces import Piece, constant_speed
@@ -44,15 +45,21 @@ MARGIN = 0.995
 """Share of every limit the plan uses; the rest covers the path's derivatives between the
 kernel's points, the averaged squared speed (v² of the mean is at most the mean of v²)
 and the kernel's step landing within a few nm of the plan."""
-CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most
+CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most (0.5 and 0.75 were slower or equal
+                        # on every run of the three programs: the window grows instead)
 D_SHARE = 0.25          # of J_i: D_i v^3 at most
 WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window grown
 FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
+TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
+TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened this much
 MAX_PERIODS = 50_000_000
 
 
-class PlanError(InputError):
-    """The machine's limits admit no plan of this program (names the run and the limit)."""
+class PlanError(CadcncError):
+    """No stream within the machine's limits: nothing is written (names the run or the
+    period and the limit; exit 5, as any stream over the limits)."""
+
+    exit_code = EXIT_GOUGE
 
 
 @dataclass
@@ -86,30 +93,10 @@ class Profile:
 
 
 @njit(cache=True, error_model="numpy")
-def _integral(t, s, v, a, S, tau: float) -> float:
-    """S(tau) = integral of s from 0 to tau (s = 0 before 0, L after the end)."""
-    if tau <= 0.0:
-        return 0.0
-    end = t[-1]
-    k = min(max(np.searchsorted(t, tau, side="right") - 1, 0), len(t) - 2)
-    x = min(tau, end) - t[k]
-    return (S[k] + s[k] * x + v[k] * x * x / 2.0 + a[k] * x ** 3 / 6.0
-            + s[-1] * max(tau - end, 0.0))
-
-
-@njit(cache=True, error_model="numpy")
 def _positions(t, s, v, a, S, window: float, tau, out) -> None:
     """Profile.position into ``out``: s(t) averaged over ``window`` (or s(t) if 0)."""
-    L = s[-1]
     for i in range(len(tau)):
-        if window > 0.0:
-            x = (_integral(t, s, v, a, S, tau[i])
-                 - _integral(t, s, v, a, S, tau[i] - window)) / window
-        else:
-            k = min(max(np.searchsorted(t, tau[i], side="right") - 1, 0), len(t) - 2)
-            y = min(max(tau[i], 0.0), t[-1]) - t[k]
-            x = s[k] + v[k] * y + a[k] * y * y / 2.0
-        out[i] = min(max(x, 0.0), L)
+        out[i] = topp.averaged(t, s, v, a, S, window, tau[i])
 
 
 def _limits(machine: Machine, derate=(1.0, 1.0, 1.0)):
@@ -131,43 +118,78 @@ def _speed_limits(run: Run, V, J, period: float) -> np.ndarray:
     return np.nan_to_num(np.min(terms, axis=0), nan=math.inf, posinf=math.inf)
 
 
-def _plan_once(run: Run, wl: np.ndarray, V, A, J, period: float, window: float):
-    """One plan of the run with averaging ``window``: t, w, u, v, a, S and per knot the
-    window needed."""
+def _plan_once(run: Run, wl: np.ndarray, V, A, J, period: float, window: float,
+               coriolis: float, reach=None):
+    """One plan of the run with averaging ``window`` and the Coriolis term's share
+    ``coriolis`` of J, the path's derivatives taken over ``reach`` ((lo, hi) (n,) arc
+    lengths around each point; None: +- the top speed times the window): t, w, u, v, a,
+    S and per knot the window needed."""
     s = run.s
     wl_e = topp.erode(s, wl, window)
     top = float(np.sqrt(np.max(wl_e[np.isfinite(wl_e)], initial=0.0)))
-    reach = top * window
-    t_lo, t_hi = topp.boxes(s, run.T, reach)
-    k_lo, k_hi = topp.boxes(s, run.K, reach)
+    if reach is None:
+        reach = (s - top * window, s + top * window)
+    t_lo, t_hi = topp.boxes(s, run.T, *reach)
+    k_lo, k_hi = topp.boxes(s, run.K, *reach)
     Tc, Tr = 0.5 * (t_lo + t_hi), 0.5 * (t_hi - t_lo)
     Kc, Kr = 0.5 * (k_lo + k_hi), 0.5 * (k_hi - k_lo)
     Kmax = np.maximum(np.abs(k_lo), np.abs(k_hi))
-    C = CORIOLIS_SHARE * J
+    C = coriolis * J
     w, u = topp.passes(s, wl_e, Tc, Tr, Kc, Kr, Kmax, A, C)
     t, v, a, S = topp.time_law(s, w, u)
+    cap = np.minimum(wl_e, top * top)[:, None]
     with np.errstate(invalid="ignore", over="ignore"):
-        static = (run.D * np.minimum(wl_e, top * top)[:, None] ** 1.5
-                  + run.jump * np.minimum(wl_e, top * top)[:, None] / period
-                  + run.kink * np.sqrt(np.minimum(wl_e, top * top))[:, None] / period ** 2)
-    static = topp.boxes(s, np.nan_to_num(static, nan=0.0), reach)[1]
+        static = (run.D * cap ** 1.5 + run.jump * cap / period
+                  + run.kink * np.sqrt(cap) / period ** 2)
+    static = topp.boxes(s, np.nan_to_num(static, nan=0.0), *reach)[1]
     Tabs = np.maximum(np.abs(t_lo), np.abs(t_hi))
     need = topp.window_needed(t, v, a, Tabs, Kmax, static, J, C, window)
     return t, w, u, v, a, S, need
 
 
-def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
-    """The jerk-limited, near time-optimal profile of one run (see the module doc);
-    ``derate`` (3,) scales the velocity, acceleration and jerk used."""
-    V, A, J = _limits(machine, derate)
+def _tightened(run: Run, wl, limits, period: float, window: float, coriolis: float, first):
+    """The plan again with the derivatives taken only where the averaged motion goes
+    (the first plan assumed the top speed everywhere); kept if its own ranges lie within
+    the ranges it assumed and its window suffices, else ``first`` (sound as it is)."""
+    V, A, J = limits
+    s = run.s
+    lo, hi = topp.ranges(first[0], s, first[3], first[4], first[5], window)
+    for _ in range(TIGHTEN_ROUNDS):
+        grow = TIGHTEN_SLACK * (hi - lo)
+        assumed = (lo - grow, hi + grow)
+        plan = _plan_once(run, wl, V, A, J, period, window, coriolis, assumed)
+        if float(np.max(plan[6], initial=0.0)) > window:
+            return first
+        lo2, hi2 = topp.ranges(plan[0], s, plan[3], plan[4], plan[5], window)
+        if (lo2 >= assumed[0]).all() and (hi2 <= assumed[1]).all():
+            return plan
+        lo, hi = np.minimum(lo, lo2), np.maximum(hi, hi2)
+    return first
+
+
+def _first_window(run: Run, A, J) -> float:
+    """The first averaging window (s): the shortest A_i / J_i of the axes the run moves;
+    the plan lengthens it where the profile needs more."""
+    t = np.max(np.abs(run.T), axis=0)
+    return float(np.min(np.where(t > 0.0, A / J, np.inf)))
+
+
+def _plan_share(run: Run, machine: Machine, limits, coriolis: float) -> Profile:
+    """The run's profile with the Coriolis term's share ``coriolis`` (see the module
+    doc): turns flattened, or the window grown, until the window is long enough."""
+    V, A, J = limits
     wl = _speed_limits(run, V, J, machine.period)
-    window = float(np.max(A / J))
+    window = _first_window(run, A, J)
+    flattening, last = True, math.inf
     for round_ in range(WINDOW_ROUNDS):
-        t, w, u, v, a, S, need = _plan_once(run, wl, V, A, J, machine.period, window)
+        plan = _plan_once(run, wl, V, A, J, machine.period, window, coriolis)
+        t, w, u, v, a, S, need = plan
         top = float(np.max(need, initial=0.0))
         if top <= window:
             break
-        if round_ < FLATTEN_ROUNDS and topp.flatten(run.s, t, w, u, wl, need, window):
+        flattening = flattening and round_ < FLATTEN_ROUNDS and top < last   # progress
+        last = top
+        if flattening and topp.flatten(run.s, t, w, u, wl, need, window):
             continue
         if not math.isfinite(top):
             raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: the "
@@ -177,8 +199,20 @@ def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
     else:
         raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: no "
                         f"averaging window keeps the jerk within {machine.summary()}")
+    if run.curved:   # (a straight run's derivatives are the same everywhere)
+        plan = _tightened(run, wl, limits, machine.period, window, coriolis, plan)
+    t, w, u, v, a, S, need = plan
     keep = np.r_[np.diff(run.s) > 0.0, True]
     return Profile(t[keep], run.s[keep], v[keep], a[keep], S[keep], window)
+
+
+def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
+    """The jerk-limited, near time-optimal profile of one run (see the module doc);
+    ``derate`` (3,) scales the velocity, acceleration and jerk used."""
+    V, A, J = _limits(machine, derate)
+    # a short run: the acceleration a jerk ramp up and down over its length reaches
+    A = np.minimum(A, np.cbrt(J * J * run.length))
+    return _plan_share(run, machine, (V, A, J), CORIOLIS_SHARE)
 
 
 def _constant_run(first: int, piece: Piece, machine: Machine) -> tuple[Run, Profile]:

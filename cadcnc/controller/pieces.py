@@ -1,10 +1,9 @@
 """A program cut into the pieces the feed planner plans one by one (no OCCT).
 
 A piece is one cut (the kernel's points, which the stream re-interpolates) or one
-straight move of a link. Pieces meet at rest: a link's moves turn by 90° and a cut meets
-its links at a corner, so a stop there costs little and keeps every axis within its
-limits. Arrays: ``points`` (n, 3) mm, ``s`` (n,) arc length (chord sum) from the piece's
-start, mm; speeds mm/s.
+straight move of a link. Pieces are grouped into runs that stop only at corners
+(:mod:`.runs`). Arrays: ``points`` (n, 3) mm, ``s`` (n,) arc length (chord sum) from the
+piece's start, mm; speeds mm/s.
 """
 
 from __future__ import annotations

@@ -28,7 +28,9 @@ from .pieces import Piece
 LINE_KNOT = 0.25       # mm: the largest knot of a straight move (the plan's resolution)
 LINE_KNOTS_MAX = 4000  # knots of one straight move at most
 MIN_KNOT = 1e-4        # mm: the shortest knot of a cut's grid
-STOP_SPEED = 1.0       # mm/s: a join slower than this is a stop at rest (a corner)
+STOP_SPEED = 10.0      # mm/s: a join slower than this is a stop at rest (a corner, or a
+                       # curvature jump that lets the feed through at a crawl)
+STOP_SHARE = 0.5       # ... or slower than this share of the fastest the axes allow there
 JOIN_SHARE = 0.25
 """Share of an axis's jerk (and acceleration) that the one-period jolt of a join or a
 curvature jump may take; the rest stays with the smooth motion around it."""
@@ -54,6 +56,12 @@ class Run:
     def length(self) -> float:
         return float(self.offsets[-1])
 
+    @property
+    def curved(self) -> bool:
+        """Whether the path's derivatives change along the run (curvature, jumps, joins)."""
+        return bool(np.any(self.K) or np.any(self.jump) or np.any(self.kink)
+                    or np.ptp(self.T, axis=0).max() > 0.0)
+
 
 def _lagrange(p: np.ndarray, s: np.ndarray, at: int) -> tuple[np.ndarray, np.ndarray]:
     """p' and p'' at point ``at`` (0 or 2) of the parabola through 3 points (3, 3)."""
@@ -73,13 +81,18 @@ def end_derivatives(piece: Piece, end: bool) -> tuple[np.ndarray, np.ndarray]:
         return d / np.linalg.norm(d), np.zeros(3)
     sl = slice(-3, None) if end else slice(0, 3)
     t, k = _lagrange(p[sl], s[sl] - s[sl][0], 2 if end else 0)
+    if len(p) >= 4:   # p'' of the next three points too: extrapolated onto the end (a
+        sl = slice(-4, -1) if end else slice(1, 4)   # ramp of curvature is no jump)
+        k2 = _lagrange(p[sl], s[sl] - s[sl][0], 0)[1]
+        k = 2.0 * k - k2
     return t / np.linalg.norm(t), k
 
 
 def join_speed(before: Piece, after: Piece, machine: Machine) -> tuple[float, np.ndarray,
                                                                        np.ndarray]:
-    """The fastest pass through the join of two pieces (mm/s; 0: a corner) and the jumps
-    of the unit tangent and of p'' there ((3,) each).
+    """The fastest pass through the join of two pieces (mm/s; 0: a stop, at a corner or
+    where the pass would crawl) and the jumps of the unit tangent and of p'' there ((3,)
+    each).
 
     In sampled time a tangent jump dt at speed v changes an axis's velocity by v |dt_i|
     within one period: acceleration v |dt_i| / Ts and jerk v |dt_i| / Ts²; a jump dK of
@@ -93,12 +106,16 @@ def join_speed(before: Piece, after: Piece, machine: Machine) -> tuple[float, np
     with np.errstate(divide="ignore"):
         v = np.min(JOIN_SHARE * np.minimum(A * ts, J * ts * ts) / np.abs(dt))
         v = min(v, float(np.min(np.sqrt(JOIN_SHARE * J * ts / np.abs(dk)))))
-    v = min(v, before.cap, after.cap)
-    return (0.0 if v < STOP_SPEED else float(v)), dt, dk
+    with np.errstate(divide="ignore"):
+        axes = np.asarray(machine.max_velocity) / np.maximum(np.abs(t0), np.abs(t1))
+    top = min(before.cap, after.cap, float(np.min(axes)))
+    v = min(v, top)
+    return (0.0 if v < max(STOP_SPEED, STOP_SHARE * top) else float(v)), dt, dk
 
 
 def _line_grid(piece: Piece) -> np.ndarray:
-    n = int(min(max(math.ceil(piece.length / LINE_KNOT), 1), LINE_KNOTS_MAX))
+    n = int(min(max(math.ceil(piece.length / LINE_KNOT), 2), LINE_KNOTS_MAX))   # (from
+    # rest to rest needs two knots: one accelerating, one braking)
     return np.linspace(0.0, piece.length, n + 1)
 
 
@@ -134,7 +151,7 @@ def _cut_derivatives(piece: Piece) -> tuple[np.ndarray, ...]:
 
 def _piece_grid(piece: Piece, machine: Machine):
     """s, T, K, D, jump, cap at the grid points of one piece."""
-    if piece.cut is None and len(piece.points) == 2:
+    if len(piece.points) == 2:   # a straight move (or a cut of one step)
         s = _line_grid(piece)
         n = len(s)
         t = (piece.points[1] - piece.points[0]) / piece.length

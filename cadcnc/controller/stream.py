@@ -171,16 +171,21 @@ NOISE = 1.5       # ... unless it is broken this much: the positions' noise, not
 
 def _over(positions: np.ndarray, machine: Machine) -> list[tuple[float, int, int]]:
     """Per quantity (velocity, acceleration, jerk): the largest finite-difference share
-    of the axis's limit, its period and its axis."""
-    ts, out = machine.period, []
-    for k, lim in enumerate((machine.max_velocity, machine.max_acceleration,
-                             machine.max_jerk), start=1):
-        if len(positions) <= k:
-            out.append((0.0, 0, 0))
-            continue
-        share = np.abs(np.diff(positions, k, axis=0)) / ts ** k / np.asarray(lim)
-        row, axis = np.unravel_index(int(np.argmax(share)), share.shape)
-        out.append((float(share[row, axis]), int(row) + k, int(axis)))
+    of the axis's limit, its period and its axis (CHUNK rows at a time: the differences'
+    temporaries stay bounded whatever the stream's length)."""
+    ts = machine.period
+    out = [(0.0, 0, 0)] * 3
+    for start in range(0, max(len(positions) - 1, 1), CHUNK):
+        block = positions[start:start + CHUNK + 3]
+        for k, lim in enumerate((machine.max_velocity, machine.max_acceleration,
+                                 machine.max_jerk), start=1):
+            if len(block) <= k:
+                continue
+            share = np.abs(np.diff(block, k, axis=0))
+            share /= ts ** k * np.asarray(lim)
+            row, axis = np.unravel_index(int(np.argmax(share)), share.shape)
+            if share[row, axis] > out[k - 1][0]:
+                out[k - 1] = (float(share[row, axis]), start + int(row) + k, int(axis))
     return out
 
 
@@ -189,7 +194,8 @@ def _refusal(over: list[tuple[float, int, int]], machine: Machine) -> PlanError:
     q = max(range(3), key=lambda i: over[i][0])
     share, row, axis = over[q]
     return PlanError(
-        f"the planned stream would reach {100 * share:.1f} % of axis {AXES[axis]}'s "
+        "the stream is over the machine's limits: nothing written: it would reach "
+        f"{100 * share:.1f} % of axis {AXES[axis]}'s "
         f"{names[q]} limit at period {row} (the positions' own noise at a "
         f"{machine.period * 1e6:g} us period, or limits the path cannot meet): refused; "
         "a longer servo period or a lower jerk limit may stream")
@@ -205,7 +211,7 @@ def _cut_rows(stepper, piece: Piece, s: np.ndarray, what: str, done: int, total:
         out[a:b] = follow(stepper, plan[a:b], piece.points[-1], float(piece.kappa[-1]),
                           LANDING)
         if progress is not None:
-            progress(done + b, total)
+            progress(min(done + b, total), total)
     return _landed(stepper, piece, out, what)
 
 
@@ -243,8 +249,8 @@ def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
     """One plan (limits scaled by ``derate``) and its positions."""
     plan = plan_feed(pieces, machine, planned, tuple(derate))
     rows, s = plan.targets(max_periods)
-    total = len(s)
-    positions = np.empty((total, 3))
+    total = len(s) - 1   # periods: the rows after the start
+    positions = np.empty((len(s), 3))
     cuts = program.cuts
     kernel = hermite = 0
     for j, piece in enumerate(pieces):

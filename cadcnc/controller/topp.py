@@ -23,13 +23,14 @@ import math
 import numpy as np
 from numba import njit
 
-BISECTIONS = 48   # the top of a point's feasible speeds to 2^-48 of its limit
+BISECTIONS = 40   # the top of a point's feasible speeds to 2^-40 of its bracket
 
 
 @njit(cache=True, error_model="numpy")
-def _bounds(k: int, w: float, h: float, Tc, Tr, Kc, Kr, Kmax, A, C) -> tuple:
-    """(lo, hi): the tangential accelerations on knot k (length h > 0) feasible from w."""
-    lo, hi = -w / (2.0 * h), math.inf
+def _coefficients(k: int, h: float, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs) -> float:
+    """Knot k's acceleration constraints cu u + cw w <= rhs (24, into the buffers) for
+    the speed w at its start, and its Coriolis bound: |u| <= returned / sqrt(w)."""
+    n = 0
     for e in range(2):
         j = k + e
         reach = 2.0 * h if e == 1 else 0.0
@@ -37,26 +38,40 @@ def _bounds(k: int, w: float, h: float, Tc, Tr, Kc, Kr, Kmax, A, C) -> tuple:
             for s1 in (-1.0, 1.0):
                 kw = s1 * Kc[j, i] + Kr[j, i]
                 for s2 in (-1.0, 1.0):
-                    cu = s1 * Tc[j, i] + s2 * Tr[j, i] + kw * reach
-                    rhs = A[i] - kw * w
-                    if cu > 0.0:
-                        hi = min(hi, rhs / cu)
-                    elif cu < 0.0:
-                        lo = max(lo, rhs / cu)
-                    elif rhs < 0.0:
-                        return 1.0, -1.0
-    if w > 0.0:
-        for i in range(3):
-            km = max(Kmax[k, i], Kmax[k + 1, i])
-            if km > 0.0:
-                c = C[i] / (3.0 * km * math.sqrt(w))
-                lo, hi = max(lo, -c), min(hi, c)
+                    cu[n] = s1 * Tc[j, i] + s2 * Tr[j, i] + kw * reach
+                    cw[n] = kw
+                    rhs[n] = A[i]
+                    n += 1
+    c = math.inf
+    for i in range(3):
+        km = max(Kmax[k, i], Kmax[k + 1, i])
+        if km > 0.0:
+            c = min(c, C[i] / (3.0 * km))
+    return c
+
+
+@njit(cache=True, error_model="numpy")
+def _bounds(w: float, h: float, cu, cw, rhs, coriolis: float) -> tuple:
+    """(lo, hi): the tangential accelerations feasible from speed w on a knot of length
+    h > 0 with the constraints of :func:`_coefficients` (lo > hi: none)."""
+    lo, hi = -w / (2.0 * h), math.inf
+    for j in range(len(cu)):
+        r = rhs[j] - cw[j] * w
+        if cu[j] > 0.0:
+            hi = min(hi, r / cu[j])
+        elif cu[j] < 0.0:
+            lo = max(lo, r / cu[j])
+        elif r < 0.0:
+            return 1.0, -1.0
+    if w > 0.0 and coriolis < math.inf:
+        c = coriolis / math.sqrt(w)
+        lo, hi = max(lo, -c), min(hi, c)
     return lo, hi
 
 
 @njit(cache=True, error_model="numpy")
-def _feasible(k, w, h, w_next, Tc, Tr, Kc, Kr, Kmax, A, C) -> bool:
-    lo, hi = _bounds(k, w, h, Tc, Tr, Kc, Kr, Kmax, A, C)
+def _feasible(w, h, w_next, cu, cw, rhs, coriolis) -> bool:
+    lo, hi = _bounds(w, h, cu, cw, rhs, coriolis)
     return lo <= hi and w + 2.0 * h * lo <= w_next + 1e-12 * w   # (w - w: round-off)
 
 
@@ -65,6 +80,7 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
     """(w (n,), u (n - 1,)): the time-optimal squared speeds from rest at s[0] to rest at
     s[-1] and the accelerations between (knots of length 0, a join, keep the speed)."""
     n = len(s)
+    cu, cw, rhs = np.empty(24), np.empty(24), np.empty(24)
     wb = np.empty(n)
     wb[n - 1] = 0.0
     for k in range(n - 2, -1, -1):
@@ -73,13 +89,14 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
         if h <= 0.0:
             wb[k] = min(top, wb[k + 1])
             continue
-        if _feasible(k, top, h, wb[k + 1], Tc, Tr, Kc, Kr, Kmax, A, C):
+        cor = _coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
+        if _feasible(top, h, wb[k + 1], cu, cw, rhs, cor):
             wb[k] = top
             continue
-        a, b = 0.0, top
+        a, b = 0.0, min(top, wb[k + 1] + 2.0 * h * np.max(np.abs(A)) * 1e3)
         for _ in range(BISECTIONS):
             m = 0.5 * (a + b)
-            if _feasible(k, m, h, wb[k + 1], Tc, Tr, Kc, Kr, Kmax, A, C):
+            if _feasible(m, h, wb[k + 1], cu, cw, rhs, cor):
                 a = m
             else:
                 b = m
@@ -92,7 +109,8 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
         if h <= 0.0:
             w[k + 1] = min(w[k], wb[k + 1])
             continue
-        lo, hi = _bounds(k, w[k], h, Tc, Tr, Kc, Kr, Kmax, A, C)
+        cor = _coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
+        lo, hi = _bounds(w[k], h, cu, cw, rhs, cor)
         x = min(hi, (wb[k + 1] - w[k]) / (2.0 * h))
         x = max(x, lo)
         u[k] = x
@@ -122,23 +140,85 @@ def erode(s, wl, window: float):
 
 
 @njit(cache=True, error_model="numpy")
-def boxes(s, x, reach: float):
-    """(lo, hi) (n, 3): the smallest and largest x over s_k +- reach."""
+def boxes(s, x, lo_s, hi_s):
+    """(lo, hi) (n, 3): the smallest and largest x over s in [lo_s[k], hi_s[k]] (each
+    range holding s[k]; ranges widened to a monotone sequence, then a sliding window)."""
     n = len(s)
-    lo, hi = x.copy(), x.copy()
-    a = 0
-    b = 0
+    first = np.empty(n, dtype=np.int64)   # the ranges as index windows, monotone
+    last = np.empty(n, dtype=np.int64)
+    j = n - 1
+    for k in range(n - 1, -1, -1):
+        j = min(j, k)
+        while j > 0 and s[j - 1] >= lo_s[k]:
+            j -= 1
+        first[k] = j if k == n - 1 else min(j, first[k + 1])
+    j = 0
     for k in range(n):
-        while s[k] - s[a] > reach:
-            a += 1
-        while b + 1 < n and s[b + 1] - s[k] <= reach:
-            b += 1
-        for i in range(3):
-            mn, mx = x[a, i], x[a, i]
-            for j in range(a + 1, b + 1):
-                mn = min(mn, x[j, i])
-                mx = max(mx, x[j, i])
-            lo[k, i], hi[k, i] = mn, mx
+        j = max(j, k)
+        while j + 1 < n and s[j + 1] <= hi_s[k]:
+            j += 1
+        last[k] = j if k == 0 else max(j, last[k - 1])
+    lo, hi = np.empty((n, 3)), np.empty((n, 3))
+    qmin = np.empty(n, dtype=np.int64)
+    qmax = np.empty(n, dtype=np.int64)
+    for i in range(3):
+        h1 = t1 = h2 = t2 = 0   # deque heads and tails (exclusive)
+        nxt = 0
+        for k in range(n):
+            while nxt <= last[k]:
+                while t1 > h1 and x[qmin[t1 - 1], i] >= x[nxt, i]:
+                    t1 -= 1
+                qmin[t1] = nxt
+                t1 += 1
+                while t2 > h2 and x[qmax[t2 - 1], i] <= x[nxt, i]:
+                    t2 -= 1
+                qmax[t2] = nxt
+                t2 += 1
+                nxt += 1
+            while qmin[h1] < first[k]:
+                h1 += 1
+            while qmax[h2] < first[k]:
+                h2 += 1
+            lo[k, i] = x[qmin[h1], i]
+            hi[k, i] = x[qmax[h2], i]
+    return lo, hi
+
+
+@njit(cache=True, error_model="numpy")
+def _integral(t, s, v, a, S, tau: float) -> float:
+    """The time integral of s(t) from 0 to tau (s = 0 before 0, s[-1] after the end)."""
+    if tau <= 0.0:
+        return 0.0
+    n = len(t)
+    end = t[n - 1]
+    k = min(max(np.searchsorted(t, tau, side="right") - 1, 0), n - 2)
+    x = min(tau, end) - t[k]
+    return (S[k] + s[k] * x + v[k] * x * x / 2.0 + a[k] * x ** 3 / 6.0
+            + s[n - 1] * max(tau - end, 0.0))
+
+
+@njit(cache=True, error_model="numpy")
+def averaged(t, s, v, a, S, window: float, tau: float) -> float:
+    """s(t) averaged over the ``window`` s before ``tau`` (s(tau) itself if window 0)."""
+    if window <= 0.0:
+        n = len(t)
+        k = min(max(np.searchsorted(t, tau, side="right") - 1, 0), n - 2)
+        y = min(max(tau, 0.0), t[n - 1]) - t[k]
+        return min(max(s[k] + v[k] * y + a[k] * y * y / 2.0, 0.0), s[n - 1])
+    x = (_integral(t, s, v, a, S, tau) - _integral(t, s, v, a, S, tau - window)) / window
+    return min(max(x, 0.0), s[len(s) - 1])
+
+
+@njit(cache=True, error_model="numpy")
+def ranges(t, s, v, a, S, window: float):
+    """(lo, hi) (n,): where the averaged motion is while grid point k is in its window,
+    s_f(t_k) .. s_f(t_k + window): every place whose path derivatives meet this point's
+    speed and acceleration."""
+    n = len(t)
+    lo, hi = np.empty(n), np.empty(n)
+    for k in range(n):
+        lo[k] = min(averaged(t, s, v, a, S, window, t[k]), s[k])
+        hi[k] = max(averaged(t, s, v, a, S, window, t[k] + window), s[k])
     return lo, hi
 
 
@@ -191,6 +271,68 @@ def window_needed(t, v, a, Tabs, Kmax, static, J, C, window: float):
 
 
 @njit(cache=True, error_model="numpy")
+def _above(w, j: int, level: float) -> tuple:
+    """(a, b): the grid points around j where w >= level, without a gap."""
+    a = j
+    while a > 0 and w[a - 1] >= level:
+        a -= 1
+    b = j
+    while b < len(w) - 1 and w[b + 1] >= level:
+        b += 1
+    return a, b
+
+
+@njit(cache=True, error_model="numpy")
+def _turn(t, u, k: int, window: float, tiny: float) -> tuple:
+    """(p, q): knots before and after the last sign change of the acceleration in the
+    windows ending on knot k (u[p] and u[q] of opposite signs), or (-1, -1)."""
+    q = k
+    while q > 0 and abs(u[q]) <= tiny:
+        q -= 1
+    p = q
+    while p > 0 and t[p] > t[k] - 2.0 * window and not (u[p] * u[q] < 0.0
+                                                         and abs(u[p]) > tiny):
+        p -= 1
+    if u[p] * u[q] < 0.0 and abs(u[p]) > tiny:
+        return p, q
+    return -1, -1
+
+
+@njit(cache=True, error_model="numpy")
+def _flatten_at(s, w, u, wl, p: int, q: int, window: float) -> bool:
+    """Lower ``wl`` around the turn between knots p and q into a cruise of ``window`` s:
+    a peak to the highest level held that long, a valley's speed held over +-v window /
+    2. False if nothing can be done (a peak too short to cruise, a stop)."""
+    peak = u[p] > 0.0
+    j = p + 1
+    for i in range(p + 1, q + 1):
+        if (w[i] > w[j]) if peak else (w[i] < w[j]):
+            j = i
+    if peak:
+        lo, hi = 0.0, w[j]
+        for _ in range(40):
+            m = 0.5 * (lo + hi)
+            a, b = _above(w, j, m)
+            if s[b] - s[a] >= math.sqrt(m) * window:
+                lo = m
+            else:
+                hi = m
+        if lo <= 1e-6 * w[j]:
+            return False
+        a, b = _above(w, j, lo)
+        for i in range(a, b + 1):
+            wl[i] = min(wl[i], lo)
+        return True
+    if w[j] <= 0.0:
+        return False
+    r = 0.5 * math.sqrt(w[j]) * window
+    for i in range(len(s)):
+        if abs(s[i] - s[j]) <= r:
+            wl[i] = min(wl[i], w[j])
+    return True
+
+
+@njit(cache=True, error_model="numpy")
 def flatten(s, t, w, u, wl, need, window: float) -> int:
     """Lower ``wl`` (in place) so that each turn of the profile that needs a longer window
     than ``window`` (acceleration straight into deceleration at a peak, or the reverse at
@@ -200,63 +342,13 @@ def flatten(s, t, w, u, wl, need, window: float) -> int:
     tiny = 1e-9 * np.max(np.abs(u)) if len(u) else 0.0
     k = 0
     while k < n - 1:
-        if need[k] <= window:
-            k += 1
-            continue
-        q = k   # the turn in the window ending on knot k: u's last sign, then the other
-        while q > 0 and abs(u[q]) <= tiny:
-            q -= 1
-        p = q
-        while p > 0 and t[p] > t[k] - 2.0 * window and not (u[p] * u[q] < 0.0 and
-                                                             abs(u[p]) > tiny):
-            p -= 1
-        if not (u[p] * u[q] < 0.0 and abs(u[p]) > tiny):
-            k += 1
-            continue
-        j = p + 1
-        for i in range(p + 1, q + 1):
-            if (w[i] > w[j]) if u[p] > 0.0 else (w[i] < w[j]):
-                j = i
-        if u[p] > 0.0:   # a peak at j: the highest level cruising >= window
-            lo, hi = 0.0, w[j]
-            for _ in range(40):
-                m = 0.5 * (lo + hi)
-                a = j
-                while a > 0 and w[a - 1] >= m:
-                    a -= 1
-                b = j
-                while b < n - 1 and w[b + 1] >= m:
-                    b += 1
-                if s[b] - s[a] >= math.sqrt(m) * window:
-                    lo = m
-                else:
-                    hi = m
-            if lo <= 1e-6 * w[j]:   # no level cruises long enough: the window grows
-                k += 1
+        if need[k] > window:
+            p, q = _turn(t, u, k, window, tiny)
+            if p >= 0 and _flatten_at(s, w, u, wl, p, q, window):
+                done += 1
+                end = t[q] + window   # the next turn lies past this one's window
+                while k < n - 1 and t[k] <= end:
+                    k += 1
                 continue
-            a = j
-            while a > 0 and w[a - 1] >= lo:
-                a -= 1
-            b = j
-            while b < n - 1 and w[b + 1] >= lo:
-                b += 1
-            for i in range(a, b + 1):
-                wl[i] = min(wl[i], lo)
-        elif w[j] <= 0.0:    # a stop at j: nothing to hold
-            k += 1
-            continue
-        else:                # a valley at j: hold its speed over +-v window / 2
-            r = 0.5 * math.sqrt(w[j]) * window
-            i = j
-            while i >= 0 and s[j] - s[i] <= r:
-                wl[i] = min(wl[i], w[j])
-                i -= 1
-            i = j
-            while i < n and s[i] - s[j] <= r:
-                wl[i] = min(wl[i], w[j])
-                i += 1
-        done += 1
         k += 1
-        while k < n - 1 and t[k] <= t[j] + window:
-            k += 1
     return done
