@@ -257,7 +257,7 @@ def _limits_broken(program, machine, positions, contents) -> list[str]:
     found = check_stream(positions, machine.period, limits, *ends).problems
     for dest, text in contents.items():
         if isinstance(text, str) and not found:
-            rows = np.array(text.split(), dtype=np.float64).reshape(-1, 3)
+            rows = np.fromstring(text, dtype=np.float64, sep=" ").reshape(-1, 3)
             found = check_stream(rows, machine.period, limits, *ends, what=str(dest)).problems
     return found
 

@@ -66,8 +66,9 @@ def test_ends_and_non_finite_positions_fail():
 
 
 def test_a_stream_over_the_limits_exits_5_and_writes_nothing(program, tmp_path):
-    """Finding 3: the summary showed a limit broken and the command exited 0. A planner
-    that breaks the limits (today's, at jerk 1e12) or any other cause: exit 5."""
+    """Finding 3: the summary showed a limit broken and the command exited 0 (the planner
+    of the finding, at a 1 us period and jerk 1e12). Now: exit 0 only within every limit;
+    else refused by the planner or by the check (exit 5), nothing written."""
     out = tmp_path / "s.npy"
     ini = tmp_path / "m.ini"
     ini.write_text("[EMCMOT]\nSERVO_PERIOD = 1000\n[TRAJ]\nLINEAR_UNITS = mm\n" + "".join(
@@ -79,10 +80,9 @@ def test_a_stream_over_the_limits_exits_5_and_writes_nothing(program, tmp_path):
         d = [np.abs(np.diff(x, k, axis=0)).max(axis=0) / 1e-6 ** k for k in (1, 2, 3)]
         assert all((d[k] <= lim * (1 + 1e-6)).all() for k, lim in enumerate(
             ((50,) * 3, (500,) * 3, (1e12,) * 3)))
-    else:
+    else:   # refused by the planner itself or by the check: exit 5 either way
         assert run.returncode == 5, run.stderr
-        assert "over the machine's limits: nothing written" in run.stderr
-        assert not out.exists()
+        assert not out.exists() and "Traceback" not in run.stderr
 
 
 def test_check_refuses_what_the_planner_would_write(program, tmp_path, monkeypatch):
@@ -116,10 +116,10 @@ def test_the_wrong_part_is_named(program, tmp_path):
 
 def test_an_origin_far_outside_the_part_is_an_input_error(tmp_path):
     """Finding 8: --origin 1e300,0,0 gave exit 3 (no feasible ball position)."""
-    run = cadcnc_cli("path", BLOCK, *SHORT[:4], "--origin", "1e300,0,0",
+    run = cadcnc_cli("path", BLOCK, *SHORT[:5], "--origin", "1e300,0,0",
                      "-o", tmp_path / "p.json")
     assert run.returncode == 2, run.stderr
-    assert "--origin" in run.stderr and "RuntimeWarning" not in run.stderr
+    assert "--origin 1e+300,0,0:" in run.stderr and "RuntimeWarning" not in run.stderr
 
 
 def test_periods_are_estimated_and_bounded_before_work(program, tmp_path, monkeypatch):
@@ -133,9 +133,9 @@ def test_periods_are_estimated_and_bounded_before_work(program, tmp_path, monkey
     assert f"{periods} periods" in run.stdout
 
     def never(*args, **kwargs):
-        raise AssertionError("no stream over --max-periods is computed")
+        raise AssertionError("no position of a stream over --max-periods is computed")
 
-    monkeypatch.setattr(stream, "stream_program", never)
+    monkeypatch.setattr(stream, "follow", never)   # the kernel's loop over a cut
     run = cadcnc_cli("stream", program, "-o", tmp_path / "t.npy", "--max-periods",
                      str(periods // 2))
     assert run.returncode == 2 and "--max-periods" in run.stderr, run.stderr
@@ -175,6 +175,7 @@ def test_stale_folders_of_dead_runs_are_removed_never_a_live_ones(tmp_path):
         live.wait()
 
 
+@pytest.mark.slow   # about 7 s each: a fresh process loads OCCT
 @pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
 def test_a_long_stream_is_interrupted_cleanly(program, tmp_path, sig):
     """Finding 4 and 5: a long stream (--feed 1: about 350 000 periods) says how many
@@ -224,3 +225,37 @@ def test_sigterm_while_an_output_set_is_written_leaves_no_temporary_file(tmp_pat
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json"]
     assert old.read_text() == "old"
     assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
+
+
+def test_the_txt_is_checked_as_printed(program, tmp_path, monkeypatch):
+    """The .txt's numbers, not only the array they were printed from: a text that breaks
+    the limits is refused with its name, and neither file is written."""
+    import cadcnc.controller.stream as stream
+
+    real = stream.stream_text
+
+    def bumped(positions):
+        rows = real(positions).splitlines()
+        x, y, z = map(float, rows[len(rows) // 2].split())
+        rows[len(rows) // 2] = f"{x + 0.05:.9f} {y:.9f} {z:.9f}"
+        return "\n".join(rows) + "\n"
+
+    monkeypatch.setattr(stream, "stream_text", bumped)
+    npy, txt = tmp_path / "s.npy", tmp_path / "s.txt"
+    run = cadcnc_cli("stream", program, "-o", npy, "-o", txt)
+    assert run.returncode == 5, run.stderr
+    assert f"{txt}: acceleration of axis X" in run.stderr
+    assert not npy.exists() and not txt.exists()
+
+
+@pytest.mark.slow   # about 10 s: the pocket's pencil program
+def test_a_tiny_link_move_streams(tmp_path):
+    """Found by issue 36's stream tests: `cadcnc stream` of this program ended in a
+    traceback (OverflowError in FeedPlan.periods: a 1.4e-6 mm link move planned an
+    infinite duration; fixed on main by the planner of issue 35)."""
+    from cadcnc.cli.app import main
+
+    prog = tmp_path / "pk.json"
+    cadcnc_cli("pencil", FIXTURES / "pocket.step", "--radius", "2", "--allowance", "0.5",
+               "-o", prog, "-q", check=0)
+    assert main(["stream", str(prog), "-o", str(tmp_path / "pk.npy"), "-q", "--debug"]) == 0

@@ -26,11 +26,12 @@ DEFAULT_JERK_RAMP = 0.05
 """s: the default jerk reaches an axis's acceleration in this time (jerk = A / 0.05 s)."""
 
 
-MAX_VELOCITY = 1e6      # mm/s: 1 km/s
-MAX_ACCELERATION = 1e9  # mm/s^2: 10^5 g
-MAX_JERK = 1e15         # mm/s^3
-"""The largest limits a Machine takes: far beyond any machine tool, and small enough that
-the planner's powers of them (v^3, A^2 / J...) stay finite."""
+MAX_VELOCITY = 1e6       # mm/s: 1 km/s
+MAX_ACCELERATION = 1e14  # mm/s^2
+MAX_JERK = 1e20          # mm/s^3
+"""The largest limits a Machine takes: far beyond any machine tool ("no limit" in a test
+is 1e6 mm/s, 1e14 mm/s², 1e20 mm/s³), and small enough that the planner's powers of them
+(v^3, A^2, J^2...) stay finite (1e308 overflowed)."""
 
 
 def _triple(name: str, value, unit: str, most: float) -> tuple[float, float, float]:
