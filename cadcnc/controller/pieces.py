@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..interp.cycle import MAX_TURN
 from ..job import check_number
 from ..program.program import Program
 from .machine import Machine
@@ -81,10 +82,14 @@ def _distinct(points: np.ndarray):
     return pts, arc_lengths(pts, kappa), kappa, mask
 
 
-def _step_caps(seg, machine: Machine, mask: np.ndarray) -> np.ndarray | None:
+def _step_caps(seg, machine: Machine, mask: np.ndarray,
+               kappa: np.ndarray) -> np.ndarray | None:
     """Per kept point, the speed (mm/s) whose step at the machine's period stays within
-    ACCURACY_SHARE of what the accuracy rule allowed the program there; None if no cap.
-    The last step (landed on the end or a limit, not shortened for accuracy) is not one."""
+    ACCURACY_SHARE of what the accuracy rule allowed the program there, and of what it
+    allows any step on the path's curvature ``kappa`` (the chord's sag kappa f² / 4 within
+    the accuracy, a turn of at most MAX_TURN): a step the kernel shortens would leave it
+    behind the plan. None if no cap. The last step (landed on the end or a limit, not
+    shortened for accuracy) is not one."""
     path = seg.path
     job = path.job
     full = job.step
@@ -97,6 +102,9 @@ def _step_caps(seg, machine: Machine, mask: np.ndarray) -> np.ndarray | None:
         limit[:-2] = np.minimum(limit[:-2], steps)
         limit[1:-1] = np.minimum(limit[1:-1], steps)
     limit = limit[mask]
+    with np.errstate(divide="ignore"):
+        chord = np.minimum(np.sqrt(4.0 * job.tolerances.accuracy / kappa), MAX_TURN / kappa)
+    limit = np.minimum(limit, chord)
     if not np.isfinite(limit).any():
         return None
     return ACCURACY_SHARE * limit / machine.period
@@ -112,8 +120,8 @@ def pieces_of(program: Program, machine: Machine, feed: float | None = None) -> 
         if seg.kind == "cut":
             pts, s, kappa, mask = _distinct(np.asarray(seg.points, dtype=float))
             if s[-1] > DUPLICATE:
-                pieces.append(Piece(pts, s, feed / 60.0, k, cut, _step_caps(seg, machine, mask),
-                                    kappa))
+                caps = _step_caps(seg, machine, mask, kappa)
+                pieces.append(Piece(pts, s, feed / 60.0, k, cut, caps, kappa))
             cut += 1
             continue
         moves = np.asarray(seg.points, dtype=float)

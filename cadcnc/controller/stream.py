@@ -165,8 +165,9 @@ Progress = Callable[[int, int], None]
 """progress(periods done, periods in all), called at least every CHUNK periods."""
 CHUNK = 100_000   # periods the kernel follows between two progress calls
 SLACK = 1e-6      # relative: the finite differences' allowance over a limit
-REPLANS = 2       # plans again with the limit that was broken lowered by as much ...
+REPLANS = 3       # plans again with the limit that was broken lowered by as much ...
 NOISE = 1.5       # ... unless it is broken this much: the positions' noise, not the plan
+NOISY_PERIOD = 1e-4   # s: below it the positions' rounding can break the jerk
 
 
 def _over(positions: np.ndarray, machine: Machine) -> list[tuple[float, int, int]]:
@@ -190,15 +191,21 @@ def _over(positions: np.ndarray, machine: Machine) -> list[tuple[float, int, int
 
 
 def _refusal(over: list[tuple[float, int, int]], machine: Machine) -> PlanError:
+    """The refusal, naming the limit, the axis and the period, and the likely cause: the
+    positions' own rounding when the period is short and the excess large."""
     names = ("velocity", "acceleration", "jerk")
     q = max(range(3), key=lambda i: over[i][0])
     share, row, axis = over[q]
+    if share > NOISE and machine.period < NOISY_PERIOD:
+        why = (f"the positions' own rounding at a {machine.period * 1e6:g} us period: a "
+               "longer servo period may stream")
+    else:
+        why = ("the plan could not keep this limit along this path after "
+               f"{REPLANS} replans: please report it; a lower feed may stream")
     return PlanError(
         "the stream is over the machine's limits: nothing written: it would reach "
-        f"{100 * share:.1f} % of axis {AXES[axis]}'s "
-        f"{names[q]} limit at period {row} (the positions' own noise at a "
-        f"{machine.period * 1e6:g} us period, or limits the path cannot meet): refused; "
-        "a longer servo period or a lower jerk limit may stream")
+        f"{100 * share:.1f} % of axis {AXES[axis]}'s {names[q]} limit at period {row} "
+        f"({why})")
 
 
 def _cut_rows(stepper, piece: Piece, s: np.ndarray, what: str, done: int, total: int,
@@ -240,7 +247,7 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
         if shares.max() > NOISE:
             break
         # the path's derivatives between coarse points: plan again with less of the limit
-        derate = np.where(shares > 1.0, derate / (shares * (1.0 + 1e-3)), derate)
+        derate = np.where(shares > 1.0, derate / (shares * (1.0 + 1e-2)), derate)
     raise _refusal(over, machine)
 
 
