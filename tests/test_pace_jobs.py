@@ -39,9 +39,10 @@ def test_largest_first_keeps_every_result_in_its_place(part):
     assert sorted(seen) == [(k, k) for k in tasks]   # each reported under its own index
     assert {r[2] for r in out} - {os.getpid()}       # the workers ran them
     assert not {r[2] for r in out} & {os.getpid()}
-    # the pool is kept for the part: the same two workers again
+    # the pool is kept for the part: no worker beyond the pool's two, across both runs
+    # (the first run may have been served by one of them alone: its tasks are instant)
     again = on_workers(_where, tasks, part, 2, sizes=sizes[::-1])
-    assert {r[2] for r in again} <= {r[2] for r in out}
+    assert len({r[2] for r in again} | {r[2] for r in out}) <= 2
 
 
 def test_one_job_runs_here_in_order(part):
