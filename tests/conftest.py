@@ -9,6 +9,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -91,6 +92,19 @@ def occt_distance(point, shape) -> float:
     d.Perform()
     assert d.IsDone()
     return d.Value()
+
+
+def random_cell_boxes(face, boxes, rng, n: int):
+    """n random parameter cells of ``face``: (box (6,) from ``boxes.box``, points (49, 3)
+    of the face sampled on the cell), for the box-holds-its-surface tests."""
+    (u0, u1), (w0, w1) = face.u_range, face.w_range
+    out = []
+    for _ in range(n):
+        a, b = sorted(rng.uniform(u0, u1, 2))
+        c, d = sorted(rng.uniform(w0, w1, 2))
+        pts = [face.point(u, w) for u in np.linspace(a, b, 7) for w in np.linspace(c, d, 7)]
+        out.append((np.array(boxes.box(a, b, c, d)), np.array(pts), (b - a, d - c)))
+    return out
 
 
 @pytest.fixture

@@ -13,7 +13,7 @@ from cadcnc.guard.box_tree import BoxTree
 from cadcnc.guard.cells import FaceBoxes, HeightCells
 from cadcnc.guard.guard import OperationGuard
 
-from conftest import FIXTURES
+from conftest import FIXTURES, random_cell_boxes
 
 
 @pytest.fixture(scope="module")
@@ -26,17 +26,11 @@ def test_every_cell_box_contains_its_surface(slab, face):
     f = slab.face(face)
     boxes = FaceBoxes(f)
     assert boxes.surface is not None or boxes.curve is not None   # the tight path
-    (u0, u1), (w0, w1) = f.u_range, f.w_range
     rng = np.random.default_rng(1)
-    for _ in range(40):
-        a, b = np.sort(rng.uniform(u0, u1, 2))
-        c, d = np.sort(rng.uniform(w0, w1, 2))
-        box = np.array(boxes.box(a, b, c, d))
-        pts = np.array([f.point(u, w) for u in np.linspace(a, b, 7)
-                        for w in np.linspace(c, d, 7)])
+    for box, pts, (du, dw) in random_cell_boxes(f, boxes, rng, 40):
         assert (pts >= box[:3]).all() and (pts <= box[3:]).all()
         # and tight: within a tenth of a mm of the samples' own box for small cells
-        if (b - a) < 2 and (d - c) < 2:
+        if du < 2 and dw < 2:
             assert (box[3:] - pts.max(0)).max() < 0.1
 
 

@@ -20,7 +20,7 @@ from cadcnc.guard.clearance import ClearanceGuard
 from cadcnc.guard.face_boxes import face_cells, normal_box
 from cadcnc.guard.guard import OperationGuard
 
-from conftest import FIXTURES
+from conftest import FIXTURES, random_cell_boxes
 
 
 @pytest.fixture(scope="module")
@@ -39,14 +39,8 @@ def test_every_offset_box_contains_its_surface(offset_boss, face):
     assert bounded(f)
     boxes = FaceBoxes(f)
     assert boxes.offset is not None and abs(abs(boxes.offset) - 1.0) < 1e-9
-    (u0, u1), (w0, w1) = f.u_range, f.w_range
     rng = np.random.default_rng(3)
-    for _ in range(30):
-        a, b = np.sort(rng.uniform(u0, u1, 2))
-        c, d = np.sort(rng.uniform(w0, w1, 2))
-        box = np.array(boxes.box(a, b, c, d))
-        pts = np.array([f.point(u, w) for u in np.linspace(a, b, 7)
-                        for w in np.linspace(c, d, 7)])
+    for box, pts, _ in random_cell_boxes(f, boxes, rng, 30):
         assert (pts >= box[:3]).all() and (pts <= box[3:]).all()
     us, ws = face_cells(f, 1.0)
     grid = boxes.grid(us, ws)
