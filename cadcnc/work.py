@@ -19,7 +19,6 @@ import time
 from typing import Callable
 
 from .errors import InputError
-from .interrupts import sigint_deferred
 
 MAX_CYCLES = 5_000_000
 """Interpolation cycles one command may run in all (``--max-cycles``): about 500 m of path
@@ -116,20 +115,3 @@ def sigterm_as_interrupt():
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
-
-
-@contextlib.contextmanager
-def signals_deferred():
-    """Hold Ctrl-C and SIGTERM until the block is done, then raise KeyboardInterrupt."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    caught = []
-    previous = signal.signal(signal.SIGTERM, lambda signum, frame: caught.append(signum))
-    try:
-        with sigint_deferred():
-            yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-    if caught:
-        raise KeyboardInterrupt

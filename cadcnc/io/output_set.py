@@ -17,7 +17,8 @@ import tempfile
 from pathlib import Path
 
 from ..errors import OutputError, OutputIsInputError
-from ..work import sigterm_as_interrupt, signals_deferred
+from ..interrupts import signals_deferred
+from ..work import sigterm_as_interrupt
 from .atomic import NAME_MAX, temp_prefix
 
 
