@@ -13,13 +13,13 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import (
+from .core.errors import (
     CadcncError, FaceNumberError, FacePairError, GeometryError, InputError, OutputError,
     SingularPointError, StartPointError, StepFileError,
 )
-from .job import Finish, Job, PairPath, Pencil, Tool
+from .core.job import Finish, Job, PairPath, Pencil, Tool
 from .batch import batch  # the function: the name `cadcnc.batch` is not the package
-from .tolerances import Tolerances
+from .core.tolerances import Tolerances
 
 __version__ = "0.1.0"
 

@@ -41,7 +41,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Sequence
 
-from .errors import CadcncError, InputError
+from .core.errors import CadcncError, InputError
 
 PRELOAD = ["cadcnc.ops.run", "cadcnc.verification.gate_jobs", "cadcnc.ops.warm_up"]
 """Modules the workers' server imports once (every worker starts with them loaded; the

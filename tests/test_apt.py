@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from cadcnc import apt
-from cadcnc.errors import FacePairError, InputError, ProgramSyntaxError, StepFileError
-from cadcnc.job import Job
-from cadcnc.tolerances import DEFAULT, Tolerances
+from cadcnc.core.errors import FacePairError, InputError, ProgramSyntaxError, StepFileError
+from cadcnc.core.job import Job
+from cadcnc.core.tolerances import DEFAULT, Tolerances
 
 from conftest import FIXTURES, fixture_path, load_fixture
 

@@ -20,7 +20,7 @@ from cadcnc.io.program_gcode import segment_moves
 from cadcnc.io.program_json import read_program
 from cadcnc.io.toolpath_csv import CSV_COLUMNS
 from cadcnc.io.outputs import PROGRAM_CSV_COLUMNS
-from cadcnc.job import Job, PairPath, Tool
+from cadcnc.core.job import Job, PairPath, Tool
 from cadcnc.ops import common
 from cadcnc.ops.path import pair_program
 from conftest import FIXTURES, cadcnc_cli

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from cadcnc.errors import InputError
-from cadcnc.units import format_duration, parse_duration, parse_feed, parse_length, parse_point
+from cadcnc.core.errors import InputError
+from cadcnc.core.units import format_duration, parse_duration, parse_feed, parse_length, parse_point
 
 
 @pytest.mark.parametrize("text, seconds", [("4ms", 0.004), ("0.004s", 0.004), ("250us", 250e-6),

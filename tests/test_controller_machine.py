@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from cadcnc.controller.machine import Machine, read_machine_ini
-from cadcnc.errors import InputError
+from cadcnc.core.errors import InputError
 
 from conftest import cadcnc_cli
 

@@ -11,7 +11,7 @@ import pytest
 from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
 
 import cadcnc
-from cadcnc.errors import FaceNumberError
+from cadcnc.core.errors import FaceNumberError
 from cadcnc.ops.pencil.corners import BLEND, EDGE, NOT_SELECTED, TANGENT_FACES, find_corners
 
 FIX = Path(__file__).resolve().parent.parent / "fixtures"

@@ -17,8 +17,8 @@ import pytest
 from benchmarks.coverage.coverage_oracle import Oracle, read_shape
 from benchmarks.entries.sweeps import TOL, entries_at, entry_exists, links_check
 import cadcnc
-from cadcnc.errors import EXIT_GOUGE, EXIT_NOTHING, EXIT_OK
-from cadcnc.job import Job, PairPath, Tool
+from cadcnc.core.errors import EXIT_GOUGE, EXIT_NOTHING, EXIT_OK
+from cadcnc.core.job import Job, PairPath, Tool
 from cadcnc.ops.common import safe_height
 from cadcnc.program.linking import linked
 from cadcnc.program.program import Program

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.job import Job, PairPath, Tool
+from cadcnc.core.job import Job, PairPath, Tool
 from cadcnc.ops.common import safe_height
 from cadcnc.ops.entries import entered_program_segments
 from cadcnc.ops.path import pair_program

@@ -17,7 +17,7 @@ from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 
 from cadcnc import FaceSurface, SingularPointError
-from cadcnc.trim import BOUNDARY, INSIDE, OUTSIDE
+from cadcnc.core.trim_labels import BOUNDARY, INSIDE, OUTSIDE
 
 V = cq.Vector
 

@@ -17,15 +17,15 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.errors import InputError
-from cadcnc.job import Finish, Job, Tool
+from cadcnc.core.errors import InputError
+from cadcnc.core.job import Finish, Job, Tool
 from cadcnc.ops.finish.check import planned_intervals
 from cadcnc.ops.finish.finish import finish_program
 from cadcnc.ops.finish.passes import GuidePlane, _Pass
 from cadcnc.ops.finish.plan import centre_chord
 from cadcnc.ops.finish.setup import pass_setup
 from cadcnc.program.program import FAILED, STOPPED_SHORT
-from cadcnc.work import HEARTBEAT_S, MAX_PLANES, WorkLimitError
+from cadcnc.core.work_limits import HEARTBEAT_S, MAX_PLANES, WorkLimitError
 
 from conftest import FIXTURES
 

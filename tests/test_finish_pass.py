@@ -21,7 +21,7 @@ from OCP.gp import gp_Pnt
 
 import cadcnc
 from cadcnc.interp.cycle import COLLISION
-from cadcnc.job import Job, PairPath, Tool
+from cadcnc.core.job import Job, PairPath, Tool
 from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
 from cadcnc.verification.probe import FaceProbe
 from cadcnc.verification.surface_checks import check_surface

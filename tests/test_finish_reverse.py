@@ -16,7 +16,7 @@ import pytest
 import cadcnc
 import cadcnc.ops.finish.crossings as crossings_module
 import cadcnc.ops.finish.passes as pass_module
-from cadcnc.job import Finish, Job, PairPath, Tool
+from cadcnc.core.job import Finish, Job, PairPath, Tool
 from cadcnc.ops.finish.finish import finish, plan_for_job
 from cadcnc.ops.finish.check import pass_problems
 from cadcnc.ops.finish.passes import GuidePlane, pass_cuts

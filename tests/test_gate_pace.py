@@ -21,7 +21,7 @@ import pytest
 import cadcnc
 from OCP.GeomAbs import (GeomAbs_BSplineSurface, GeomAbs_Cylinder, GeomAbs_Sphere,
                          GeomAbs_SurfaceOfExtrusion, GeomAbs_Torus)
-from cadcnc.job import Finish, Job, Tool
+from cadcnc.core.job import Finish, Job, Tool
 from cadcnc.program.program import CutSegment, Program
 from cadcnc.verification import gate_program
 from cadcnc.verification.gate_cache import shared_gates

@@ -22,7 +22,7 @@ from cadcnc.guard.cells import BOUNDED_KINDS
 from cadcnc.guard.clearance import ClearanceGuard
 from cadcnc.guard.face_distance import FaceDistance
 from cadcnc.io.program_json import program_json
-from cadcnc.job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
+from cadcnc.core.job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
 
 from conftest import FIXTURES
 

@@ -16,7 +16,7 @@ import cadcnc
 from cadcnc.interp.cycle import CLOSED, END
 from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for
 from cadcnc.interp.stepper import Stepper, Tangency
-from cadcnc.tolerances import DEFAULT
+from cadcnc.core.tolerances import DEFAULT
 
 FEED, PERIOD = 1500.0, 0.004      # the paper's example: f = 0.1 mm
 R = 3.0

@@ -20,9 +20,9 @@ from pathlib import Path
 import pytest
 
 import cadcnc
-from cadcnc.errors import EXIT_INTERNAL, EXIT_INTERRUPTED
+from cadcnc.core.errors import EXIT_INTERNAL, EXIT_INTERRUPTED
 from cadcnc.geometry.part_bytes import part_blob, part_from_blob
-from cadcnc.errors import InputError
+from cadcnc.core.errors import InputError
 from cadcnc.workers import START_ENV, WorkerError, close, map_ordered, start_method
 from conftest import FIXTURES, cadcnc_cli
 

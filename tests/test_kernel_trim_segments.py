@@ -1,6 +1,6 @@
 """The trim grid's third round: segment lists in MIXED cells, the compiled polygon samples.
 
-- ``cadcnc.trim.resolve`` takes a labelled neighbour's label only across a clear move, and
+- ``cadcnc.interp.kernel.trim_lookup.resolve`` takes a labelled neighbour's label only across a clear move, and
   defers (CELL_MIXED) inside a band or when boxed in (a synthetic cell, closed forms).
 - The compiled pcurve and surface samples agree with OCCT's evaluation to round-off, and
   the polygon, bands and labels built with them equal the OCCT-only build (fixture faces).
@@ -23,7 +23,8 @@ from cadcnc.geometry.polygon_points import pcurve_points, surface_points
 from cadcnc.geometry.surface_data import surface_data
 from cadcnc.geometry.trim_grid import TrimGrid, classifier_tolerance
 from cadcnc.interp.tangency import _solve4
-from cadcnc.trim import CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, SEGMENTS, lookup
+from cadcnc.core.trim_labels import CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, SEGMENTS
+from cadcnc.interp.kernel.trim_lookup import lookup
 
 FIXTURES = Path(__file__).resolve().parents[1] / "fixtures"
 NAMES = ["bspline_boss", "crossing_cylinders", "sphere_cylinder", "torus_cone"]

@@ -14,7 +14,7 @@ import pytest
 
 from cadcnc.controller.ini_file import leading_number
 from cadcnc.controller.machine import IniWarning, read_machine_ini
-from cadcnc.errors import InputError
+from cadcnc.core.errors import InputError
 
 from conftest import FIXTURES, cadcnc_cli
 

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.errors import InputError
+from cadcnc.core.errors import InputError
 from cadcnc.io.outputs import PROGRAM_CSV_COLUMNS
 from cadcnc.io.program_json import program_json, read_program
-from cadcnc.job import Finish, Job, PairPath, Pencil, Tool
+from cadcnc.core.job import Finish, Job, PairPath, Pencil, Tool
 
 from conftest import FIXTURES, cadcnc_cli
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.job import Job, Pencil, Tool
+from cadcnc.core.job import Job, Pencil, Tool
 from cadcnc.ops.pencil import pencil
 from cadcnc.program.linking import TWO_OPT_MAX, order_cuts
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.errors import EXIT_NOTHING, InputError, NothingToCutError
-from cadcnc.job import Job, PairPath, Tool
+from cadcnc.core.errors import EXIT_NOTHING, InputError, NothingToCutError
+from cadcnc.core.job import Job, PairPath, Tool
 from cadcnc.ops.path.pair_program import LIMIT_SLACK, program_for_job, safe_height
 from conftest import FIXTURES
 

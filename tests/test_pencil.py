@@ -153,7 +153,7 @@ def test_the_guard_keeps_own_face_edges_within_the_written_programs_allowance():
     rule of digits_for): every operation's guard (pencil's, path's) must stop the ball inside that, with room for the
     chords between points; third faces keep the 1 nm rule."""
     from cadcnc.io.gcode import DEFAULT_TOLERANCE, blend_for, digits_for
-    from cadcnc.job import Job, PairPath, Tool
+    from cadcnc.core.job import Job, PairPath, Tool
     from cadcnc.guard import guard_for
 
     part = load_fixture("pocket")

@@ -14,16 +14,16 @@ import pytest
 
 import cadcnc
 from benchmarks.reliability.judge import polyline_depths
-from cadcnc.errors import EXIT_NOTHING, InputError, NothingToCutError
-from cadcnc.job import Job, PairPath, Pencil, Tool
+from cadcnc.core.errors import EXIT_NOTHING, InputError, NothingToCutError
+from cadcnc.core.job import Job, PairPath, Pencil, Tool
 from cadcnc.ops.path.pair_path import plan_path
 from cadcnc.ops.path.pair_program import program_for_job, stretch_cuts
 from cadcnc.ops.path.stretches import EdgeStretches, Limit, Stretch, too_tight
 from cadcnc.ops.pencil.pencil import pencil_program
 from cadcnc.ops.common import safe_height
-from cadcnc.tolerances import DEFAULT
+from cadcnc.core.tolerances import DEFAULT
 from cadcnc.verification.judgement import judge, settle
-from cadcnc.work import HEARTBEAT_S, WorkLimitError
+from cadcnc.core.work_limits import HEARTBEAT_S, WorkLimitError
 
 _parts: dict = {}
 

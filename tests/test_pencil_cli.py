@@ -14,8 +14,8 @@ import pytest
 from cadcnc.cli import operation as operation_cli
 from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_json import read_program
-from cadcnc import job as job_module
-from cadcnc.units import parse_duration, parse_feed
+from cadcnc.core import job as job_module
+from cadcnc.core.units import parse_duration, parse_feed
 from conftest import FIXTURES
 from test_cli import cadcnc_cli
 

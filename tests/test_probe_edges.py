@@ -26,7 +26,7 @@ from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.TopoDS import TopoDS
 
 import cadcnc
-from cadcnc.trim import INSIDE
+from cadcnc.core.trim_labels import INSIDE
 from cadcnc.verification.probe import INNER_MARGIN, FaceProbe, project_on_curve
 
 from conftest import FIXTURES

@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from cadcnc.errors import InputError
+from cadcnc.core.errors import InputError
 from cadcnc.io.program_json import program_to_dict, read_program, write_program_json
 from cadcnc.io.toolpath_json import write_json
 from cadcnc.program.linking import APPROACH, link, linked

@@ -30,7 +30,7 @@ import cadcnc
 from cadcnc.geometry.setup import job_setup, setup_part
 from cadcnc.interp.cycle import Contact
 from cadcnc.ops.path.stretches import TANGENT, pair_stretches
-from cadcnc.tolerances import DEFAULT
+from cadcnc.core.tolerances import DEFAULT
 
 from conftest import FIXTURES, occt_distance as distance
 

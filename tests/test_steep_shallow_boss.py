@@ -21,7 +21,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 import cadcnc
-from cadcnc.job import Finish, Job, Tool
+from cadcnc.core.job import Finish, Job, Tool
 from cadcnc.ops.finish.finish import plan_for_job
 from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
 from cadcnc.program.program import FAILED

@@ -14,7 +14,7 @@ import pytest
 
 from cadcnc.controller.hal.session import remove_stale
 from cadcnc.verification.stream_check import check_stream
-from cadcnc.work import Ticker
+from cadcnc.core.work_limits import Ticker
 
 from conftest import FIXTURES, cadcnc_cli
 

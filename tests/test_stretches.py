@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.errors import EXIT_NOTHING, NothingToCutError
+from cadcnc.core.errors import EXIT_NOTHING, NothingToCutError
 from cadcnc.guard import guard_for
-from cadcnc.job import Tool
+from cadcnc.core.job import Tool
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.stretch_paths import nearest_start, stretch_paths
 from cadcnc.ops.path.stretches import COLLISION, REASONS, Feasibility, pair_stretches
@@ -194,7 +194,7 @@ def test_a_hole_of_the_balls_radius_is_one_position_cut_as_a_point():
     the ball fits the hole exactly (R' k = 1, a tie, not a gouge: every point of the wall
     and floor is R' from the centre), so the whole bottom edge is one feasible position,
     the closed form (10, 10, 17), and its program is a single-point cut."""
-    from cadcnc.job import Job, PairPath
+    from cadcnc.core.job import Job, PairPath
     from cadcnc.ops.path.pair_program import program_for_job
 
     part = cadcnc.load_step(FIXTURES / "narrow_slot.step")

@@ -27,7 +27,7 @@ from cadcnc.geometry.material_side import CLOSED_SHELL, FLIPPED, OPEN_LEVEL, OPE
 from cadcnc.geometry.report import faces_report
 from cadcnc.geometry.sewing import file_faces, inconsistent_edges, sew
 from cadcnc.geometry.step_file import read_step
-from cadcnc.tolerances import DEFAULT
+from cadcnc.core.tolerances import DEFAULT
 from cadcnc.verification import gouge_gate
 from cadcnc.verification.material import IN, OUT, Material, PartFaces
 from conftest import FIXTURES, cadcnc_cli

@@ -23,8 +23,8 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.tolerances import Tolerances
-from cadcnc.trim import TRIM_STATES
+from cadcnc.core.tolerances import Tolerances
+from cadcnc.core.trim_labels import TRIM_STATES
 from cadcnc.verification import (
     FeedCheck, GateResult, StopCheck, TheoryRow, VerificationReport, WholePartCheck,
     WholePartHit, gouge_gate, verify,

@@ -11,15 +11,15 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.errors import InputError
+from cadcnc.core.errors import InputError
 from cadcnc.geometry.offset_section import loop_count, offset_face
-from cadcnc.job import Finish, Job, Tool
+from cadcnc.core.job import Finish, Job, Tool
 from cadcnc.ops.finish.levels import CRITICAL_MM, critical_heights, plan_levels
 from cadcnc.ops.finish.loops import level_cuts
 from cadcnc.ops.finish.plan import sample_faces
 from cadcnc.ops.finish.setup import pass_setup
 from cadcnc.verification.probe import shape_distances
-from cadcnc.work import WorkLimitError
+from cadcnc.core.work_limits import WorkLimitError
 from conftest import FIXTURES
 
 FACTS = json.loads((FIXTURES / "waterline_fixtures.json").read_text())

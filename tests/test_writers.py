@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from cadcnc.interp.error_bounds import SurfaceBounds
-from cadcnc.errors import InputError, OutputError
+from cadcnc.core.errors import InputError, OutputError
 from cadcnc.io import (
     ARRAYS, CSV_COLUMNS, atomic_write, check_output, read_csv, read_json, toolpath_from_dict,
     toolpath_to_dict, write_csv, write_json,

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.errors import InputError
+from cadcnc.core.errors import InputError
 from cadcnc.io.program_gcode import program_ngc, program_written_moves, segment_moves
-from cadcnc.job import Finish, Job, Pencil, Tool
+from cadcnc.core.job import Finish, Job, Pencil, Tool
 from conftest import FIXTURES
 
 pytestmark = pytest.mark.slow

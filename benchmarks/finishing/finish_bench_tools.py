@@ -37,7 +37,7 @@ from OCP.TopoDS import TopoDS
 from scipy.spatial import cKDTree
 
 from cadcnc.geometry.mesh import face_triangles
-from cadcnc.trim import INSIDE
+from cadcnc.core.trim_labels import INSIDE
 from cadcnc.verification.probe import FaceProbe
 
 from benchmarks import ROOT

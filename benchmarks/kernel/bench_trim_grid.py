@@ -58,7 +58,7 @@ def kernel_loop():
     (grid args..., window (4,), u (n,), w (n,), out (n,))."""
     if numba is None:
         return None
-    one, into = lookup, wrap  # compiled already (cadcnc.trim)
+    one, into = lookup, wrap  # compiled already (cadcnc.core.trim_labels)
 
     @numba.njit
     def run(grid, fine, u0, w0, du, dw, nu, nw, window, us, ws, out):

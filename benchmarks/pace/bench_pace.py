@@ -32,7 +32,7 @@ import cadcnc
 from cadcnc.io.gcode import blend_for
 from cadcnc.io.outputs import render
 from cadcnc.io.program_gcode import program_written_moves
-from cadcnc.job import Finish, Job, Pencil, Tool
+from cadcnc.core.job import Finish, Job, Pencil, Tool
 from cadcnc.ops.common import safe_height
 from cadcnc.ops.run import cut_back_gap
 from cadcnc.verification import gate_program

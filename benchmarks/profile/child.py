@@ -1,7 +1,8 @@
 """``python -m benchmarks.profile.child OUT.json [--tree DIR] -- ARGS...``: run ``cadcnc
 ARGS`` in this process under :mod:`.hooks` and write what they measured (and the exit
 code, the total CPU seconds) to OUT.json. ``--tree DIR``: run the cadcnc of another
-checkout (its ``cadcnc/`` and ``cli/``), e.g. the previous commit's, for a comparison."""
+checkout (its ``cadcnc/``, and ``cli/`` in checkouts older than the round that moved it
+into the package), e.g. the previous commit's, for a comparison."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import importlib.util
 import json
 import sys
 import time
+from pathlib import Path
 
 
 def _use_tree(tree: str) -> None:
@@ -19,8 +21,9 @@ def _use_tree(tree: str) -> None:
     module = importlib.util.module_from_spec(spec)
     sys.modules["cadcnc"] = module
     spec.loader.exec_module(module)
+    where = f"{tree}/cli" if Path(f"{tree}/cli/__init__.py").is_file() else f"{tree}/cadcnc/cli"
     spec = importlib.util.spec_from_file_location(
-        "cadcnc.cli", f"{tree}/cli/__init__.py", submodule_search_locations=[f"{tree}/cli"])
+        "cadcnc.cli", f"{where}/__init__.py", submodule_search_locations=[where])
     cli = importlib.util.module_from_spec(spec)
     sys.modules["cadcnc.cli"] = cli
     spec.loader.exec_module(cli)

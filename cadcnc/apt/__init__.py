@@ -22,7 +22,7 @@ Three stages, each complete before the next, one module each:
 - :mod:`~cadcnc.apt.grammar`: :func:`parse`, text to statements (syntax only; errors
   name line and column);
 - :mod:`~cadcnc.apt.program`: :func:`entries` / :func:`read_program`, statements to one
-  :class:`ProgramEntry` per PATH (its name, line and validated :class:`~cadcnc.job.Job`);
+  :class:`ProgramEntry` per PATH (its name, line and validated :class:`~cadcnc.core.job.Job`);
 - :mod:`~cadcnc.apt.execute`: :func:`check` loads the parts and checks face numbers and
   EDGE ends before any path is computed, then :func:`run_job` / :func:`stream_job` per
   entry.

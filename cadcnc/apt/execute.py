@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from ..errors import CadcncError, InputError
+from ..core.errors import CadcncError, InputError
 from ..geometry.part import load_step
 from ..ops.path.pair_path import path_for_job, plan_path, shared_edge_for, stepper_for
 from .program import ProgramEntry

@@ -2,7 +2,7 @@
 
 Pure syntax: no file system, no geometry, no ranges. A statement carries its values in
 user units (mm, mm/min, s) and, in ``where``, the (line, column) of each value, so that
-the program stage (:mod:`cadcnc.apt.program`) can report a value the :class:`~cadcnc.job.Job`
+the program stage (:mod:`cadcnc.apt.program`) can report a value the :class:`~cadcnc.core.job.Job`
 refuses at the place it was written. The checks here are the grammar's own: token kinds,
 the period's unit, face and edge numbers being whole numbers, edges numbered from 1.
 """
@@ -12,8 +12,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from ..errors import ProgramSyntaxError
-from ..units import DURATION_UNITS
+from ..core.errors import ProgramSyntaxError
+from ..core.units import DURATION_UNITS
 
 _NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _TOKEN = re.compile(rf"""

@@ -2,8 +2,8 @@
 
 CUTTER, FEED and PERIOD are modal (they apply to the paths after them); PART may change
 between paths, and a relative part file is relative to the program's folder. Every value
-is validated by the :class:`~cadcnc.job.Job` record itself (its :class:`~cadcnc.job.Tool`
-and :func:`~cadcnc.job.check_number`), where the statement is met; a value it refuses
+is validated by the :class:`~cadcnc.core.job.Job` record itself (its :class:`~cadcnc.core.job.Tool`
+and :func:`~cadcnc.core.job.check_number`), where the statement is met; a value it refuses
 comes back as a :class:`ProgramSyntaxError` at the value's line and column. Nothing here
 reads a part: :func:`cadcnc.apt.execute.check` does that.
 """
@@ -15,9 +15,9 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import InputError, ProgramSyntaxError
-from ..job import Job, PairPath, Tool, check_number, check_point
-from ..tolerances import DEFAULT, Tolerances
+from ..core.errors import InputError, ProgramSyntaxError
+from ..core.job import Job, PairPath, Tool, check_number, check_point
+from ..core.tolerances import DEFAULT, Tolerances
 from .grammar import Endpoint, Statement, parse
 
 # the modal settings a PATH needs, and the statement that gives each

@@ -25,7 +25,7 @@ from distributed import Client, LocalCluster, as_completed
 from distributed.client import FutureCancelledError
 from distributed.scheduler import KilledWorker
 
-from ..errors import EXIT_INTERNAL, InputError, OutputError
+from ..core.errors import EXIT_INTERNAL, InputError, OutputError
 from ..io.output_set import OutputSet, check_not_inputs
 from ..io.outputs import SUFFIXES
 from .records import STATE, Record, job_hash, save_state, unchanged, write_summary

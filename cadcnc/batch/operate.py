@@ -13,17 +13,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, NothingToCutError
+from ..core.errors import InputError, NothingToCutError
 from ..geometry.part import Part, load_step
 from ..geometry.setup import setup_in, setup_part
 from ..io.outputs import render_all
-from ..job import Job
+from ..core.job import Job
 from ..ops.common import safe_height
 from ..ops.run import cut_back_gap, run
 from ..program.program import Program
 from ..verification.gate_cache import open_shared
 from ..verification.judgement import Verdict, judge, settle
-from ..work import MAX_CYCLES
+from ..core.work_limits import MAX_CYCLES
 
 
 @dataclass(frozen=True)

@@ -17,9 +17,9 @@ from dataclasses import asdict, dataclass, field, fields
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
-from ..errors import EXIT_OK, EXIT_PARTIAL, InputError
+from ..core.errors import EXIT_OK, EXIT_PARTIAL, InputError
 from ..io.atomic import write_text
-from ..jsonable import plain
+from ..core.jsonable import plain
 from .task import BatchPart, OperationResult
 
 STATE = "batch-part.json"

@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 from distributed import get_worker
 
-from ..errors import EXIT_INTERNAL, EXIT_OK, CadcncError
-from ..job import Job
+from ..core.errors import EXIT_INTERNAL, EXIT_OK, CadcncError
+from ..core.job import Job
 from .operate import Settings, operate, rendered
 
 EVENT_TOPIC = "cadcnc-batch"

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ..errors import EXIT_GOUGE, CadcncError, InputError
+from ..core.errors import EXIT_GOUGE, CadcncError, InputError
 from . import topp
 from .machine import Machine
 from .pieces import Piece, constant_speed

@@ -1,6 +1,6 @@
 """The machine a program is streamed to: servo period and per-axis limits, and its INI file.
 
-:class:`Machine` is validated where it is built (an :class:`~cadcnc.errors.InputError`
+:class:`Machine` is validated where it is built (an :class:`~cadcnc.core.errors.InputError`
 names the field); :func:`read_machine_ini` reads the limits from the LinuxCNC INI file a
 user already has. Units inside: mm, s.
 """
@@ -13,7 +13,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import InputError
+from ..core.errors import InputError
 from .ini_file import IniFile, leading_number
 
 AXES = ("X", "Y", "Z")

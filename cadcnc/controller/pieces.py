@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..interp.cycle import MAX_TURN
-from ..job import check_number
+from ..core.job import check_number
 from ..program.program import Program
 from .machine import Machine
 

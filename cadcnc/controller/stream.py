@@ -19,7 +19,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import GeometryError
+from ..core.errors import GeometryError
 from ..interp.cycle import CLOSED, END
 from ..interp.follow import follow
 from ..program.program import Program

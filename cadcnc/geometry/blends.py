@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import GeometryError
+from ..core.errors import GeometryError
 from .part import TANGENT, Part, SharedEdge
 
 GRID = 5                # samples per parameter direction (GRID x GRID over the face's box)

@@ -28,9 +28,9 @@ from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
 
 from . import differential as dg
 from .surface_data import SURFACE_KINDS, SurfaceData, as_topods_face, surface_data
-from ..errors import GeometryError, InputError, SingularPointError
-from ..tolerances import DEFAULT, Tolerances
-from ..trim_states import BOUNDARY, INSIDE, OUTSIDE
+from ..core.errors import GeometryError, InputError, SingularPointError
+from ..core.tolerances import DEFAULT, Tolerances
+from ..core.trim_labels import BOUNDARY, INSIDE, OUTSIDE
 
 @dataclass(frozen=True)
 class Derivatives:

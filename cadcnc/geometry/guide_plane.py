@@ -7,7 +7,7 @@ import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt
 
-from ..tolerances import DEFAULT, Tolerances
+from ..core.tolerances import DEFAULT, Tolerances
 from .face_surface import FaceSurface
 
 

@@ -25,7 +25,7 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_HSequenceOfShape
 
-from ..errors import GeometryError
+from ..core.errors import GeometryError
 
 JOIN_TOL = 1e-6
 """mm: section edges whose ends are this near are joined into one wire."""

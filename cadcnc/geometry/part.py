@@ -23,14 +23,14 @@ from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
-from ..errors import FaceNumberError, InputError, StepFileError
+from ..core.errors import FaceNumberError, InputError, StepFileError
 from .boxes import optimal_box
 from .differential import cross
 from .face_surface import FaceSurface
 from .material_side import FLIPPED, SOLID, SurfaceModel, material_sides
 from .sewing import file_faces, sew
 from .step_file import read_step
-from ..tolerances import DEFAULT, Tolerances
+from ..core.tolerances import DEFAULT, Tolerances
 
 CONCAVE, CONVEX, TANGENT, MIXED = "concave", "convex", "tangent", "mixed"
 

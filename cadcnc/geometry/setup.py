@@ -26,8 +26,8 @@ import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
 from OCP.gp import gp_Trsf
 
-from ..errors import OutputError
-from ..job import PRINCIPAL_AXES, Job, axis_name
+from ..core.errors import OutputError
+from ..core.job import PRINCIPAL_AXES, Job, axis_name
 from .boxes import optimal_box
 from .part import Part
 

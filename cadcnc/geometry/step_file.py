@@ -21,7 +21,7 @@ from OCP.Message import Message, Message_Gravity
 from OCP.STEPControl import STEPControl_Reader
 from OCP.TopoDS import TopoDS_Shape
 
-from ..errors import StepFileError
+from ..core.errors import StepFileError
 
 _LIBC = ctypes.CDLL(None)
 HEADER = b"ISO-10303-21"

@@ -62,7 +62,7 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Face
 
 from . import bspline_blob
-from ..errors import InputError
+from ..core.errors import InputError
 
 SURFACE_KINDS = {
     GeomAbs_Plane: "plane",

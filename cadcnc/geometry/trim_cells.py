@@ -6,7 +6,7 @@ arithmetic of the vectorised rule it replaced (segments cut into pieces no longe
 cell, each piece's band-inflated bounding box), and which segments touch it; ``regions``
 numbers the free cells' 4-connected regions and picks three cells of each (first, middle,
 last in row-major order) for the exact calls; ``segment_blocks`` stores each MIXED cell's
-segments for ``cadcnc.trim.resolve``.
+segments for ``cadcnc.interp.kernel.trim_lookup.resolve``.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import math
 import numba
 import numpy as np
 
-from ..trim import CELL_MIXED, SEGMENT_WORDS, SEGMENTS
+from ..core.trim_labels import CELL_MIXED, SEGMENT_WORDS, SEGMENTS
 
 _jit = numba.njit(cache=True, nogil=True)
 
@@ -120,7 +120,7 @@ def segment_blocks(labels: np.ndarray, start: np.ndarray, ids: np.ndarray, p: np
                    q: np.ndarray, h: np.ndarray, eps: np.ndarray) -> tuple:
     """(codes (nu, nw) int64, fine (m,) float64): ``labels`` with 3 + k on every MIXED cell
     that has segments, ``fine[k:]`` its block [SEGMENTS, n, eps_u, eps_w, n x (p, q, h)]
-    for ``cadcnc.trim.resolve``."""
+    for ``cadcnc.interp.kernel.trim_lookup.resolve``."""
     nu, nw = labels.shape
     codes = labels.astype(np.int64)
     total = 0

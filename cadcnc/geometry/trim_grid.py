@@ -28,13 +28,13 @@ cells each side (periodic ones inside a one-period window centred on them), so a
 beyond the grid takes its nearest border cell's label.
 
 MIXED cells (``trim_cells.segment_blocks``) keep the band segments that meet them (seam and
-periodic copies included). ``cadcnc.trim.resolve`` answers a point of such a cell with the
+periodic copies included). ``cadcnc.interp.kernel.trim_lookup.resolve`` answers a point of such a cell with the
 label of a labelled neighbour cell when the axis-parallel move from the point to their
 shared side, swept by each segment's half-widths + eps (FClass2d's own ON test), meets no
 segment: that rectangle and the neighbour form a connected set meeting no band, so
 FClass2d's answer is the neighbour's. Only a point that no such move clears (inside a band,
 where FClass2d itself turns to BRepClass, or boxed in between bands) is classified exactly.
-``kernel_args`` hands codes and segment lists to ``cadcnc.trim.lookup``, the reader the
+``kernel_args`` hands codes and segment lists to ``cadcnc.interp.kernel.trim_lookup.lookup``, the reader the
 kernel and ``cell`` share.
 """
 
@@ -51,7 +51,8 @@ from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT
 
 from .fclass_polygon import classifier_tolerance, polygon_bands  # noqa: F401 (re-exported)
 from .trim_cells import layout, paint, regions, segment_blocks, segment_lists
-from ..trim import BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE, lookup
+from ..core.trim_labels import BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE
+from ..interp.kernel.trim_lookup import lookup
 
 
 def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
@@ -90,7 +91,7 @@ class TrimGrid:
 
     ``classify(u, w)`` is ``face_surface.classify(u, w)``, O(1) outside MIXED cells. The
     kernel: ``lookup(*kernel_args, *to_window(u, w))`` (``window`` = (u start, u period,
-    w start, w period), period 0 where not periodic; ``cadcnc.trim.wrap`` does to_window).
+    w start, w period), period 0 where not periodic; ``cadcnc.interp.kernel.trim_lookup.wrap`` does to_window).
     ``stats``: build_s (s), regions, calls (exact calls at build), suspect, exact_only.
     """
 
@@ -107,7 +108,7 @@ class TrimGrid:
               checks: int = 3, sub_cells: int = 256, data=None) -> "TrimGrid":
         """Label a grid for ``face_surface`` (a FaceSurface) by the module's rule, with
         ``checks`` (1..3) exact calls per region (the first decides, the others confirm);
-        ``sub_cells`` > 1: MIXED cells keep their segments (``cadcnc.trim.resolve``), 1:
+        ``sub_cells`` > 1: MIXED cells keep their segments (``cadcnc.interp.kernel.trim_lookup.resolve``), 1:
         they always defer to FClass2d. ``data``: the face's SurfaceData, if built already
         (its B-spline poles are reused)."""
         t_start = time.perf_counter()
@@ -157,7 +158,7 @@ class TrimGrid:
 
     def cell(self, u: float, w: float) -> int:
         """The label of (u, w), given in the window (CELL_MIXED if not finite), read as the
-        kernel reads it (``cadcnc.trim.lookup``)."""
+        kernel reads it (``cadcnc.interp.kernel.trim_lookup.lookup``)."""
         return lookup(self.codes, self.fine, self.u0, self.w0, self.du, self.dw, self.nu,
                       self.nw, u, w)
 
@@ -172,5 +173,5 @@ class TrimGrid:
     @property
     def kernel_args(self) -> tuple:
         """(codes, fine, u0, w0, du, dw, nu, nw): the leading arguments of
-        ``cadcnc.trim.lookup``."""
+        ``cadcnc.interp.kernel.trim_lookup.lookup``."""
         return self.codes, self.fine, self.u0, self.w0, self.du, self.dw, self.nu, self.nw

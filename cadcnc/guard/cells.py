@@ -39,7 +39,7 @@ import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..trim import OUTSIDE
+from ..core.trim_labels import OUTSIDE
 from .clearance import distance
 from .face_boxes import BOUNDED_KINDS, CELL_MM, MAX_CELLS, SLACK, FaceBoxes, bounded, face_cells
 

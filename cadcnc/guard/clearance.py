@@ -46,7 +46,7 @@ from OCP.gp import gp_Pnt
 
 from .analytic import AnalyticFace
 from .face_distance import FaceDistance
-from ..tolerances import DEFAULT
+from ..core.tolerances import DEFAULT
 
 TIE = 1e-9  # mm: margins this close are the same contact
 BOX_SLACK = 1e-4  # mm added to each face box: OCCT's optimal box is tight, not outer-exact

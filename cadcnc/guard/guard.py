@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 
-from ..tolerances import DEFAULT
+from ..core.tolerances import DEFAULT
 from .box_tree import BoxTree
 from .cells import HeightCells, bounded, shared
 from .clearance import BOX_SLACK, ClearanceGuard, distance

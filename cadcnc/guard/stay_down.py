@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .moves import MoveClearance
-from ..trim import OUTSIDE
+from ..core.trim_labels import OUTSIDE
 
 NEWTON = 6
 """Newton steps towards the foot of a point on a face (the witness is valid at any step)."""

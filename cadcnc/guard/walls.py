@@ -38,7 +38,7 @@ from OCP.TopExp import TopExp
 from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.TopoDS import TopoDS
 
-from ..trim import INSIDE, OUTSIDE
+from ..core.trim_labels import INSIDE, OUTSIDE
 from .cells import DROPS, REUSE, HeightCells, shared
 
 VERTICAL = 1e-12   # |1 - |d_z|| below this: a direction is vertical

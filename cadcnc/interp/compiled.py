@@ -18,11 +18,11 @@ import math
 
 import numpy as np
 
-from ..errors import GeometryError
-from ..job import MIN_STEP as JOB_MIN_STEP
-from ..job import check_number, check_step
-from ..tolerances import DEFAULT
-from ..trim import OUTSIDE
+from ..core.errors import GeometryError
+from ..core.job import MIN_STEP as JOB_MIN_STEP
+from ..core.job import check_number, check_step
+from ..core.tolerances import DEFAULT
+from ..core.trim_labels import OUTSIDE
 from .cycle import (
     BOUNDARY, CLOSED, COLLISION, CORRECTION_SINGULAR, CURVATURE, DIVERGED, END, MAX_CYCLES,
     Contact,

@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple, Protocol
 
-from ..tolerances import DEFAULT, Tolerances
+from ..core.tolerances import DEFAULT, Tolerances
 from .vec3 import Vec, add, axpy, cross, dot, norm, scale, solve3, sub
 
 # stop reasons (Toolpath.stop_reason)

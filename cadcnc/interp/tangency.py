@@ -11,10 +11,10 @@ import math
 
 import numpy as np
 
-from ..errors import StartPointError
+from ..core.errors import StartPointError
 from .stepper import Tangency
 from .vec3 import add, axpy, cross, dot, norm, scale, sub
-from ..tolerances import DEFAULT, Tolerances
+from ..core.tolerances import DEFAULT, Tolerances
 
 
 def offset_point_and_jacobian(surface, offset: float, u: float, w: float):

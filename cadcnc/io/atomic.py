@@ -11,7 +11,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from ..errors import OutputError
+from ..core.errors import OutputError
 
 
 NAME_MAX = 255  # bytes in one file name on common file systems

@@ -24,8 +24,8 @@ import re
 
 import numpy as np
 
-from ..errors import InputError
-from ..tolerances import DEFAULT as _DEFAULT_TOLERANCES
+from ..core.errors import InputError
+from ..core.tolerances import DEFAULT as _DEFAULT_TOLERANCES
 
 DEFAULT_GOUGE = _DEFAULT_TOLERANCES.gouge  # mm: the default gouge limit
 

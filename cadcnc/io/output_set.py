@@ -16,9 +16,9 @@ import os
 import tempfile
 from pathlib import Path
 
-from ..errors import OutputError, OutputIsInputError
-from ..interrupts import signals_deferred
-from ..work import sigterm_as_interrupt
+from ..core.errors import OutputError, OutputIsInputError
+from ..core.interrupts import signals_deferred
+from ..core.work_limits import sigterm_as_interrupt
 from .atomic import NAME_MAX, temp_prefix
 
 

@@ -14,7 +14,7 @@ import csv
 import io
 from pathlib import Path
 
-from ..errors import OutputError
+from ..core.errors import OutputError
 from ..geometry.setup import job_setup
 from ..program.program import Program
 from ..program.transform import in_part_coordinates

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import OutputError
+from ..core.errors import OutputError
 from ..geometry.mesh import tessellate
 from .output_set import write_one
 

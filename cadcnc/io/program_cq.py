@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import require
+from ..core.errors import require
 from ..program.program import Program
 
 MIN_EDGE = 1e-3  # mm: a shorter move is merged into the next

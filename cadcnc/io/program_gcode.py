@@ -17,9 +17,9 @@ import re
 
 import numpy as np
 
-from ..errors import InputError
-from ..job import check_number
-from ..job import SAFE_MARGIN
+from ..core.errors import InputError
+from ..core.job import check_number
+from ..core.job import SAFE_MARGIN
 from ..program.linking import linked
 from ..program.program import CutSegment, Program
 from .atomic import write_text

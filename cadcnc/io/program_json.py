@@ -28,10 +28,10 @@ import os
 
 import numpy as np
 
-from ..errors import require
-from ..errors import InputError
-from ..job import Job
-from ..jsonable import plain
+from ..core.errors import require
+from ..core.errors import InputError
+from ..core.job import Job
+from ..core.jsonable import plain
 from ..geometry.setup import Setup
 from ..program.program import CutSegment, LinkSegment, Program, Skipped
 from ..program.transform import in_part_coordinates, in_setup_coordinates

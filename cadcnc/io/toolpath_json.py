@@ -18,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..core.errors import InputError
 from ..interp.error_bounds import SurfaceBounds
-from ..job import Job
-from ..jsonable import plain
+from ..core.job import Job
+from ..core.jsonable import plain
 from ..program.toolpath import Toolpath
 from .atomic import write_text
 

@@ -3,12 +3,12 @@ height of link moves, running one stretch's cut, and the program of a single pat
 
 from __future__ import annotations
 
-from ..errors import GeometryError, InputError
-from ..job import SAFE_MARGIN, Job
+from ..core.errors import GeometryError, InputError
+from ..core.job import SAFE_MARGIN, Job
 from ..program.linking import linked
 from ..program.program import CutSegment, Program
 from ..program.toolpath import Toolpath, toolpath_from_record
-from ..work import MAX_CYCLES, refuse_over
+from ..core.work_limits import MAX_CYCLES, refuse_over
 from .path.pair_path import PathPlan, stepper_for
 
 
@@ -25,7 +25,7 @@ def require_ball(job: Job) -> None:
 def refuse_cycles(lengths_mm, job: Job, what: str, max_cycles: int = MAX_CYCLES) -> float:
     """The cycles ``job``'s step needs for paths of ``lengths_mm`` in all (their sum over
     the step F Ts, the commanded step; the accuracy rule's shorter steps come on top),
-    refused up front (:class:`~cadcnc.work.WorkLimitError`) over ``max_cycles``."""
+    refused up front (:class:`~cadcnc.core.work_limits.WorkLimitError`) over ``max_cycles``."""
     total = float(sum(lengths_mm))
     cycles = total / job.step
     refuse_over(f"{what}: {total:.4g} mm of corners at a step of {job.step:.3g} mm",

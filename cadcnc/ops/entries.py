@@ -32,7 +32,7 @@ import numpy as np
 
 from ..interp.cycle import END
 from ..guard import FINISH_OWN_SHARE, PAIR_OWN_SHARE, MoveClearance, guard_for
-from ..job import Job
+from ..core.job import Job
 from ..program.linking import Visit, linked
 from ..program.program import CutSegment, LinkSegment, Skipped
 from ..program.toolpath import toolpath_piece

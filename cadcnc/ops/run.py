@@ -1,13 +1,13 @@
-"""One entry for every operation: :func:`run` a :class:`~cadcnc.job.Job` on a part."""
+"""One entry for every operation: :func:`run` a :class:`~cadcnc.core.job.Job` on a part."""
 
 from __future__ import annotations
 
-from ..errors import InputError
+from ..core.errors import InputError
 from ..geometry.part import Part
 from ..geometry.setup import setup_part
-from ..job import Finish, Job, PairPath, Pencil
+from ..core.job import Finish, Job, PairPath, Pencil
 from ..program.program import Program
-from ..work import MAX_CYCLES
+from ..core.work_limits import MAX_CYCLES
 from ..workers import start
 from .path.pair_program import program_for_job
 from .pencil.pencil import CHAIN_GAP, pencil_program
@@ -17,9 +17,9 @@ def run(part, job: Job, *, progress=None, times: dict | None = None,
         max_cycles: int = MAX_CYCLES, jobs: int | None = 1) -> Program:
     """The :class:`~cadcnc.program.program.Program` of ``job`` on ``part`` (a
     :class:`~cadcnc.geometry.part.Part`, or a CadQuery Workplane or Shape): the pair's
-    corner for :class:`~cadcnc.job.PairPath` (every feasible stretch, cut and linked),
-    every inner corner for :class:`~cadcnc.job.Pencil`, the raster passes for
-    :class:`~cadcnc.job.Finish`. ``progress``: the operation's progress callback
+    corner for :class:`~cadcnc.core.job.PairPath` (every feasible stretch, cut and linked),
+    every inner corner for :class:`~cadcnc.core.job.Pencil`, the raster passes for
+    :class:`~cadcnc.core.job.Finish`. ``progress``: the operation's progress callback
     (:func:`program_for_job`: ``(cycles, mm)``; pencil and finish: ``(done, total,
     what)``); ``times``: pencil's seconds per stage
     (:func:`pencil_program`); ``max_cycles``: the interpolation cycles the path or pencil

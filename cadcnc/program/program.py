@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..job import Job
+from ..core.job import Job
 from .summary import program_summary
 from .toolpath import Toolpath
 

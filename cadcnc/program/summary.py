@@ -4,8 +4,8 @@ count), the links, what was skipped and why, the notes, the totals and complete 
 
 from __future__ import annotations
 
-from ..job import Finish, PairPath, Pencil
-from ..units import format_duration
+from ..core.job import Finish, PairPath, Pencil
+from ..core.units import format_duration
 
 CUT_LINES = 12
 """Programs with more cuts than this list them counted, not one by one."""

@@ -18,7 +18,7 @@ from ..interp.cycle import CLOSED, END, PAPER_INVERSE_LIMIT
 from ..interp.bounds_compiled import pair_bounds
 from ..interp.error_bounds import SurfaceBounds
 from ..interp.record import PathRecord
-from ..job import Job
+from ..core.job import Job
 
 
 INTENDED_STOPS = (END, CLOSED)

@@ -11,7 +11,7 @@ it (+ out of the material) minus its offset R' = R + C, so a negative deviation 
 over-cut (a gouge) and a positive one an under-cut (material left). The depth of the ball
 into the part is material-aware: OCCT's solid classifier, not a face's side, says which
 centres are in the material. Every threshold comes from
-:class:`~cadcnc.tolerances.Tolerances`. Lengths in mm, times in s. See docs/notes/validation.md
+:class:`~cadcnc.core.tolerances.Tolerances`. Lengths in mm, times in s. See docs/notes/validation.md
 and docs/notes/gate.md.
 
 Modules: :mod:`.records` (one typed record per check), :mod:`.report` (the report and

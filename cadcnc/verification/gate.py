@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import math
 from ..program.toolpath import Toolpath
-from ..errors import require
+from ..core.errors import require
 from dataclasses import dataclass, field
 
-from ..tolerances import Tolerances
+from ..core.tolerances import Tolerances
 from .records import SweepCheck, WholePartHit, strict_max
 from .gate_cache import cache_for, toolpath_key
 from .surface_checks import SAMPLE_UNSEEDED, check_pair, prepare, resolve_part

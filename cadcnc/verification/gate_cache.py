@@ -23,7 +23,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..tolerances import Tolerances
+from ..core.tolerances import Tolerances
 from .material import Material, PartFaces
 
 _CACHES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()

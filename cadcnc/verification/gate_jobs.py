@@ -12,7 +12,7 @@ it in whichever processes they run.
 from __future__ import annotations
 
 from ..geometry.part_bytes import part_blob, part_from_blob
-from ..tolerances import Tolerances
+from ..core.tolerances import Tolerances
 from ..ops.parallel import on_workers
 from .gate import GateResult, gouge_gate
 from .gate_cache import cache_for, open_shared, toolpath_key

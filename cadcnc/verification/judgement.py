@@ -2,7 +2,7 @@
 operation: cut gouging cuts back (pencil, finish), gate the whole program as written, and
 judge partial and gouging programs (refused unless the user allows them).
 
-Exit codes (docs/reliability.md) are those of :mod:`cadcnc.errors`: 0 only for a complete
+Exit codes (docs/reliability.md) are those of :mod:`cadcnc.core.errors`: 0 only for a complete
 program whose every cut and every written move passed the gouge gate; 5 a gouge; 6 partial.
 """
 
@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ..errors import (EXIT_GOUGE, EXIT_INPUT, EXIT_INTERNAL, EXIT_NOTHING, EXIT_OK,
+from ..core.errors import (EXIT_GOUGE, EXIT_INPUT, EXIT_INTERNAL, EXIT_NOTHING, EXIT_OK,
                       EXIT_OUTPUT, EXIT_PARTIAL, NothingToCutError)
 from ..io.program_gcode import program_written_moves
 from ..program.program import FAILED, STOPPED_SHORT, Program

@@ -26,7 +26,7 @@ from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_SOLID
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
-from ..tolerances import Tolerances
+from ..core.tolerances import Tolerances
 from .bounds import point_box_distance
 from .planar import planar_twin
 from .probe import FaceProbe

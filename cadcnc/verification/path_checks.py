@@ -1,6 +1,6 @@
 """Checks of the path as a whole: step lengths, theory against measurement, the stop.
 
-Everything is read from the toolpath's :class:`~cadcnc.job.Job` (period, end point, edge)
+Everything is read from the toolpath's :class:`~cadcnc.core.job.Job` (period, end point, edge)
 and its per-cycle arrays. Lengths in mm, feeds in mm/min.
 """
 
@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry.part import CONCAVE
-from ..tolerances import Tolerances
-from ..trim import INSIDE
+from ..core.tolerances import Tolerances
+from ..core.trim_labels import INSIDE
 from .probe import FaceProbe
 from .records import BOUND_NAMES, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, TheoryRow
 

@@ -27,7 +27,7 @@ from OCP.TopAbs import TopAbs_FORWARD, TopAbs_WIRE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
-from ..tolerances import Tolerances
+from ..core.tolerances import Tolerances
 from .probe import FaceProbe
 
 PLANAR_TOL = 1e-10

@@ -29,8 +29,8 @@ from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
 
 from ..geometry.boxes import optimal_box
-from ..tolerances import DEFAULT, Tolerances
-from ..trim import BOUNDARY, INSIDE, OUTSIDE
+from ..core.tolerances import DEFAULT, Tolerances
+from ..core.trim_labels import BOUNDARY, INSIDE, OUTSIDE
 from .box_face import whole_box
 from .face_edges import FaceEdges
 

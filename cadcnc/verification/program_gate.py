@@ -14,12 +14,12 @@ from __future__ import annotations
 
 import math
 from ..program.program import Program
-from ..errors import require
+from ..core.errors import require
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..tolerances import Tolerances
+from ..core.tolerances import Tolerances
 from .gate import GateResult, gouge_gate
 from .gate_cache import shared_gates
 from .gate_jobs import gate_cuts

@@ -1,7 +1,7 @@
 """One typed record per check, with its JSON form (``to_dict``).
 
 Callers read attributes, never guessed keys. Lengths in mm; cycle ranges are [first,
-last] pairs of cycle numbers, inclusive; trim states are :mod:`cadcnc.trim`'s strings.
+last] pairs of cycle numbers, inclusive; trim states are :mod:`cadcnc.core.trim_labels`'s strings.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ class SurfaceCheck:
 
     ``deviation``: against the untrimmed surface; ``face_deviation``: against the trimmed
     face (its nearest point, boundary included); ``states`` the foot point's trim state
-    per cycle (:mod:`cadcnc.trim`). ``max_trim_gap_mm``: the largest trimmed minus
+    per cycle (:mod:`cadcnc.core.trim_labels`). ``max_trim_gap_mm``: the largest trimmed minus
     untrimmed distance (> 0 where the nearest surface point lies outside the face: the
     ball touches only the surface's extension there); ``off_face_cycles`` the cycle ranges
     where it exceeds ``Tolerances.off_face``. ``unseeded_*``: the global re-projection check.
@@ -160,7 +160,7 @@ class StopCheck:
     """Where the last contacts lie, and whether that matches the stop reason.
 
     ``last_contact_states``: per face, the last foot point's trim state
-    (:mod:`cadcnc.trim`) with the loose classifier ``Tolerances.classify_loose``; ``span``
+    (:mod:`cadcnc.core.trim_labels`) with the loose classifier ``Tolerances.classify_loose``; ``span``
     what the path was meant to cover ("closed", "end" or "target"); ``remaining_mm`` the
     uncovered reference length at the end of that span; ``consistent`` None when the stop
     reason says nothing checkable; ``left_face`` the faces whose last foot is not inside.

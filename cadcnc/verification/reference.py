@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..tolerances import DEFAULT, Tolerances
+from ..core.tolerances import DEFAULT, Tolerances
 from . import probe as occt
 from .records import ReferenceCheck
 

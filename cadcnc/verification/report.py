@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..jsonable import plain
-from ..tolerances import DEFAULT, Tolerances
+from ..core.jsonable import plain
+from ..core.tolerances import DEFAULT, Tolerances
 from .records import (
     Criterion, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, SweepCheck, TheoryRow,
     WholePartCheck, WholePartHit, strict_max,

@@ -14,8 +14,8 @@ import time
 import numpy as np
 
 from ..program.toolpath import Toolpath
-from ..errors import require
-from ..tolerances import Tolerances
+from ..core.errors import require
+from ..core.tolerances import Tolerances
 from .path_checks import check_feed, check_stop, check_theory, followed_edge, intended_span
 from .probe import offset_surface, shape_distances
 from .reference import check_reference

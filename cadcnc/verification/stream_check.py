@@ -4,8 +4,8 @@
 row per servo period), the period and the limits as plain numbers, and the program's
 first and last points. It judges by finite differences alone (velocity
 ``diff(x) / T``, acceleration ``diff(x, 2) / T^2``, jerk ``diff(x, 3) / T^3`` per axis,
-within the limit times 1 + :data:`~cadcnc.tolerances.STREAM_LIMIT_SLACK`) and by the ends
-(within :data:`~cadcnc.tolerances.STREAM_END` of the program's). It shares no code with
+within the limit times 1 + :data:`~cadcnc.core.tolerances.STREAM_LIMIT_SLACK`) and by the ends
+(within :data:`~cadcnc.core.tolerances.STREAM_END` of the program's). It shares no code with
 the feed planner (:mod:`cadcnc.controller`), so a planner's defect cannot hide here.
 
 :func:`check_program_on_part` asks whether a program was computed on the part given: each
@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FaceNumberError, InputError
-from ..tolerances import STREAM_END, STREAM_LIMIT_SLACK
+from ..core.errors import FaceNumberError, InputError
+from ..core.tolerances import STREAM_END, STREAM_LIMIT_SLACK
 
 AXES = "XYZ"
 CHUNK = 1 << 20   # rows differenced at a time: memory stays ~100 MB for any stream

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
+from ..core.errors import InputError
 from ..geometry.part import load_step
 from ..geometry.setup import setup_part
-from ..tolerances import Tolerances
-from ..trim import OUTSIDE
+from ..core.tolerances import Tolerances
+from ..core.trim_labels import OUTSIDE
 from .probe import FaceProbe
 from .records import SurfaceCheck, cycle_ranges
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..tolerances import Tolerances
+from ..core.tolerances import Tolerances
 from .probe import FaceProbe
 from .records import SurfaceCheck, SweepCheck, SweepHit, WholePartCheck, WholePartHit, cycle_ranges
 from .material import Material, PartFaces

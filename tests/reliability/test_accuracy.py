@@ -26,9 +26,9 @@ from OCP.gp import gp_Pnt
 import cadcnc
 from cadcnc.interp.cycle import CLOSED, CURVATURE, DIVERGED, END, paper_inverse_ratio, track
 from cadcnc.interp.stepper import Stepper
-from cadcnc.job import MIN_STEP, Job, PairPath, Tool
+from cadcnc.core.job import MIN_STEP, Job, PairPath, Tool
 from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for
-from cadcnc.tolerances import DEFAULT
+from cadcnc.core.tolerances import DEFAULT
 
 from conftest import FIXTURES, load_fixture
 

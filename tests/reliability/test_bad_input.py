@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.job import Job, PairPath, Tool
+from cadcnc.core.job import Job, PairPath, Tool
 
 from conftest import FIXTURES, cadcnc_cli, load_fixture
 

@@ -16,9 +16,9 @@ from pathlib import Path
 import pytest
 
 import cadcnc
-from cadcnc.errors import InputError
-from cadcnc.job import Finish, Job, PairPath, Pencil, Tool
-from cadcnc.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT
+from cadcnc.core.errors import InputError
+from cadcnc.core.job import Finish, Job, PairPath, Pencil, Tool
+from cadcnc.core.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT
 
 from conftest import FIXTURES, cadcnc_cli
 

@@ -25,7 +25,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import cadcnc
-from cadcnc.errors import CadcncError
+from cadcnc.core.errors import CadcncError
 from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_gcode import to_ngc
 from cadcnc.verification import gouge_gate

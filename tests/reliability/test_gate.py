@@ -25,10 +25,10 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.errors import InputError
+from cadcnc.core.errors import InputError
 from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_gcode import to_ngc
-from cadcnc.tolerances import DEFAULT, Tolerances
+from cadcnc.core.tolerances import DEFAULT, Tolerances
 from cadcnc.verification import gouge_gate, verify
 from cadcnc.verification import whole_part
 from cadcnc.verification.bounds import point_box_distance, segment_lower_bound

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import EXIT_PARTIAL, CadcncError
+from ...core.errors import EXIT_PARTIAL, CadcncError
 from .loop import run_hal_loop, summary
 from .session import HalError, hal_available
 

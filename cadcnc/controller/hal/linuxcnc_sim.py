@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ...work import sigterm_as_interrupt
+from ...core.work_limits import sigterm_as_interrupt
 from .session import HalError, HalInterrupted, HalSession, work_folder
 
 SAMPLE_DEPTH = 600_000  # periods the sampler FIFO holds (10 min at 1 ms)

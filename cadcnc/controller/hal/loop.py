@@ -19,8 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import InputError
-from ...work import sigterm_as_interrupt
+from ...core.errors import InputError
+from ...core.work_limits import sigterm_as_interrupt
 from .session import HalError, HalInterrupted, HalSession, work_folder
 
 SAMPLE_RES = 1e-9  # mm: halsampler prints 6 decimals of the µm the sampler holds

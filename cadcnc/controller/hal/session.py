@@ -21,7 +21,7 @@ import threading
 import time
 from pathlib import Path
 
-from ...errors import EXIT_INTERNAL, EXIT_INTERRUPTED, CadcncError
+from ...core.errors import EXIT_INTERNAL, EXIT_INTERRUPTED, CadcncError
 
 LOCK_PATH = Path(tempfile.gettempdir()) / "cadcnc-hal.lock"
 NOBODY_UID = 65534

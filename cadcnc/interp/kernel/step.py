@@ -33,7 +33,7 @@ from . import trim_lookup
 from .trim_lookup import CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-lookup = trim_lookup.lookup   # numba-compiled already (cadcnc.trim)
+lookup = trim_lookup.lookup   # numba-compiled already (.trim_lookup)
 wrap = trim_lookup.wrap
 
 # statuses

@@ -23,12 +23,12 @@ import time
 
 import numpy as np
 
-from ...errors import InputError
+from ...core.errors import InputError
 from ...geometry.part import Part
-from ...job import Finish, Job, Tool
+from ...core.job import Finish, Job, Tool
 from ...program.program import CutSegment, Program, Skipped
-from ...tolerances import DEFAULT, Tolerances
-from ...work import MAX_PLANES, Heartbeat
+from ...core.tolerances import DEFAULT, Tolerances
+from ...core.work_limits import MAX_PLANES, Heartbeat
 from .passes import GuidePlane, PassResult, pass_cuts
 from .steep_shallow import strategy_program
 from .waterline import stay_down_links
@@ -39,7 +39,7 @@ from ..entries import entered_program_segments
 from ..parallel import on_workers
 from ...workers import check_jobs
 from .setup import pass_setup
-from ...job import DEFAULT_FEED, DEFAULT_PERIOD
+from ...core.job import DEFAULT_FEED, DEFAULT_PERIOD
 
 JOIN = 1e-6
 """mm: a cut starting this near the last one's end continues it (one pass, chained)."""
@@ -65,7 +65,7 @@ def finish(part, faces, *, radius: float, allowance: float = 0.0,
     ``scallop`` (largest scallop height, mm). ``angle``: the passes' direction to +X (deg);
     ``pattern``: "zigzag" or "oneway". ``clearance``: ball-centre Z of the retracts
     (default the part's top + 10 mm). ``progress(done, total, what)`` after each plane. A
-    keyword convenience that builds the :class:`~cadcnc.job.Job` of :func:`finish_program`.
+    keyword convenience that builds the :class:`~cadcnc.core.job.Job` of :func:`finish_program`.
     ``strategy``: "raster", "waterline" (``stepdown`` or ``scallop``; loops ``side``
     "climb" or "conventional") or "steep-shallow" (waterline where the slope exceeds
     ``threshold`` deg, raster elsewhere, ``overlap`` mm at the boundary; docs/finish.md).
@@ -82,11 +82,11 @@ def finish(part, faces, *, radius: float, allowance: float = 0.0,
 def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX_PLANES,
                    clock=time.monotonic, work: dict | None = None,
                    jobs: int | None = 1) -> Program:
-    """The finishing program of a :class:`~cadcnc.job.Finish` ``job`` on ``part``:
+    """The finishing program of a :class:`~cadcnc.core.job.Finish` ``job`` on ``part``:
     ``progress(done, total, what)`` after each plane, and inside a plane at least every
     HEARTBEAT_S seconds of ``clock`` (``done`` then counting the planes finished). The
     planes are estimated before any is placed and refused over ``max_planes``
-    (:class:`~cadcnc.work.WorkLimitError`, exit 2); the face samples are at most
+    (:class:`~cadcnc.core.work_limits.WorkLimitError`, exit 2); the face samples are at most
     MAX_SAMPLES. ``work``: a dict given ``planes_estimate``, ``planes``,
     ``samples_estimate``, ``samples`` and ``cycles`` (every stepper cycle run). ``jobs``:
     processes running the planes (None: every core); the program does not depend on it

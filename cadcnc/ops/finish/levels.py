@@ -32,8 +32,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...errors import InputError
-from ...work import MAX_PLANES, refuse_over
+from ...core.errors import InputError
+from ...core.work_limits import MAX_PLANES, refuse_over
 from .polish import face_derivatives
 from .plan import FaceSamples, across, adaptive_offsets, centre_chord, planes_estimate
 from .slope import strip_pairs
@@ -150,7 +150,7 @@ def plan_levels(samples: FaceSamples, radius: float, allowance: float, *,
                 ) -> LevelPlan:
     """The levels over ``samples`` (module doc), ``critical`` the (z, what) of
     :func:`critical_heights`. Their number is estimated before any is placed and
-    refused over ``max_levels`` (:class:`~cadcnc.work.WorkLimitError`); ``work``: a dict
+    refused over ``max_levels`` (:class:`~cadcnc.core.work_limits.WorkLimitError`); ``work``: a dict
     given ``planes_estimate``."""
     work = {} if work is None else work
     r1 = radius + allowance

@@ -30,11 +30,11 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ...errors import CadcncError
+from ...core.errors import CadcncError
 from ...geometry.offset_section import SectionWire, section_wires
 from ...interp.cycle import BOUNDARY, CLOSED, COLLISION, END
 from ...interp.stepper import Stepper, Tangency
-from ...job import Job, PairPath
+from ...core.job import Job, PairPath
 from ...program.program import FAILED, STOPPED_SHORT, CutSegment, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
 from .polish import polish

@@ -32,11 +32,11 @@ from typing import Sequence
 
 import numpy as np
 
-from ...errors import CadcncError, GeometryError
+from ...core.errors import CadcncError, GeometryError
 from ...geometry.part import Part
 from ...interp.cycle import BOUNDARY, COLLISION, END
 from ...interp.stepper import Stepper, Tangency
-from ...job import Job, PairPath
+from ...core.job import Job, PairPath
 from ...program.program import FAILED, STOPPED_SHORT, CutSegment, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
 from .check import along_pass, pass_problems
@@ -108,7 +108,7 @@ def pass_cuts(part: Part, faces: Sequence[int], plane: GuidePlane, job: Job, *,
     and tool), a :class:`PassSetup` (its per-face guards), False for none, or any object
     with ``margin(p)`` used for every cut. ``beat(text)``: told while the pass runs (every
     BEAT_CYCLES stepper cycles and at every piece), e.g. a
-    :class:`~cadcnc.work.Heartbeat`'s ``beat``, which reports when due.
+    :class:`~cadcnc.core.work_limits.Heartbeat`'s ``beat``, which reports when due.
     """
     if isinstance(guard, PassSetup):
         setup, fixed = guard, None

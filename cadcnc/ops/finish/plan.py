@@ -34,9 +34,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ...errors import InputError
-from ...trim import OUTSIDE
-from ...work import MAX_PLANES, refuse_over
+from ...core.errors import InputError
+from ...core.trim_labels import OUTSIDE
+from ...core.work_limits import MAX_PLANES, refuse_over
 from .polish import face_derivatives
 from .slope import strip_pairs
 
@@ -228,7 +228,7 @@ def plan_planes(samples: FaceSamples, radius: float, allowance: float, angle: fl
                 max_planes: int = MAX_PLANES, work: dict | None = None) -> PlanePlan:
     """The guide planes over ``samples`` (see the module doc). Their number is estimated
     before any is placed (:func:`planes_estimate`) and refused over ``max_planes``
-    (:class:`~cadcnc.work.WorkLimitError`, naming the option that brings it down);
+    (:class:`~cadcnc.core.work_limits.WorkLimitError`, naming the option that brings it down);
     ``work``: a dict given ``planes_estimate``."""
     work = {} if work is None else work
     r1 = radius + allowance

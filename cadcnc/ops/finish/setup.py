@@ -14,11 +14,11 @@ from weakref import WeakKeyDictionary
 
 import numpy as np
 
-from ...errors import InputError
+from ...core.errors import InputError
 from ...geometry.face_surface import FaceSurface
 from ...geometry.guide_plane import plane_surface
 from ...geometry.part import Part
-from ...job import Job
+from ...core.job import Job
 from .crossings import FaceEdges
 from ...guard import FINISH_OWN_SHARE, guard_for
 

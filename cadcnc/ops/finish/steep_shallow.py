@@ -27,9 +27,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...geometry.part import Part
-from ...job import Finish, Job
+from ...core.job import Finish, Job
 from ...program.program import CutSegment, Program
-from ...work import MAX_PLANES
+from ...core.work_limits import MAX_PLANES
 from .plan import FaceSamples, plan_planes
 from .uncut import UncutReport, uncut_report
 from .waterline import entered_program, waterline_cuts, waterline_program, \

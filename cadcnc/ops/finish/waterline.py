@@ -23,9 +23,9 @@ import numpy as np
 from ...geometry.offset_section import offset_face
 from ...geometry.part import Part
 from ...guard.stay_down import StayDown
-from ...job import Job
+from ...core.job import Job
 from ...program.program import CutSegment, Program, Skipped
-from ...work import MAX_PLANES, Heartbeat
+from ...core.work_limits import MAX_PLANES, Heartbeat
 from ..common import safe_height
 from ..entries import entered_program_segments
 from .levels import CRITICAL_MM, LevelPlan, check_stepdown, critical_heights, plan_levels
@@ -125,7 +125,7 @@ def entered_program(part: Part, job: Job, cuts: list[CutSegment], skipped: list[
 
 def waterline_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX_PLANES,
                       clock=time.monotonic, work: dict | None = None) -> Program:
-    """The waterline finishing program of a :class:`~cadcnc.job.Finish` ``job``
+    """The waterline finishing program of a :class:`~cadcnc.core.job.Finish` ``job``
     (strategy waterline) on ``part`` (the module doc)."""
     work = {} if work is None else work
     samples = waterline_samples(part, job, work)

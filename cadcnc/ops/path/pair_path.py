@@ -12,13 +12,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...errors import FacePairError, GeometryError, InputError, StartPointError
+from ...core.errors import FacePairError, GeometryError, InputError, StartPointError
 from ...geometry.face_surface import FaceSurface
 from ...geometry.part import CONCAVE
 from ...interp.stepper import Stepper, Tangency
 from ...interp.tangency import solve_tangency
-from ...job import Job, PairPath, Tool
-from ...tolerances import DEFAULT, Tolerances
+from ...core.job import Job, PairPath, Tool
+from ...core.tolerances import DEFAULT, Tolerances
 from ...program.toolpath import Toolpath, toolpath_from_record
 
 

@@ -22,10 +22,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...errors import InputError, NothingToCutError, StartPointError
+from ...core.errors import InputError, NothingToCutError, StartPointError
 from ...interp.cycle import BOUNDARY, COLLISION
 from ...interp.stepper import Tangency
-from ...job import Job
+from ...core.job import Job
 from ...program.program import STOPPED_SHORT, CutSegment, Program, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
 from ..common import require_ball, run_stretch, safe_height

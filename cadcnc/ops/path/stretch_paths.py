@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import NothingToCutError
+from ...core.errors import NothingToCutError
 from ...guard.clearance import ClearanceGuard
-from ...job import Job
+from ...core.job import Job
 from ...program.toolpath import Toolpath
 from .pair_path import PathPlan, run_plan
 from .stretches import EdgeStretches, Feasibility, Stretch, pair_stretches

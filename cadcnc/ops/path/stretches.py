@@ -34,15 +34,15 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ...errors import GeometryError, StartPointError
+from ...core.errors import GeometryError, StartPointError
 from ...guard.clearance import ClearanceGuard
 from ...geometry.edge_curve import EdgeCurve
 from ...geometry.part import CONCAVE
 from ...interp.cycle import Contact
 from ...interp.stepper import Tangency
 from ...interp.tangency import solve_tangency
-from ...job import Job
-from ...tolerances import Tolerances
+from ...core.job import Job
+from ...core.tolerances import Tolerances
 from ...guard import guard_for
 from .centre_curve import polyline_length, travel_direction
 

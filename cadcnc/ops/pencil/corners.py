@@ -23,12 +23,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ...errors import GeometryError
+from ...core.errors import GeometryError
 from ...geometry.blends import Blend, find_blends
 from ...geometry.part import CONCAVE, MIXED, TANGENT, Part
-from ...job import Tool
+from ...core.job import Tool
 from ...program.program import Skipped
-from ...tolerances import DEFAULT, Tolerances
+from ...core.tolerances import DEFAULT, Tolerances
 from ..path.stretches import too_tight
 
 EDGE, BLEND = "edge", "blend"

@@ -25,14 +25,14 @@ import time
 from dataclasses import replace
 
 
-from ...errors import CadcncError
+from ...core.errors import CadcncError
 from ...geometry.part import Part
 from ...geometry.setup import setup_part
-from ...job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
+from ...core.job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
 from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program, Skipped
-from ...tolerances import DEFAULT, Tolerances
-from ...work import MAX_CYCLES, Heartbeat, refuse_over
+from ...core.tolerances import DEFAULT, Tolerances
+from ...core.work_limits import MAX_CYCLES, Heartbeat, refuse_over
 from .corners import BLEND, EDGE, Corner, find_corners
 from ...guard import guard_for
 from ..common import refuse_cycles, require_ball, run_stretch, safe_height
@@ -54,7 +54,7 @@ def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT
     """The pencil program of ``part`` (a :class:`~cadcnc.geometry.part.Part`, or a CadQuery
     Workplane or Shape, read with :meth:`Part.from_cadquery`) for a ball of radius
     ``radius`` (mm) with ``allowance`` (mm): see the module doc. A keyword convenience
-    that builds the :class:`~cadcnc.job.Job` of :func:`pencil_program`.
+    that builds the :class:`~cadcnc.core.job.Job` of :func:`pencil_program`.
 
     ``faces``: face numbers to restrict the corners to (both faces of a corner must be
     among them); ``clearance``: ball-centre Z of the links (default the part's top + 10
@@ -83,7 +83,7 @@ def keyword_job(part, radius: float, allowance: float = 0.0, feed: float = DEFAU
 def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = None,
                    max_cycles: int = MAX_CYCLES, clock=time.monotonic,
                    work: dict | None = None, jobs: int | None = 1) -> Program:
-    """The pencil program of a :class:`~cadcnc.job.Pencil` ``job`` on ``part``.
+    """The pencil program of a :class:`~cadcnc.core.job.Pencil` ``job`` on ``part``.
 
     ``progress(done, total, what)`` after each corner, and within a corner at least every
     HEARTBEAT_S seconds of ``clock`` (the stretch search, sample by sample; the stepper;
@@ -93,7 +93,7 @@ def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = 
     search; ``interpolation``: the stepper along every stretch; ``linking``: reachability
     from +Z, ordering and links). Before any corner is cut, the work is estimated
     (:func:`estimate_work`) and refused over ``max_cycles`` interpolation cycles or
-    MAX_SAMPLES search samples (:class:`~cadcnc.work.WorkLimitError`, exit 2); ``work``:
+    MAX_SAMPLES search samples (:class:`~cadcnc.core.work_limits.WorkLimitError`, exit 2); ``work``:
     a dict given the estimates and the counts (``cycles_estimate``, ``samples_estimate``,
     ``cycles``: every stepper cycle run, re-runs included; ``samples``). ``jobs``:
     processes cutting the corners, one pair's corners a task (None: every core); the
@@ -254,7 +254,7 @@ def search_samples(length: float, offset: float, closed: bool = False) -> int:
 
 def estimate_work(todo: list[Corner], job: Job, max_cycles: int = MAX_CYCLES) -> dict:
     """The work of cutting the corners ``todo``, estimated before any is searched or cut,
-    and refused (:class:`~cadcnc.work.WorkLimitError`) over its limit:
+    and refused (:class:`~cadcnc.core.work_limits.WorkLimitError`) over its limit:
     ``cycles_estimate``: their lengths over the step F Ts, twice (a cut whose corner runs
     against ``side`` is run again from its other end), over ``max_cycles``; ``samples_estimate``: the ball positions their stretch search solves
     (:func:`search_samples`), over MAX_SAMPLES."""

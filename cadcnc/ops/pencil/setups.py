@@ -23,15 +23,15 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ...errors import CadcncError, InputError, NothingToCutError
+from ...core.errors import CadcncError, InputError, NothingToCutError
 from ...geometry.edge_curve import EdgeCurve
 from ...geometry.part import CONCAVE, Part
 from ...geometry.setup import Setup, original_part, setup_in, setup_part
-from ...job import PRINCIPAL_AXES, Job, Pencil, axis_name
+from ...core.job import PRINCIPAL_AXES, Job, Pencil, axis_name
 from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program
 from ...program.transform import in_part_coordinates
-from ...units import check_axis
+from ...core.units import check_axis
 from ..common import safe_height
 from ..entries import entered_program_segments
 from .pencil import CHAIN_GAP, keyword_job, pencil as pencil_one, pencil_program
@@ -107,7 +107,7 @@ def parse_setups(value) -> list[tuple[float, float, float]] | str:
 def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
                   progress=None, max_cycles: int | None = None,
                   jobs: int | None = 1) -> SetupsResult:
-    """The fewest setups of ``job`` (a :class:`~cadcnc.job.Pencil` job) on ``part`` among
+    """The fewest setups of ``job`` (a :class:`~cadcnc.core.job.Pencil` job) on ``part`` among
     ``setups`` (AUTO: the six principal axes; or a list of axes): module doc. ``overlap``:
     mm of lap at a boundary with an earlier setup; ``jobs``: processes for each setup's
     corners (None: every core). Raises NothingToCutError when no candidate reaches

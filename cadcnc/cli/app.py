@@ -1,6 +1,6 @@
 """``cadcnc``: argparse subcommands, then one library call, then printing.
 
-Errors the library raises on purpose (:class:`cadcnc.errors.CadcncError`) become one line
+Errors the library raises on purpose (:class:`cadcnc.core.errors.CadcncError`) become one line
 ``cadcnc: error: <message>`` on stderr and the error's exit code (2 input, 3 geometry,
 4 output; argparse usage errors are 2 as well; a refused gouge is 5). ``--debug`` shows the
 traceback instead. Every option is defined once here; the commands live in
@@ -14,8 +14,8 @@ import os
 import sys
 from importlib.metadata import version
 
-from cadcnc.errors import EXIT_INTERRUPTED, CadcncError  # light: the package loads OCCT lazily
-from cadcnc.interrupts import sigint_deferred
+from cadcnc.core.errors import EXIT_INTERRUPTED, CadcncError  # light: the package loads OCCT lazily
+from cadcnc.core.interrupts import sigint_deferred
 from cadcnc import workers
 
 from .operation import DEFAULT_FEED, DEFAULT_PERIOD, add_axis_options, add_max_cycles

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 import sys
 
-from cadcnc.errors import EXIT_INTERRUPTED
+from cadcnc.core.errors import EXIT_INTERRUPTED
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,6 +1,10 @@
-"""Where a parameter point lies with respect to a trimmed face, and a trim grid's cell
-labels: plain constants (no numba), so that reading a part needs no compiler.
-:mod:`cadcnc.trim` re-exports them beside the grid's compiled reader."""
+"""Where a parameter point lies with respect to a trimmed face, and a trim grid's cell labels:
+one spelling for every layer.
+
+The geometry layer's classifier, the interpolator's boundary rule and verification's OCCT
+classifier all answer with these three strings. The compiled reader of a trim grid is
+:mod:`cadcnc.interp.kernel.trim_lookup`; these names need no compiler.
+"""
 
 INSIDE = "inside"
 BOUNDARY = "boundary"
@@ -15,3 +19,6 @@ CELL_INSIDE = 1
 """The whole cell is inside the trimmed face (the exact classifier says IN everywhere)."""
 CELL_MIXED = 2
 """Near the trim boundary: ask the exact classifier."""
+SEGMENTS = -1.0
+"""Marker (first word of a MIXED cell's block in ``fine``) of a segment list."""
+SEGMENT_WORDS = 6  # per segment: p (2), q (2), half-widths (2)

@@ -17,7 +17,7 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from cadcnc.errors import InputError
+from cadcnc.core.errors import InputError
 
 TOP_KEYS = ("parts", "operations", "options", "per_part", "out", "outputs")
 OPERATION_KEYS = ("command", "name", "parts")

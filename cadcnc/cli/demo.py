@@ -7,11 +7,11 @@ from dataclasses import replace
 from pathlib import Path
 
 import cadcnc
-from cadcnc.errors import EXIT_GOUGE, OutputError, StepFileError
+from cadcnc.core.errors import EXIT_GOUGE, OutputError, StepFileError
 from cadcnc.io.gcode import blend_for
 from cadcnc.io.output_set import OutputSet
 from cadcnc.io.outputs import SUFFIXES, render
-from cadcnc.job import Job, PairPath, Pencil, Tool
+from cadcnc.core.job import Job, PairPath, Pencil, Tool
 from cadcnc.ops.common import single_cut_program
 from cadcnc.ops.path.pair_path import path_for_job
 from cadcnc.ops.run import run

@@ -8,14 +8,14 @@ import math
 from pathlib import Path
 
 from cadcnc.batch.operate import Settings
-from cadcnc.errors import InputError
+from cadcnc.core.errors import InputError
 from cadcnc.io.gcode import blend_for
-from cadcnc.job import Finish, Job, PairPath, Pencil, Tool, check_number
-from cadcnc.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT, Tolerances
-from cadcnc.units import parse_duration, parse_feed, parse_length, parse_point
+from cadcnc.core.job import Finish, Job, PairPath, Pencil, Tool, check_number
+from cadcnc.core.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT, Tolerances
+from cadcnc.core.units import parse_duration, parse_feed, parse_length, parse_point
 from cadcnc.workers import check_jobs
 
-JOB_OPTIONS = ("faces", "radius")  # feed and period have defaults (cli/operation.py)
+JOB_OPTIONS = ("faces", "radius")  # feed and period have defaults (cadcnc/cli/operation.py)
 
 
 def tolerances(args) -> Tolerances:

@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import io
 
-from cadcnc.units import parse_feed, parse_length
-from cadcnc.work import MAX_STREAM_PERIODS
+from cadcnc.core.units import parse_feed, parse_length
+from cadcnc.core.work_limits import MAX_STREAM_PERIODS
 
 from .feedback import say_error
 
@@ -81,7 +81,7 @@ def machine_of(args):
 
 def stream_command(args) -> int:
     import cadcnc
-    from cadcnc.errors import InputError
+    from cadcnc.core.errors import InputError
     from cadcnc.io.output_set import OutputSet
     from cadcnc.io.program_json import read_program
     from cadcnc.verification.stream_check import check_program_on_part
@@ -128,8 +128,8 @@ def stream_outputs(program, part, machine, out, *, feed=None, planned=True, tole
     For ``path``, ``pencil`` and ``finish --stream OUT``: call it with the program they
     computed, the part, :func:`machine_of` of the arguments and OUT, after their own
     outputs are written."""
-    from cadcnc.work import sigterm_as_interrupt
-    from cadcnc.work import Ticker
+    from cadcnc.core.work_limits import sigterm_as_interrupt
+    from cadcnc.core.work_limits import Ticker
 
     if hal:
         from cadcnc.controller.hal import HalError, hal_available
@@ -149,10 +149,10 @@ def stream_outputs(program, part, machine, out, *, feed=None, planned=True, tole
 def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, allow_gouge,
             hal, quiet, name, inputs, max_periods) -> int:
     """:func:`stream_outputs` inside its heartbeat and SIGTERM handler."""
-    from cadcnc.errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL
+    from cadcnc.core.errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL
     from cadcnc.io.output_set import OutputSet
     from cadcnc.ops.stream_steppers import stepper_factory
-    from cadcnc.tolerances import DEFAULT
+    from cadcnc.core.tolerances import DEFAULT
     from cadcnc.verification import gate_program
 
     outputs = OutputSet(outs, SUFFIXES, inputs=inputs) if outs else None
@@ -202,7 +202,7 @@ def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_peri
     """The stream, its periods estimated and bounded before the positions are computed,
     progress reported (the plan is made once here to count the periods first)."""
     from cadcnc.controller.stream import stream_program
-    from cadcnc.work import refuse_over
+    from cadcnc.core.work_limits import refuse_over
 
     said = []
 

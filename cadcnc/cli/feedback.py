@@ -27,7 +27,7 @@ def stage_progress(args, label: str, after_s: float = 0.0, clock=time.monotonic)
     it runs, with its count; None with --quiet. ``clock`` is injectable for tests."""
     if args.quiet:
         return None
-    from cadcnc.work import HEARTBEAT_S, Heartbeat
+    from cadcnc.core.work_limits import HEARTBEAT_S, Heartbeat
 
     seen = set()
     start = clock()

@@ -1,4 +1,4 @@
-"""The finishing strategies' fields of a :class:`~cadcnc.job.Finish`, validated once.
+"""The finishing strategies' fields of a :class:`~cadcnc.core.job.Finish`, validated once.
 
 ``strategy``: raster (vertical guide planes, ``stepover`` or ``scallop``), waterline
 (horizontal levels ``stepdown`` mm apart, or spaced for ``scallop``; loops ``side`` climb

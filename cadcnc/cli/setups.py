@@ -24,14 +24,14 @@ def suffixed(out: str, tag: str) -> str:
 def setups_command(args) -> int:
     import cadcnc
     from cadcnc import workers
-    from cadcnc.errors import EXIT_NOTHING, InputError, NothingToCutError
+    from cadcnc.core.errors import EXIT_NOTHING, InputError, NothingToCutError
     from cadcnc.io.output_set import OutputSet, check_destination
     from cadcnc.io.outputs import SUFFIXES, render
-    from cadcnc.job import PRINCIPAL_AXES
+    from cadcnc.core.job import PRINCIPAL_AXES
     from cadcnc.ops.common import safe_height
     from cadcnc.ops.pencil.pencil import CHAIN_GAP
     from cadcnc.ops.pencil.setups import AUTO, axis_tag, parse_setups, pencil_setups
-    from cadcnc.units import parse_length
+    from cadcnc.core.units import parse_length
     from cadcnc.workers import check_jobs
     from cadcnc.verification.judgement import judge, settle, worst
 

@@ -37,7 +37,7 @@ def add_parser(add, commands) -> None:
 def batch_command(args) -> int:
     import cadcnc
     from cadcnc.batch.records import batch_exit, summary_table
-    from cadcnc.work import sigterm_as_interrupt
+    from cadcnc.core.work_limits import sigterm_as_interrupt
 
     from . import jobfile
     from .batch_jobs import batch_parts

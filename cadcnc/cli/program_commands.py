@@ -12,7 +12,7 @@ import math
 from pathlib import Path
 
 import cadcnc
-from cadcnc.errors import EXIT_GOUGE, InputError
+from cadcnc.core.errors import EXIT_GOUGE, InputError
 from cadcnc.io.output_set import OutputSet
 from cadcnc.io.plot import PICTURE_SUFFIXES
 from cadcnc.io.program_json import read_program
@@ -20,7 +20,7 @@ from cadcnc.io.program_plot import program_picture_bytes
 from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.verification import gate_program, verify as run_verify
 from cadcnc.verification.program_gate import cut_label
-from cadcnc.work import MAX_VERIFY_POINTS, refuse_over
+from cadcnc.core.work_limits import MAX_VERIFY_POINTS, refuse_over
 
 from .feedback import progress, say_error, stage_progress
 from .operation import operation_command

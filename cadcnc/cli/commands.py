@@ -9,8 +9,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from cadcnc.errors import InputError
-from cadcnc.errors import EXIT_PARTIAL
+from cadcnc.core.errors import InputError
+from cadcnc.core.errors import EXIT_PARTIAL
 from cadcnc.io.output_set import OutputSet, check_destination
 from cadcnc.io.outputs import SUFFIXES, render
 from cadcnc.ops.common import single_cut_program

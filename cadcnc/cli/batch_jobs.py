@@ -12,7 +12,7 @@ import re
 from pathlib import Path
 
 from cadcnc.batch.task import BatchOperation, BatchPart
-from cadcnc.errors import InputError
+from cadcnc.core.errors import InputError
 from cadcnc.io.outputs import SUFFIXES
 
 from .options import BUILDERS, settings_of

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from cadcnc.job import DEFAULT_FEED as FEED, DEFAULT_PERIOD as PERIOD
-from cadcnc.work import MAX_CYCLES
+from cadcnc.core.job import DEFAULT_FEED as FEED, DEFAULT_PERIOD as PERIOD
+from cadcnc.core.work_limits import MAX_CYCLES
 
 DEFAULT_FEED = f"{FEED:g}"  # the job's defaults as the options' text
 DEFAULT_PERIOD = f"{PERIOD * 1000:g}ms"
