@@ -15,7 +15,8 @@ from OCP.gp import gp_Pnt
 import cadcnc
 from cadcnc.interp.cycle import CLOSED, END
 from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for
-from cadcnc.interp.stepper import Stepper, Tangency
+from cadcnc.interp.compiled import new_stepper
+from cadcnc.interp.stepper import Tangency
 from cadcnc.core.tolerances import DEFAULT
 
 FEED, PERIOD = 1500.0, 0.004      # the paper's example: f = 0.1 mm
@@ -238,7 +239,7 @@ def test_interpolator_on_plain_python_surfaces_without_occt():
     x0 = B + Rp
     start = solve_tangency(s1, s2, (Rp, Rp), (math.pi / 2, x0 - 1), (0.1, 15.0),
                            anchor=(x0, 0.0, math.sqrt((A + Rp) ** 2)), direction=(0, 1, 0))
-    st = Stepper(s1, s2, (Rp, Rp), start, feed=FEED, period=PERIOD, direction=(0, 1, 0),
+    st = new_stepper(s1, s2, (Rp, Rp), start, feed=FEED, period=PERIOD, direction=(0, 1, 0),
                  closed=True).run()
     assert st.stop_reason == CLOSED
     pts = st.record.points

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from conftest import load_fixture
 
-from cadcnc.interp.compiled import CompiledStepper
+from cadcnc.interp.compiled import CompiledStepper, new_stepper
 from cadcnc.interp.stepper import Stepper
 from cadcnc.ops.path.pair_path import pair_job, plan_path
 from test_pinned_paths import CASES
@@ -26,7 +26,7 @@ def plan_for(name, i, j):
 
 
 def make(plan, job, compiled, **kw):
-    return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
+    return new_stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
                    period=job.period, direction=plan.direction, end=plan.end,
                    closed=plan.closed, tol=job.tolerances,
                    check_boundary=plan.check_boundary, compiled=compiled, **kw)
@@ -38,7 +38,7 @@ def test_compiled_path_agrees_with_the_occt_evaluated_path(key, name, i, j):
         plan, job = plan_for(name, i, j)
     except Exception as exc:   # refused before computing: nothing to compare
         pytest.skip(f"refused: {type(exc).__name__}")
-    ref, fast = make(plan, job, False), make(plan, job, None)
+    ref, fast = make(plan, job, False), make(plan, job, True)
     assert type(ref) is Stepper and type(fast) is CompiledStepper
     ref.run()
     fast.run()
@@ -56,7 +56,7 @@ def test_compiled_path_agrees_with_the_occt_evaluated_path(key, name, i, j):
 @pytest.mark.parametrize("name, i, j", [("ramp_wall", 3, 7), ("torus_cone", 1, 2)])
 def test_step_by_step_with_the_record_off_gives_the_same_increments(name, i, j):
     plan, job = plan_for(name, i, j)
-    ref, fast = make(plan, job, False, record=False), make(plan, job, None, record=False)
+    ref, fast = make(plan, job, False, record=False), make(plan, job, True, record=False)
     feeds = [None, 900.0, 1500.0, 2400.0]     # an override changing every few periods
     k = 0
     while True:
@@ -84,7 +84,7 @@ def test_a_surface_without_compiled_data_keeps_the_reference():
         def __getattr__(self, name):
             return getattr(self._s, name)
 
-    st = Stepper(Plain(plan.s1), plan.s2, plan.offsets, plan.start, feed=job.feed,
+    st = new_stepper(Plain(plan.s1), plan.s2, plan.offsets, plan.start, feed=job.feed,
                  period=job.period, direction=plan.direction, end=plan.end)
     assert type(st) is Stepper
     st.run()
@@ -94,6 +94,6 @@ def test_a_surface_without_compiled_data_keeps_the_reference():
 def test_the_progress_callback_sees_the_compiled_loop():
     plan, job = plan_for("torus_cone", 1, 2)
     seen = []
-    st = make(plan, job, None).run(lambda n, mm: seen.append((n, mm)), every=256)  # the record fills (1024 rows) between reports
+    st = make(plan, job, True).run(lambda n, mm: seen.append((n, mm)), every=256)  # the record fills (1024 rows) between reports
     assert [n for n, _ in seen] == list(range(256, st.cycles + 1, 256))
     assert all(0 < mm < st.travelled for _, mm in seen)

@@ -10,6 +10,7 @@ from conftest import load_fixture
 
 from cadcnc.interp.cycle import BOUNDARY, COLLISION, STOP_REASONS
 from cadcnc.interp.landing import LANDING_TOL, MAX_TRIALS, land
+from cadcnc.interp.compiled import new_stepper
 from cadcnc.interp.stepper import Stepper
 from cadcnc.ops.path.pair_path import pair_job, plan_path
 from test_pinned_paths import CASES
@@ -48,12 +49,12 @@ def test_a_yes_no_rule_is_bisected_within_the_trial_budget(root):
     assert lo <= root and root - lo <= 2.0 ** -(MAX_TRIALS - 1)
 
 
-def stepper(name, i, j, guard=None, radius=3.0, compiled=None):
+def stepper(name, i, j, guard=None, radius=3.0, compiled=True):
     part = load_fixture(name)
     s1, s2, job = pair_job(part.face(i), part.face(j), radius=radius, feed=1500.0,
                            period=0.004)
     plan = plan_path(s1, s2, job)
-    return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
+    return new_stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
                    period=job.period, direction=plan.direction, end=plan.end,
                    closed=plan.closed, tol=job.tolerances, check_boundary=plan.check_boundary,
                    guard=guard, compiled=compiled)
@@ -118,7 +119,7 @@ def test_collision_is_a_stop_reason():
     assert COLLISION == "collision" and COLLISION in STOP_REASONS
 
 
-@pytest.mark.parametrize("compiled", [False, None])
+@pytest.mark.parametrize("compiled", [False, True])
 def test_a_plane_across_the_pocket_edge_stops_the_ball_tangent_to_it(compiled):
     # pocket 10/17: the centre runs straight from x = -22 to x = 22 at y = -17, z = 18
     guard = Plane((1.0, 0.0, 0.0), 5.0123456789, 3.0)   # a wall at x = 5.0123456789
@@ -132,7 +133,7 @@ def test_a_plane_across_the_pocket_edge_stops_the_ball_tangent_to_it(compiled):
     assert (type(st) is Stepper) == (compiled is False)
 
 
-@pytest.mark.parametrize("compiled", [False, None])
+@pytest.mark.parametrize("compiled", [False, True])
 def test_a_sphere_beside_a_closed_path_stops_it_tangent_to_the_sphere(compiled):
     # sphere_cylinder: the centre runs on a circle of radius 13 about z at z = 30.33
     centre = (13.0 * math.cos(1.0), 13.0 * math.sin(1.0), 30.3315018 + 4.0)
@@ -153,7 +154,7 @@ def test_a_sphere_beside_a_closed_path_stops_it_tangent_to_the_sphere(compiled):
     assert max(per_step) <= MAX_TRIALS
 
 
-@pytest.mark.parametrize("compiled", [False, None])
+@pytest.mark.parametrize("compiled", [False, True])
 def test_a_start_already_in_collision_takes_no_step(compiled):
     st = stepper("pocket", 10, 17, Plane((1.0, 0.0, 0.0), -30.0, 3.0), compiled=compiled)
     assert st.step() is None

@@ -34,7 +34,7 @@ from OCP.GeomAPI import GeomAPI_IntSS
 from OCP.gp import gp_Pnt, gp_Vec
 
 import cadcnc
-from cadcnc.interp.stepper import Stepper
+from cadcnc.interp.compiled import new_stepper
 from cadcnc.ops.path.pair_path import pair_job, plan_path
 
 from benchmarks import ROOT
@@ -53,8 +53,8 @@ def plan_of(name: str, i: int, j: int):
     return part, plan_path(s1, s2, job), job
 
 
-def stepper(plan, job, compiled=None, record=False, end=True, max_cycles=10**9, guard=None):
-    return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
+def stepper(plan, job, compiled=True, record=False, end=True, max_cycles=10**9, guard=None):
+    return new_stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
                    period=job.period, direction=plan.direction,
                    end=plan.end if end else None, closed=plan.closed and end,
                    tol=job.tolerances, check_boundary=plan.check_boundary,

@@ -1,3 +1,2 @@
-"""The interpolation core; importing it registers the compiled stepper."""
-
-from . import compiled  # noqa: F401 (Stepper.compiled_class)
+"""The interpolation core: the stepper (plain reference and compiled kernel), its cycle's
+mathematics, records and error bounds. No OCCT."""

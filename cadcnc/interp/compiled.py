@@ -1,8 +1,8 @@
 """The stepper on the compiled kernel: Stepper's rules, with the period's work in numba.
 
-``Stepper(...)`` builds a :class:`CompiledStepper` when both surfaces offer compiled data
-(``surface.kernel`` = (surface data, trim grid), see cadcnc.geometry.face_surface) and
-``compiled`` is not False. Each period is one call of ``kernel.step.step`` (track,
+:func:`new_stepper` builds a :class:`CompiledStepper` when both surfaces offer compiled
+data (``surface.kernel`` = (surface data, trim grid), see cadcnc.geometry.face_surface)
+and ``compiled`` is True, else the reference :class:`Stepper`. Each period is one call of ``kernel.step.step`` (track,
 accurate step, end landing, trial cycle on the compiled evaluators, O(1) trim check,
 commit, record row); Python is entered only for what the kernel leaves to it: an exact
 trim classification where a contact's grid cell is MIXED, the guard, a landing (the same
@@ -32,7 +32,7 @@ from .cycle import (
 from .kernel import entry as E
 from .kernel import follow as KF
 from .kernel import step as K
-from .kernel.cycle_math import C_OFF, C_SING, C_U, C_W, CS
+from .kernel import layout as L
 from .record import ROW, PathRecord
 from .stepper import Stepper, Tangency
 from .vec3 import Vec
@@ -48,33 +48,47 @@ def kernel_data(surface) -> tuple | None:
 
 def pack(surfaces, grids) -> tuple[np.ndarray, np.ndarray]:
     """F (float64) and I (int64) holding both surfaces' evaluator arrays, trim grids and
-    wrap data in the layout of kernel/step.py."""
-    floats, ints = [np.zeros(32)], [np.zeros(32, dtype=np.int64)]
-    nf, ni = 32, 32
+    wrap data in the layout of kernel/layout.py."""
+    floats, ints = [np.zeros(L.HEADERS)], [np.zeros(L.HEADERS, dtype=np.int64)]
+    nf, ni = L.HEADERS, L.HEADERS
     for s, (surface, (data, grid)) in enumerate(zip(surfaces, grids)):
         kind, params, iarr, ku, kv, poles, weights = data.args
-        h = 16 * s
+        h = L.HEAD * s
         head = ints[0]
-        head[h] = kind
-        for slot, arr in ((1, params), (5, ku), (7, kv), (9, poles), (12, weights)):
+        head[h + L.H_KIND] = kind
+        for slot, arr in ((L.H_PARAMS, params), (L.H_KU, ku), (L.H_KV, kv),
+                          (L.H_POLES, poles), (L.H_WEIGHTS, weights)):
             head[h + slot] = nf
             floats.append(np.ascontiguousarray(arr, dtype=np.float64).ravel())
             nf += floats[-1].size
-        head[h + 2], head[h + 6], head[h + 8] = len(params), len(ku), len(kv)
-        head[h + 10], head[h + 11] = poles.shape[0], poles.shape[1]
-        head[h + 3], head[h + 4] = ni, len(iarr)
+        head[h + L.H_PARAMS_LEN], head[h + L.H_KU_LEN] = len(params), len(ku)
+        head[h + L.H_KV_LEN] = len(kv)
+        head[h + L.H_NU], head[h + L.H_NV] = poles.shape[0], poles.shape[1]
+        head[h + L.H_IARR], head[h + L.H_IARR_LEN] = ni, len(iarr)
         ints.append(np.asarray(iarr, dtype=np.int64))
         ni += len(iarr)
         codes, fine, u0, w0, du, dw, nu, nw = grid.kernel_args
-        head[h + 13], head[h + 14], head[h + 15] = ni, nu, nw  # the cell codes
+        head[h + L.H_CELLS], head[h + L.H_CELLS_NU], head[h + L.H_CELLS_NW] = ni, nu, nw
         ints.append(codes.astype(np.int64, copy=False).ravel())
         ni += nu * nw
         floats.append(np.asarray(fine, dtype=np.float64))  # MIXED cells' segments
         (umin, _), (wmin, _) = surface.u_range, surface.w_range
-        floats[0][h:h + 14] = (u0, w0, du, dw, *grid.window, umin, surface.u_period or 0.0,
-                               wmin, surface.w_period or 0.0, surface.normal_sign, nf)
+        floats[0][h + L.G_U0:h + L.G_USED] = (
+            u0, w0, du, dw, *grid.window, umin, surface.u_period or 0.0, wmin,
+            surface.w_period or 0.0, surface.normal_sign, nf)
         nf += len(fine)
     return np.concatenate(floats), np.concatenate(ints)
+
+
+def new_stepper(s1, s2, offsets: tuple[float, float], start: Tangency, *, compiled: bool = True,
+                **kwargs) -> Stepper:
+    """The stepper of two surfaces (the arguments of :class:`Stepper`): a
+    :class:`CompiledStepper` when ``compiled`` and both surfaces have compiled data, else
+    the plain-Python reference (``compiled=False``: always; the two agree point for
+    point)."""
+    if compiled and kernel_data(s1) and kernel_data(s2):
+        return CompiledStepper(s1, s2, offsets, start, **kwargs)
+    return Stepper(s1, s2, offsets, start, **kwargs)
 
 
 class CompiledStepper(Stepper):
@@ -84,8 +98,7 @@ class CompiledStepper(Stepper):
     def __init__(self, s1, s2, offsets: tuple[float, float], start: Tangency, *,
                  feed: float, period: float, direction: Vec, end: Tangency | None = None,
                  closed: bool = False, tol=None, max_cycles: int = 1_000_000,
-                 record: bool = True, check_boundary: bool = True, guard=None,
-                 compiled: bool | None = None):
+                 record: bool = True, check_boundary: bool = True, guard=None):
         tol = DEFAULT if tol is None else tol
         self.tol, self.surfaces = tol, (s1, s2)
         self.period = check_number("period", period, "s")
@@ -93,27 +106,27 @@ class CompiledStepper(Stepper):
         check_step(self.feed, self.period)
         self._grids = (kernel_data(s1)[1], kernel_data(s2)[1])
         self.F, self.I = pack((s1, s2), (kernel_data(s1), kernel_data(s2)))
-        self.S = S = np.zeros(K.STATE_SIZE)
+        self.S = S = np.zeros(L.STATE_SIZE)
         self.record = PathRecord() if record else None
-        S[K.P:K.P + 3] = start.p
+        S[L.P:L.P + 3] = start.p
         d = math.sqrt(sum(float(x) ** 2 for x in direction))
-        S[K.T:K.T + 3] = [float(x) / d for x in direction] if d > 0 else 0.0
+        S[L.T:L.T + 3] = [float(x) / d for x in direction] if d > 0 else 0.0
         self.end = Tangency(start.p, start.uv1, start.uv2) if closed else end
         if self.end is not None:
-            S[K.END_P:K.END_P + 3] = self.end.p
-            S[K.END_UV1:K.END_UV1 + 2] = self.end.uv1
-            S[K.END_UV2:K.END_UV2 + 2] = self.end.uv2
-            S[K.HAS_END] = 1.0
-        S[K.TOL_TANGENT:K.TOL_END + 1] = (tol.tangent_sin, tol.flat_curvature,
+            S[L.END_P:L.END_P + 3] = self.end.p
+            S[L.END_UV1:L.END_UV1 + 2] = self.end.uv1
+            S[L.END_UV2:L.END_UV2 + 2] = self.end.uv2
+            S[L.HAS_END] = 1.0
+        S[L.TOL_TANGENT:L.TOL_END + 1] = (tol.tangent_sin, tol.flat_curvature,
                                          tol.near_singular, tol.diverged, tol.accuracy,
                                          tol.end_reached)
-        S[K.MIN_STEP], S[K.CHECK_BOUNDARY] = JOB_MIN_STEP, float(check_boundary)
-        S[K.AUTO_COMMIT], S[K.ACC_RATIO], S[K.RATIO] = float(guard is None), 1.0, 1.0
-        for side, o in enumerate((K.C1, K.C2)):
-            for block in (o, o + K.N1 - K.C1, o + K.KEPT1 - K.C1):
-                S[block + C_OFF] = float(offsets[side])
+        S[L.MIN_STEP], S[L.CHECK_BOUNDARY] = JOB_MIN_STEP, float(check_boundary)
+        S[L.AUTO_COMMIT], S[L.ACC_RATIO], S[L.RATIO] = float(guard is None), 1.0, 1.0
+        for side, o in enumerate((L.C1, L.C2)):
+            for block in (o, o + L.N1 - L.C1, o + L.KEPT1 - L.C1):
+                S[block + L.C_OFF] = float(offsets[side])
             uv = (start.uv1, start.uv2)[side]
-            S[E.ARG_U], S[E.ARG_W] = uv
+            S[L.ARG_U], S[L.ARG_W] = uv
             if self._call(E.OP_MOVE_TO, -1, 0.0, side)[0] != 0:
                 raise GeometryError(f"surface {side + 1}: the compiled evaluator cannot "
                                     f"evaluate the start contact ({uv[0]:.6g}, {uv[1]:.6g})")
@@ -125,23 +138,25 @@ class CompiledStepper(Stepper):
             self.record.set_length(1)
 
     # -- state read from the kernel's array ------------------------------------------------
-    p = property(lambda self: tuple(self.S[K.P:K.P + 3].tolist()))
-    t = property(lambda self: tuple(self.S[K.T:K.T + 3].tolist()))
-    cycles = property(lambda self: int(self.S[K.CYCLES]))
-    travelled = property(lambda self: float(self.S[K.TRAVELLED]))
-    accuracy_cycles = property(lambda self: int(self.S[K.ACC_CYCLES]))
-    accuracy_ratio = property(lambda self: float(self.S[K.ACC_RATIO]))
+    p = property(lambda self: tuple(self.S[L.P:L.P + 3].tolist()))
+    t = property(lambda self: tuple(self.S[L.T:L.T + 3].tolist()))
+    cycles = property(lambda self: int(self.S[L.CYCLES]))
+    travelled = property(lambda self: float(self.S[L.TRAVELLED]))
+    accuracy_cycles = property(lambda self: int(self.S[L.ACC_CYCLES]))
+    accuracy_ratio = property(lambda self: float(self.S[L.ACC_RATIO]))
     c1 = property(lambda self: self._contact(0))
     c2 = property(lambda self: self._contact(1))
 
     def _contact(self, side: int) -> Contact:
         """A snapshot of contact 1 or 2 as the reference's Contact (for inspection)."""
-        o, S = (K.C1, K.C2)[side], self.S
+        o, S = (L.C1, L.C2)[side], self.S
         c = object.__new__(Contact)
-        c.surface, c.offset, c.u, c.w = self.surfaces[side], S[o + C_OFF], S[o + C_U], S[o + C_W]
-        c.r, c.ru, c.rw, c.n = (tuple(S[o + k:o + k + 3].tolist()) for k in (2, 5, 8, 11))
-        c.E, c.F, c.G, c.L, c.M, c.N = S[o + 14:o + 20].tolist()
-        c.singularity = float(S[o + C_SING])
+        c.surface, c.offset = self.surfaces[side], S[o + L.C_OFF]
+        c.u, c.w = S[o + L.C_U], S[o + L.C_W]
+        c.r, c.ru, c.rw, c.n = (tuple(S[o + k:o + k + 3].tolist())
+                                for k in (L.C_R, L.C_RU, L.C_RW, L.C_NRM))
+        c.E, c.F, c.G, c.L, c.M, c.N = S[o + L.C_E:o + L.C_N + 1].tolist()
+        c.singularity = float(S[o + L.C_SING])
         return c
 
     def _call(self, op: int, n: int, x: float = 0.0, k: int = 0) -> tuple:
@@ -163,7 +178,7 @@ class CompiledStepper(Stepper):
     def _committed(self, n: int) -> Vec:
         if n >= 0:
             self.record.set_length(n + 1)
-        return tuple(self.S[K.DP:K.DP + 3].tolist())
+        return tuple(self.S[L.DP:L.DP + 3].tolist())
 
     def step(self, feed: float | None = None) -> Vec | None:
         """As :meth:`Stepper.step`: the next period's dp_K (mm), None once stopped."""
@@ -206,7 +221,7 @@ class CompiledStepper(Stepper):
         n = 0
         while n < len(plan):
             if self.stop_reason is not None:
-                out[n:] = self.S[K.P:K.P + 3]
+                out[n:] = self.S[L.P:L.P + 3]
                 break
             status, n, rec = KF.follow(self.F, self.I, self.S, self._rows(), self._row(),
                                        plan, args, out, n, self.max_cycles)
@@ -220,7 +235,7 @@ class CompiledStepper(Stepper):
                 self._stop(MAX_CYCLES, f"cycle limit {self.max_cycles} reached")
             else:
                 self._finish(status, self._row())
-            out[n] = self.S[K.P:K.P + 3]
+            out[n] = self.S[L.P:L.P + 3]
             n += 1
         return out
 
@@ -232,20 +247,20 @@ class CompiledStepper(Stepper):
             self._stop(CLOSED if self.closed else END,
                        done if status == K.END_LANDED else "end point reached")
             return self._committed(n) if status == K.END_LANDED else None
-        if S[K.TR_OK] == 0.0:
+        if S[L.TR_OK] == 0.0:
             reason, detail = self._failure(status)
             self._stop(reason, detail + " (no step possible from the current point)")
             return None
-        self._margin = S[K.MARGIN]
+        self._margin = S[L.MARGIN]
         failure = self._resolve(status)
         if failure is None:
             self._call(E.OP_COMMIT_TRIAL, n)
             return self._committed(n)
-        return self._land_on_limit(float(S[K.F_TRIAL]), failure)
+        return self._land_on_limit(float(S[L.F_TRIAL]), failure)
 
     def _failure(self, status: int) -> tuple[str, str]:
         S = self.S
-        label, a, b = f"surface {int(S[K.DIAG])}", S[K.DIAG + 1], S[K.DIAG + 2]
+        label, a, b = f"surface {int(S[L.DIAG])}", S[L.DIAG + 1], S[L.DIAG + 2]
         if status == K.TRACK_TANGENT:
             return TANGENT, tangent_detail(a, self.tol)
         if status == K.TANGENT:
@@ -268,12 +283,13 @@ class CompiledStepper(Stepper):
         is classified exactly here: left if the contact and its re-estimate are outside."""
         S, names = self.S, []
         for side in range(2):
-            state = S[K.TRIM_STATE + side]
+            state = S[L.TRIM_STATE + side]
             if state == 2:
-                o = (K.N1, K.N2)[side]
+                o = (L.N1, L.N2)[side]
                 grid = self._grids[side]
-                state = float(grid.classify(S[o + C_U], S[o + C_W]) == OUTSIDE and grid.classify(
-                    S[K.REESTIMATE + 2 * side], S[K.REESTIMATE + 2 * side + 1]) == OUTSIDE)
+                again = S[L.REESTIMATE + 2 * side], S[L.REESTIMATE + 2 * side + 1]
+                state = float(grid.classify(S[o + L.C_U], S[o + L.C_W]) == OUTSIDE
+                              and grid.classify(*again) == OUTSIDE)
             if state == 1:
                 names.append(f"surface {side + 1}")
         return " and ".join(names)
@@ -287,7 +303,7 @@ class CompiledStepper(Stepper):
         elif status != K.PASSED:
             return self._failure(status)
         if self.guard is not None:
-            clearance, detail = self.guard.margin(tuple(self.S[K.P_E:K.P_E + 3].tolist()))
+            clearance, detail = self.guard.margin(tuple(self.S[L.P_E:L.P_E + 3].tolist()))
             if self._watch == COLLISION or clearance < 0.0:
                 self._margin = clearance
             if clearance < 0.0:
@@ -295,13 +311,13 @@ class CompiledStepper(Stepper):
             budget = getattr(self.guard, "budget", None)
             if budget is not None:  # clear within this distance: the kernel commits alone
                 S = self.S
-                S[K.GUARD_Q:K.GUARD_Q + 3] = S[K.P_E:K.P_E + 3]
-                S[K.GUARD_B] = float(budget(tuple(S[K.P_E:K.P_E + 3].tolist())))
+                S[L.GUARD_Q:L.GUARD_Q + 3] = S[L.P_E:L.P_E + 3]
+                S[L.GUARD_B] = float(budget(tuple(S[L.P_E:L.P_E + 3].tolist())))
         return None
 
     # -- the landing's primitives (Stepper._land_on_limit drives them) ----------------------
     def _try(self, f: float) -> tuple[str, str] | None:
-        self.S[K.WATCH] = _CODES.get(self._watch, K.WATCH_NONE)
+        self.S[L.WATCH] = _CODES.get(self._watch, K.WATCH_NONE)
         status, _, self._margin = self._call(E.OP_TRIAL, -1, f)
         return self._resolve(status)
 
@@ -320,5 +336,4 @@ class CompiledStepper(Stepper):
             else math.nan
 
 
-assert K.N1 - K.C1 == K.KEPT1 - K.N1 == 2 * CS   # the contact blocks' layout
-Stepper.compiled_class = CompiledStepper
+assert L.N1 - L.C1 == L.KEPT1 - L.N1 == 2 * L.CS   # the contact blocks' layout

@@ -64,27 +64,15 @@ class Stepper:
 
     ``guard`` (a :class:`Guard`, optional) is asked for every trial that passes the other
     rules; a negative margin stops the path with ``collision``, landed tangent to the
-    third face like any other limit. ``compiled``: None (default) runs the compiled
-    kernel (cadcnc.interp.compiled) when both surfaces have compiled data, False forces
-    this plain-Python reference.
+    third face like any other limit. This is the plain-Python reference;
+    :func:`cadcnc.interp.compiled.new_stepper` builds the compiled one where it applies.
     """
-
-    compiled_class: type | None = None
-    """Set by cadcnc.interp.compiled: the stepper used when both surfaces have compiled
-    data (``surface.kernel``) and ``compiled`` is not False."""
-
-    def __new__(cls, s1, s2, *args, compiled: bool | None = None, **kwargs):
-        if (cls is Stepper and compiled is not False and Stepper.compiled_class is not None
-                and getattr(s1, "kernel", None) and getattr(s2, "kernel", None)):
-            cls = Stepper.compiled_class
-        return object.__new__(cls)
 
     def __init__(self, s1: SurfaceLike, s2: SurfaceLike, offsets: tuple[float, float],
                  start: Tangency, *, feed: float, period: float, direction: Vec,
                  end: Tangency | None = None, closed: bool = False,
                  tol: Tolerances = DEFAULT, max_cycles: int = 1_000_000,
-                 record: bool = True, check_boundary: bool = True, guard: Guard | None = None,
-                 compiled: bool | None = None):
+                 record: bool = True, check_boundary: bool = True, guard: Guard | None = None):
         self.tol = tol
         self.period = check_number("period", period, "s")
         self.feed = self._check_feed(feed)

@@ -16,7 +16,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..interp.stepper import Stepper, Tangency
+from ..interp.compiled import new_stepper
+from ..interp.stepper import Tangency
 from .finish.passes import GuidePlane
 from .finish.setup import GUIDE_MARGIN, guide_face
 
@@ -66,7 +67,7 @@ def stepper_factory(part):
         tangent = path.points[1] - path.points[0]
         # the stream lands on the end itself (not "reached" 0.1 um before it)
         tol = replace(job.tolerances, end_reached=END_REACHED)
-        return Stepper(s1, s2, job.offsets, start, feed=job.feed, period=period,
+        return new_stepper(s1, s2, job.offsets, start, feed=job.feed, period=period,
                        direction=tuple(map(float, tangent)), end=end, tol=tol,
                        max_cycles=10 ** 9, record=False, check_boundary=False)
 

@@ -25,7 +25,7 @@ from OCP.gp import gp_Pnt
 
 import cadcnc
 from cadcnc.interp.cycle import CLOSED, CURVATURE, DIVERGED, END, paper_inverse_ratio, track
-from cadcnc.interp.stepper import Stepper
+from cadcnc.interp.compiled import new_stepper
 from cadcnc.core.job import MIN_STEP, Job, PairPath, Tool
 from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for
 from cadcnc.core.tolerances import DEFAULT
@@ -204,7 +204,7 @@ def test_a_stepper_built_directly_refuses_a_step_below_the_minimum():
     s1, s2, job = pair_job(*fixture_faces("sphere_cylinder", 1, 2), radius=3.0, **KW)
     plan = plan_path(s1, s2, job)
     with pytest.raises(cadcnc.InputError, match="feed.*period"):
-        Stepper(s1, s2, plan.offsets, plan.start, feed=1500.0, period=1e-12,
+        new_stepper(s1, s2, plan.offsets, plan.start, feed=1500.0, period=1e-12,
                 direction=plan.direction)
 
 

@@ -1,6 +1,6 @@
 """The interpolation cycle's mathematics compiled: cycle.py's functions on flat contact rows.
 
-A contact is CS floats of a float64 array (the state, see step.py) at offset o: its
+A contact is CS floats of a float64 array (the state, see layout.py) at offset o: its
 parameters, r, r_u, r_w, the unit normal, the forms E F G L M N, the singularity ratio and
 the offset R' (mm). Every function mirrors the one of the same name in
 ``cadcnc/interp/cycle.py`` (the plain-Python reference) operation for operation, with
@@ -14,12 +14,10 @@ import math
 import numba
 import numpy as np
 
+from .layout import C_E, C_F, C_G, C_L, C_M, C_N, C_NRM, C_OFF, C_R, C_RU, C_RW, C_SING, C_U, C_W
+
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 
-# a contact row
-C_U, C_W, C_R, C_RU, C_RW, C_NRM = 0, 1, 2, 5, 8, 11
-C_E, C_F, C_G, C_L, C_M, C_N, C_SING, C_OFF = 14, 15, 16, 17, 18, 19, 20, 21
-CS = 24
 PAPER_INVERSE_LIMIT = 1.0 + 1e-9   # cycle.PAPER_INVERSE_LIMIT
 MAX_TURN = 0.1                     # cycle.MAX_TURN
 

@@ -10,9 +10,10 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from .layout import ARG_U, ARG_W, C1, C2, CYCLES, MARGIN
 from .step import (
-    C1, C2, CYCLES, DONE, MARGIN, MAX_CYCLES, RECORD_FULL, commit_kept, commit_trial, keep, move_to,
-    state_margin, step, trial, write_row,
+    DONE, MAX_CYCLES, RECORD_FULL, commit_kept, commit_trial, keep, move_to, state_margin, step,
+    trial, write_row,
 )
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -37,7 +38,6 @@ def run(F: np.ndarray, I: np.ndarray, S: np.ndarray, R: np.ndarray, n_rec: int,
 
 OP_STEP, OP_RUN, OP_TRIAL, OP_KEEP, OP_COMMIT_TRIAL, OP_COMMIT_KEPT = range(6)
 OP_MOVE_TO, OP_FIRST_ROW, OP_STATE_MARGIN = 6, 7, 8
-ARG_U, ARG_W = 64, 65   # S slots for OP_MOVE_TO's parameters
 
 
 @_jit

@@ -26,7 +26,8 @@ import math
 import numba
 import numpy as np
 
-from .step import CYCLES, DONE, MAX_CYCLES, P, RECORD_FULL, TRAVELLED, step
+from .layout import CYCLES, P, TRAVELLED
+from .step import DONE, MAX_CYCLES, RECORD_FULL, step
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 

@@ -3,13 +3,13 @@
 Mirrors ``Stepper.step`` of cadcnc/interp/stepper.py (the reference) on flat arrays:
 
 - ``F`` float64 / ``I`` int64: both surfaces packed by ``cadcnc.interp.compiled.pack``
-  (evaluator arrays, trim grid, wrap); per surface s a header I[16 s : 16 s + 16]
-  (kind, offsets and lengths into F / I) and F[16 s : 16 s + 16] (grid origin, cell
-  size, window, wrap ranges and periods, normal sign, offset of the grid's ``fine``).
+  (evaluator arrays, trim grid, wrap) behind a header per surface;
 - ``S`` float64 (STATE_SIZE,): the state (centre, direction, contacts c1 c2, spares n1 n2,
-  the kept landing trial, counters, tolerances) and scratch; offsets below.
-- ``R`` (capacity, 46): the record's rows (PathRecord layout), written at commit when
+  the kept landing trial, counters, tolerances) and scratch;
+- ``R`` (capacity, ROW): the record's rows (PathRecord layout), written at commit when
   ``n_rec`` >= 0.
+
+Every offset into them is named in :mod:`.layout`.
 
 Statuses are small ints (below); the Python side turns them into stop reasons and
 messages. Nothing allocates; one trial costs two evaluations and a few hundred flops.
@@ -23,9 +23,20 @@ import numba
 import numpy as np
 
 from .cycle_math import (
-    C_OFF, C_R, C_SING, C_U, C_W, CS, PAPER_INVERSE_LIMIT, accurate_step, axpy, centre,
-    correct, cross, curvature, dot, inverse, inverse_exact, norm, paper_inverse_ratio, put,
-    scale, set_geometry, sub, tangent_coords, vec,
+    PAPER_INVERSE_LIMIT, accurate_step, axpy, centre, correct, cross, curvature, dot, inverse,
+    inverse_exact, norm, paper_inverse_ratio, put, scale, set_geometry, sub, tangent_coords, vec,
+)
+from .layout import (
+    ACC_CYCLES, ACC_RATIO, AUTO_COMMIT, C1, C2, C_E, C_NRM, C_OFF, C_R, C_SING, C_U, C_W,
+    CHECK_BOUNDARY, CS, CYCLES, D_OUT, DIAG, DP, END_P, END_UV1, END_UV2, EX1, EX2, F_TRIAL,
+    G_DU, G_DW, G_FINE, G_NORMAL_SIGN, G_U0, G_UMIN, G_UPERIOD, G_W0, G_WIN_U, G_WIN_UP,
+    G_WIN_W, G_WIN_WP, G_WMIN, G_WPERIOD, GUARD_B, GUARD_Q, H_CELLS, H_CELLS_NU,
+    H_CELLS_NW, H_IARR, H_IARR_LEN, H_KIND, H_KU, H_KU_LEN, H_KV, H_KV_LEN, H_NU, H_NV,
+    H_PARAMS, H_PARAMS_LEN, H_POLES, H_WEIGHTS, HAS_END, HAS_LAST, HEAD, K1, K2, KEPT1,
+    KEPT2, KEPT_P, KEPT_T, LAST_K1, LAST_K2, LAST_R1, LAST_R2, MARGIN, MIN_STEP, N1, N2, P,
+    P_E, R_COMMANDED, R_CONTACTS, R_FORMS, R_POINTS, R_RATIO, R_STEP, R_UV, RATIO,
+    REESTIMATE, T, TOL_ACCURACY, TOL_DIVERGED, TOL_END, TOL_FLAT, TOL_SINGULAR, TOL_TANGENT, TR_OK,
+    TR_T, TRAVELLED, TRIM_STATE, WATCH, WORK, WORK_SIZE,
 )
 from .evaluators import OK as EVAL_OK
 from .evaluators import d2
@@ -43,20 +54,6 @@ TRACK_TANGENT, END_STOP, END_LANDED, PASSED, CHECK_TRIM, MAX_CYCLES, RECORD_FULL
 guard, then commits). CHECK_TRIM: a spare contact's cell is MIXED (TRIM_STATE says which):
 the caller classifies exactly. END_STOP / END_LANDED: at the end (no step / last step)."""
 
-# state offsets
-P, T, TR_T, K1, K2, EX1, EX2, TR_OK = 0, 3, 6, 9, 10, 11, 12, 13
-LAST_K1, LAST_K2, LAST_R1, LAST_R2, HAS_LAST = 14, 15, 16, 19, 22
-P_E, RATIO, F_TRIAL, MARGIN, DIAG, DP = 23, 27, 28, 29, 30, 33   # DIAG: label, a, b
-CYCLES, TRAVELLED, ACC_CYCLES, ACC_RATIO = 36, 37, 38, 39
-END_P, END_UV1, END_UV2, HAS_END, CLOSED = 40, 43, 45, 47, 48
-TOL_TANGENT, TOL_FLAT, TOL_SINGULAR, TOL_DIVERGED, TOL_ACCURACY = 49, 50, 51, 52, 53
-TOL_END, MIN_STEP, CHECK_BOUNDARY, WATCH, AUTO_COMMIT = 54, 55, 56, 57, 58
-TRIM_STATE, REESTIMATE = 60, 62          # 2 states (0 in, 1 out, 2 ask), 2 x (u, w)
-GUARD_Q, GUARD_B = 66, 69                # the guard's budget: clear within B of Q
-C1, C2, N1, N2, KEPT1, KEPT2, KEPT_P, KEPT_T = 80, 104, 128, 152, 176, 200, 224, 227
-D_OUT, WORK = 240, 260
-STATE_SIZE = WORK + 2048
-ROW = 46                                 # record columns (record.FIELDS)
 WATCH_NONE = -1.0
 
 
@@ -64,38 +61,43 @@ WATCH_NONE = -1.0
 def move_to(F: np.ndarray, I: np.ndarray, S: np.ndarray, s: int, o: int, u: float,
             w: float) -> int:
     """Contact.move_to: wrap, evaluate (compiled d2), refresh the contact row at o."""
-    h = 16 * s
-    if F[h + 9] > 0.0:
-        u = F[h + 8] + (u - F[h + 8]) % F[h + 9]
-    if F[h + 11] > 0.0:
-        w = F[h + 10] + (w - F[h + 10]) % F[h + 11]
-    a = I[h + 1]
-    b = I[h + 3]
-    nu = I[h + 10]
-    nv = I[h + 11]
+    h = HEAD * s
+    if F[h + G_UPERIOD] > 0.0:
+        u = F[h + G_UMIN] + (u - F[h + G_UMIN]) % F[h + G_UPERIOD]
+    if F[h + G_WPERIOD] > 0.0:
+        w = F[h + G_WMIN] + (w - F[h + G_WMIN]) % F[h + G_WPERIOD]
+    a = I[h + H_PARAMS]
+    b = I[h + H_IARR]
+    ku = I[h + H_KU]
+    kv = I[h + H_KV]
+    poles = I[h + H_POLES]
+    weights = I[h + H_WEIGHTS]
+    nu = I[h + H_NU]
+    nv = I[h + H_NV]
     out = S[D_OUT:D_OUT + 18].reshape((6, 3))
-    status = d2(I[h], F[a:a + I[h + 2]], I[b:b + I[h + 4]], F[I[h + 5]:I[h + 5] + I[h + 6]],
-                F[I[h + 7]:I[h + 7] + I[h + 8]],
-                F[I[h + 9]:I[h + 9] + nu * nv * 3].reshape((nu, nv, 3)),
-                F[I[h + 12]:I[h + 12] + nu * nv].reshape((nu, nv)), u, w,
-                S[WORK:WORK + 2048], out)
+    status = d2(I[h + H_KIND], F[a:a + I[h + H_PARAMS_LEN]], I[b:b + I[h + H_IARR_LEN]],
+                F[ku:ku + I[h + H_KU_LEN]], F[kv:kv + I[h + H_KV_LEN]],
+                F[poles:poles + nu * nv * 3].reshape((nu, nv, 3)),
+                F[weights:weights + nu * nv].reshape((nu, nv)), u, w,
+                S[WORK:WORK + WORK_SIZE], out)
     if status != EVAL_OK:
         return status
-    set_geometry(S, o, F[h + 12], u, w, out)
+    set_geometry(S, o, F[h + G_NORMAL_SIGN], u, w, out)
     return EVAL_OK
 
 
 @_jit
 def trim_cell(F: np.ndarray, I: np.ndarray, s: int, u: float, w: float) -> int:
-    h = 16 * s
-    if I[h + 14] == 0:
+    h = HEAD * s
+    if I[h + H_CELLS_NU] == 0:
         return CELL_MIXED
-    g = I[h + 13]
-    nu = I[h + 14]
-    nw = I[h + 15]
-    return lookup(I[g:g + nu * nw].reshape((nu, nw)), F[int(F[h + 13]):], F[h], F[h + 1],
-                  F[h + 2], F[h + 3], nu, nw, wrap(u, F[h + 4], F[h + 5]),
-                  wrap(w, F[h + 6], F[h + 7]))
+    g = I[h + H_CELLS]
+    nu = I[h + H_CELLS_NU]
+    nw = I[h + H_CELLS_NW]
+    return lookup(I[g:g + nu * nw].reshape((nu, nw)), F[int(F[h + G_FINE]):], F[h + G_U0],
+                  F[h + G_W0], F[h + G_DU], F[h + G_DW], nu, nw,
+                  wrap(u, F[h + G_WIN_U], F[h + G_WIN_UP]),
+                  wrap(w, F[h + G_WIN_W], F[h + G_WIN_WP]))
 
 
 @_jit
@@ -191,7 +193,7 @@ def trial(F: np.ndarray, I: np.ndarray, S: np.ndarray, f: float) -> int:
 def track(S: np.ndarray) -> int:
     """cycle.track at the current contacts into S[TR_T], S[K1], ...; 0 or a failure."""
     S[TR_OK] = 0.0
-    m = cross(vec(S, C1 + 11), vec(S, C2 + 11))
+    m = cross(vec(S, C1 + C_NRM), vec(S, C2 + C_NRM))
     s = norm(m)
     if s < S[TOL_TANGENT]:
         return _fail(S, TRACK_TANGENT, 0, s, 0.0, math.nan)
@@ -292,21 +294,21 @@ def commit_kept(S: np.ndarray, R: np.ndarray, n_rec: int, f: float) -> None:
 @_jit
 def write_row(S: np.ndarray, R: np.ndarray, n: int, f: float, step: float) -> None:
     """PathRecord.add from the state: the columns of record.FIELDS in order."""
-    _row(S, R, n, 0, P, 3)
-    R[n, 3] = S[C1 + C_U]
-    R[n, 4] = S[C1 + C_W]
-    R[n, 5] = S[C2 + C_U]
-    R[n, 6] = S[C2 + C_W]
-    col = 7
+    _row(S, R, n, R_POINTS, P, 3)
+    R[n, R_UV] = S[C1 + C_U]
+    R[n, R_UV + 1] = S[C1 + C_W]
+    R[n, R_UV + 2] = S[C2 + C_U]
+    R[n, R_UV + 3] = S[C2 + C_W]
+    col = R_CONTACTS
     for field in range(4):           # contacts, ru, rw, normals: 3 floats per surface
         _row(S, R, n, col, C1 + C_R + 3 * field, 3)
         _row(S, R, n, col + 3, C2 + C_R + 3 * field, 3)
         col += 6
-    _row(S, R, n, col, C1 + 14, 6)   # forms E F G L M N
-    _row(S, R, n, col + 6, C2 + 14, 6)
-    R[n, 43] = f
-    R[n, 44] = step
-    R[n, 45] = S[RATIO]
+    _row(S, R, n, R_FORMS, C1 + C_E, 6)   # forms E F G L M N
+    _row(S, R, n, R_FORMS + 6, C2 + C_E, 6)
+    R[n, R_COMMANDED] = f
+    R[n, R_STEP] = step
+    R[n, R_RATIO] = S[RATIO]
 
 
 @_jit

@@ -33,7 +33,8 @@ from scipy.spatial import cKDTree
 from ...core.errors import CadcncError
 from ...geometry.offset_section import SectionWire, section_wires
 from ...interp.cycle import BOUNDARY, CLOSED, COLLISION, END
-from ...interp.stepper import Stepper, Tangency
+from ...interp.compiled import new_stepper
+from ...interp.stepper import Tangency
 from ...core.job import Job, PairPath
 from ...program.program import FAILED, STOPPED_SHORT, CutSegment, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
@@ -252,7 +253,7 @@ class _Level:
         tau = self.tangent(surface.normal(*start.uv1))
         if backwards:
             tau = -tau
-        stepper = Stepper(surface, self.guide, (job.tool.offset, 0.0), start, feed=job.feed,
+        stepper = new_stepper(surface, self.guide, (job.tool.offset, 0.0), start, feed=job.feed,
                           period=job.period, direction=tuple(tau),
                           end=None if closed else end, closed=closed,
                           tol=job.tolerances, max_cycles=max_cycles, guard=guard)

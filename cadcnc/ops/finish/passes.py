@@ -35,7 +35,8 @@ import numpy as np
 from ...core.errors import CadcncError, GeometryError
 from ...geometry.part import Part
 from ...interp.cycle import BOUNDARY, COLLISION, END
-from ...interp.stepper import Stepper, Tangency
+from ...interp.compiled import new_stepper
+from ...interp.stepper import Tangency
 from ...core.job import Job, PairPath
 from ...program.program import FAILED, STOPPED_SHORT, CutSegment, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
@@ -349,7 +350,7 @@ class _Pass:
         if end is not None:   # the stepper lands on an end only after two steps
             gap = float(np.linalg.norm(np.subtract(end.p, start.p)))
             feed = min(feed, max(gap / 3.0, SHORTEST) * 60.0 / job.period)
-        stepper = Stepper(surface, self.guide, (job.tool.offset, 0.0), start, feed=feed,
+        stepper = new_stepper(surface, self.guide, (job.tool.offset, 0.0), start, feed=feed,
                           period=job.period, direction=tuple(tau), end=end,
                           tol=job.tolerances, max_cycles=max_cycles, guard=guard)
         where = self.where(face)

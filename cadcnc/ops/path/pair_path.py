@@ -15,6 +15,7 @@ import numpy as np
 from ...core.errors import FacePairError, GeometryError, InputError, StartPointError
 from ...geometry.face_surface import FaceSurface
 from ...geometry.part import CONCAVE
+from ...interp.compiled import new_stepper
 from ...interp.stepper import Stepper, Tangency
 from ...interp.tangency import solve_tangency
 from ...core.job import Job, PairPath, Tool
@@ -194,7 +195,7 @@ def stepper_for(plan: PathPlan, max_cycles: int = 1_000_000, record: bool = True
     if check_cycles:
         check_cycle_count(plan, max_cycles)
     job = plan.job
-    return Stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
+    return new_stepper(plan.s1, plan.s2, plan.offsets, plan.start, feed=job.feed,
                    period=job.period, direction=plan.direction, end=plan.end,
                    closed=plan.closed, tol=job.tolerances, max_cycles=max_cycles,
                    record=record, check_boundary=plan.check_boundary, guard=guard)
