@@ -21,8 +21,7 @@ import pytest
 PKG = Path(__file__).resolve().parents[1] / "cadcnc"
 KERNEL_FREE_TOP = {"cadcnc.core", "cadcnc.core.errors", "cadcnc.core.tolerances", "cadcnc.core.job",
                    "cadcnc.core.finish_fields", "cadcnc.core.units", "cadcnc.core.work_limits",
-                   "cadcnc.core.trim_labels", "cadcnc.core.jsonable", "cadcnc.core.interrupts",
-                   "cadcnc.workers"}
+                   "cadcnc.core.trim_labels", "cadcnc.core.jsonable", "cadcnc.core.interrupts"}
 THIRD_PARTY_OK_IN_CORE = {"numpy", "numba"}
 
 
@@ -160,11 +159,11 @@ def test_no_private_name_imported_across_modules():
     assert found == []
 
 
-STAGES = ["core", "interp", "geometry", "guard", "program", "ops", "controller", "io",
-          "verification", "apt", "batch", "cli"]
+STAGES = ["core", "interp", "geometry", "parallel", "guard", "program", "ops", "controller",
+          "io", "verification", "apt", "batch", "cli"]
 """The data flow, in the order the code has (docs/architecture.md): a stage imports only from
 itself and the stages before it."""
-TOP = {"cadcnc", "cadcnc.__main__", "cadcnc.workers"}
+TOP = {"cadcnc", "cadcnc.__main__"}
 """The modules outside any stage: the package's API and its ``python -m`` entry."""
 
 

@@ -15,7 +15,6 @@ from cadcnc.core.job import Job, PairPath, Tool
 from cadcnc.ops.common import safe_height
 from cadcnc.ops.entries import entered_program_segments
 from cadcnc.ops.path import pair_program
-from cadcnc.workers import close
 from conftest import FIXTURES
 
 pytestmark = pytest.mark.slow
@@ -46,13 +45,10 @@ def test_entries_on_two_processes_are_those_of_one(name, monkeypatch):
     # the sealed corner's cut and the others twice: more cuts than workers
     cuts = cuts + cuts
     z = safe_height(part, job)
-    try:
-        one = entered_program_segments(part, job, cuts, z, join=0.5, jobs=1)
-        ticks: list = []
-        two = entered_program_segments(part, job, cuts, z, join=0.5, jobs=2,
-                                       tick=lambda k, n: ticks.append((k, n)))
-    finally:
-        close()
+    one = entered_program_segments(part, job, cuts, z, join=0.5, jobs=1)
+    ticks: list = []
+    two = entered_program_segments(part, job, cuts, z, join=0.5, jobs=2,
+                                   tick=lambda k, n: ticks.append((k, n)))
     assert len(one[0]) == len(two[0])
     assert len(one[1]) == (len(cuts) if name == "entry_sealed" else 0)
     assert all(_same(a, b) for a, b in zip(one[0], two[0]))

@@ -23,7 +23,7 @@ import cadcnc
 from cadcnc.core.errors import EXIT_INTERNAL, EXIT_INTERRUPTED
 from cadcnc.geometry.part_bytes import part_blob, part_from_blob
 from cadcnc.core.errors import InputError
-from cadcnc.workers import START_ENV, WorkerError, close, map_ordered, start_method
+from cadcnc.parallel.pool import START_ENV, WorkerError, kept_pools, map_ordered, start_method
 from conftest import FIXTURES, cadcnc_cli
 
 BOSS = str(FIXTURES / "finish_boss.step")
@@ -63,7 +63,6 @@ def test_the_outputs_are_the_same_bytes_whatever_the_jobs(command, tmp_path, mon
     for n in (1, 2):
         outs = [tmp_path / f"p{n}.json", tmp_path / f"p{n}.ngc"]
         cadcnc_cli(*command, "--jobs", n, *[a for o in outs for a in ("-o", o)], check=0)
-        close()   # the workers a command's exit would end
         files[n] = [o.read_bytes() for o in outs]
     assert files[1] == files[2]
 
@@ -102,7 +101,6 @@ def test_a_dead_worker_is_an_error_not_a_hang(method, monkeypatch):
         map_ordered(_die, [0, 1, 2, 3], part=part, jobs=2, build=part_from_blob,
                     build_args=lambda: part_blob(part))
     assert err.value.exit_code == EXIT_INTERNAL and time.monotonic() - t0 < 120
-    close()
 
 
 @pytest.mark.parametrize("method", ["fork", "forkserver"])
@@ -111,7 +109,6 @@ def test_tasks_come_back_in_order_from_the_part_in_each_worker(method, monkeypat
     part = cadcnc.load_step(FIXTURES / "step_slot.step")
     got = map_ordered(_kind, list(range(1, len(part) + 1)), part=part, jobs=2,
                       build=part_from_blob, build_args=lambda: part_blob(part))
-    close()
     assert got == [part.face(n).kind for n in range(1, len(part) + 1)]
 
 
@@ -119,7 +116,30 @@ def _kind(part, n):
     return part.face(n).kind
 
 
-THREADED = ("import threading, time; from cadcnc.workers import start_method; "
+def _pid(part, task):
+    return os.getpid()
+
+
+def test_a_pool_lives_for_its_block_or_its_call(monkeypatch):
+    """Inside ``kept_pools()`` a part's pool serves every call and ends with the block;
+    outside, each call's pool ends with the call."""
+    monkeypatch.setenv(START_ENV, "fork")
+    part = cadcnc.load_step(FIXTURES / "step_block.step")
+    run = lambda: set(map_ordered(_pid, range(4), part=part, jobs=2, build=part_from_blob,  # noqa: E731
+                                  build_args=lambda: part_blob(part)))
+    with kept_pools() as pools:
+        first, second = run(), run()
+        assert len(first | second) <= 2 and pools.held(part)
+    assert not pools.held(part)
+    assert not {p for p in first | second if Path(f"/proc/{p}").exists()
+                and _parent_of(str(p)) == os.getpid()}
+    alone = run()
+    assert not alone & (first | second)
+    assert not {p for p in alone if Path(f"/proc/{p}").exists()
+                and _parent_of(str(p)) == os.getpid()}
+
+
+THREADED = ("import threading, time; from cadcnc.parallel.pool import start_method; "
             "print(start_method()); threading.Thread(target=time.sleep, args=(2,)).start(); "
             "print(start_method())")
 

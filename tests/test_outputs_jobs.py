@@ -13,7 +13,7 @@ from cadcnc.geometry.setup import setup_part
 from cadcnc.io.gcode import blend_for
 from cadcnc.io.outputs import render, render_all
 from cadcnc.io.program_json import RUNS_PER_JOB, _runs
-from cadcnc.workers import START_ENV, close
+from cadcnc.parallel.pool import START_ENV
 from conftest import FIXTURES
 
 
@@ -36,7 +36,6 @@ def test_the_json_made_on_two_processes_is_the_same_bytes(origin, programs, monk
     assert len(program.segments) >= 8
     one = render(program, "p.json", part)
     two = render_all(program, ["p.json"], part, jobs=2)["p.json"]
-    close()
     assert two == one and ("setup" in json.loads(one)) == (origin is not None)
     runs = _runs(program.segments, 2)
     assert 2 <= len(runs) <= 2 * RUNS_PER_JOB and all(runs)
@@ -51,7 +50,6 @@ def test_every_output_made_on_two_processes_is_the_same_bytes(programs, monkeypa
     gcode = dict(blend=blend_for(program.job.tolerances.gouge))
     one = render_all(program, outs, part, "slot", **gcode)
     two = render_all(program, outs, part, "slot", 2, **gcode)
-    close()
     assert list(two) == outs and two == one
     assert one["p.ngc"] == render(program, "p.ngc", part, "slot", **gcode)
     with pytest.raises(cadcnc.OutputError, match="unknown output format"):

@@ -1,6 +1,6 @@
 """Workers fed the largest tasks first (issue 24) change no answer.
 
-:func:`cadcnc.ops.parallel.on_workers` hands the workers the tasks by decreasing size
+:func:`cadcnc.parallel.tasks.on_workers` hands the workers the tasks by decreasing size
 and still returns (and reports) every result under its own task's index, and a worker
 that dies is named by the caller's task number; one job runs here in task order.
 """
@@ -13,8 +13,8 @@ import signal
 import pytest
 
 import cadcnc
-from cadcnc.ops.parallel import on_workers
-from cadcnc.workers import WorkerError, close
+from cadcnc.parallel.pool import WorkerError, kept_pools
+from cadcnc.parallel.tasks import on_workers
 from conftest import FIXTURES
 
 
@@ -25,23 +25,23 @@ def _where(part, task, beat=None):
 
 @pytest.fixture(scope="module")
 def part():
-    yield cadcnc.load_step(FIXTURES / "step_block.step")
-    close()
+    return cadcnc.load_step(FIXTURES / "step_block.step")
 
 
 def test_largest_first_keeps_every_result_in_its_place(part):
     tasks = list(range(9))
     sizes = [3, 9, 1, 9, 5, 0, 2, 8, 4]
     seen: list = []
-    out = on_workers(_where, tasks, part, 2, lambda k, res: seen.append((k, res[0])),
-                     sizes=sizes)
+    with kept_pools():
+        out = on_workers(_where, tasks, part, 2, lambda k, res: seen.append((k, res[0])),
+                         sizes=sizes)
+        again = on_workers(_where, tasks, part, 2, sizes=sizes[::-1])
     assert [r[0] for r in out] == tasks and all(r[1] == len(part) for r in out)
     assert sorted(seen) == [(k, k) for k in tasks]   # each reported under its own index
     assert {r[2] for r in out} - {os.getpid()}       # the workers ran them
     assert not {r[2] for r in out} & {os.getpid()}
     # the pool is kept for the part: no worker beyond the pool's two, across both runs
     # (the first run may have been served by one of them alone: its tasks are instant)
-    again = on_workers(_where, tasks, part, 2, sizes=sizes[::-1])
     assert len({r[2] for r in again} | {r[2] for r in out}) <= 2
 
 

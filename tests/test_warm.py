@@ -1,4 +1,4 @@
-"""The workers' warm-up (cadcnc/ops/warm.py, issue 24): a fresh process that runs it has
+"""The workers' warm-up (cadcnc/parallel/warm.py, issue 24): a fresh process that runs it has
 a kernel's compiled code loaded from numba's cache before its first call, and compiles
 nothing afresh."""
 
@@ -9,7 +9,7 @@ import sys
 
 CALL = ("from cadcnc.interp.kernel.cycle_math import dot; "
         "assert dot((1.0, 2.0, 3.0), (1.0, 1.0, 1.0)) == 6.0")
-WARM = ("import cadcnc.interp.kernel.cycle_math as m; from cadcnc.ops.warm import warm; "
+WARM = ("import cadcnc.interp.kernel.cycle_math as m; from cadcnc.parallel.warm import warm; "
         "before = len(m.dot.overloads); n = warm(); "
         "print(before, len(m.dot.overloads), n, sum(m.dot.stats.cache_misses.values()))")
 
@@ -26,9 +26,9 @@ def test_warm_loads_cached_kernels_before_their_first_call():
     assert misses == 0   # loaded from the cache, not compiled
 
 
-START = ("import multiprocessing.forkserver as f; from cadcnc import workers; "
-         "workers.start(1); one = f._forkserver._forkserver_pid; "
-         "workers.start(2); print(one, f._forkserver._forkserver_pid)")
+START = ("import multiprocessing.forkserver as f; from cadcnc.parallel import pool; "
+         "pool.start(1); one = f._forkserver._forkserver_pid; "
+         "pool.start(2); print(one, f._forkserver._forkserver_pid)")
 
 
 def test_the_workers_server_starts_early_only_for_more_than_one_process(monkeypatch):

@@ -14,18 +14,19 @@ import sys
 import time
 from pathlib import Path
 
-from cadcnc.workers import process_alive
+from cadcnc.parallel.pool import process_alive
 
 SCRIPT = """
 import multiprocessing, os, sys
-from cadcnc.workers import map_ordered
+from cadcnc.parallel.pool import kept_pools, map_ordered
 sys.path.insert(0, {tests!r})
 from test_workers_exit import pause
 
 part = "a part"                                                 # opaque to the pool
-map_ordered(pause, [0.0, 0.0], part=part, jobs=2, build=str, build_args=lambda: (part,))
-print(*sorted(p.pid for p in multiprocessing.active_children()), flush=True)
-os._exit(0)                                                     # no shutdown, as on a crash
+with kept_pools():
+    map_ordered(pause, [0.0, 0.0], part=part, jobs=2, build=str, build_args=lambda: (part,))
+    print(*sorted(p.pid for p in multiprocessing.active_children()), flush=True)
+    os._exit(0)                                                 # no shutdown, as on a crash
 """
 
 

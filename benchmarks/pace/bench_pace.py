@@ -38,7 +38,7 @@ from cadcnc.ops.run import cut_back_gap
 from cadcnc.verification import gate_program
 from cadcnc.verification.cut_back import cut_back
 from cadcnc.verification.gate_cache import shared_gates
-from cadcnc.workers import close
+from cadcnc.parallel.pool import kept_pools
 from benchmarks.finishing import freeform_slab
 
 clock, cpu = time.perf_counter, time.process_time
@@ -108,11 +108,10 @@ def run_case(name: str, path: str, job: Job) -> dict:
     files1 = [render(back, f"p{s}", fresh, "", **gcode) for s in (".json", ".ngc")]
     part2 = cadcnc.load_step(path)
     t0 = clock()
-    with shared_gates(part2):
+    with shared_gates(part2), kept_pools():
         program2 = cadcnc.run(part2, job, jobs=2)
         back2, _, gcode2, _ = gate(program2, part2, jobs=2, reference=False)
     out["jobs2_s"] = clock() - t0
-    close()
     out["jobs1_s"] = out["compute_s"] + out["gate_s"]
     out["speedup_2"] = out["jobs1_s"] / out["jobs2_s"]
     out["same_bytes"] = files1 == [render(back2, f"p{s}", part2, "", **gcode2)

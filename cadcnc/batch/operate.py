@@ -32,7 +32,7 @@ class Settings:
     limit), ``gcode`` (keywords of :func:`~cadcnc.io.program_gcode.program_ngc` when a
     .ngc is written, else None: the gate then checks the program's own points),
     ``allow_partial`` / ``allow_gouge`` (write a partial or gouging program anyway),
-    ``jobs``: processes computing and gating (:mod:`cadcnc.workers`; a batch task runs
+    ``jobs``: processes computing and gating (:mod:`cadcnc.parallel`; a batch task runs
     one)."""
 
     max_cycles: int = MAX_CYCLES

@@ -16,7 +16,7 @@ from importlib.metadata import version
 
 from cadcnc.core.errors import EXIT_INTERRUPTED, CadcncError  # light: the package loads OCCT lazily
 from cadcnc.core.interrupts import sigint_deferred
-from cadcnc import workers
+from cadcnc.parallel import pool
 
 from .operation import DEFAULT_FEED, DEFAULT_PERIOD, add_axis_options, add_max_cycles
 
@@ -213,7 +213,7 @@ def main(argv: list[str] | None = None) -> int:
         # Ctrl-C inside OCCT's C-extension import would surface as an ImportError
         with sigint_deferred():
             if getattr(args, "jobs", 1) != 1:   # its imports run beside ours
-                workers.start(args.jobs)
+                pool.start(args.jobs)
             if args.command == "faces":   # reads the part only: no interpolation core
                 from .faces import faces as run
             else:

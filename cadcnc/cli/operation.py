@@ -69,12 +69,10 @@ def operation_command(args, what: str, job_of, *, progress=None,
                       times: dict | None = None) -> int:
     """Run one operation from the command line (module doc), its worker processes
     (``--jobs``) ended when it returns."""
-    from cadcnc import workers
+    from cadcnc.parallel.pool import kept_pools
 
-    try:
+    with kept_pools():
         return _operation(args, what, job_of, progress=progress, times=times)
-    finally:
-        workers.close()
 
 
 def _operation(args, what: str, job_of, *, progress=None, times: dict | None = None) -> int:

@@ -13,7 +13,7 @@ from cadcnc.io.gcode import blend_for
 from cadcnc.core.job import Finish, Job, PairPath, Pencil, Tool, check_number
 from cadcnc.core.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT, Tolerances
 from cadcnc.core.units import parse_duration, parse_feed, parse_length, parse_point
-from cadcnc.workers import check_jobs
+from cadcnc.parallel.pool import check_jobs
 
 JOB_OPTIONS = ("faces", "radius")  # feed and period have defaults (cadcnc/cli/operation.py)
 

@@ -23,7 +23,6 @@ def suffixed(out: str, tag: str) -> str:
 
 def setups_command(args) -> int:
     import cadcnc
-    from cadcnc import workers
     from cadcnc.core.errors import EXIT_NOTHING, InputError, NothingToCutError
     from cadcnc.io.output_set import OutputSet, check_destination
     from cadcnc.io.outputs import SUFFIXES, render
@@ -32,7 +31,7 @@ def setups_command(args) -> int:
     from cadcnc.ops.pencil.pencil import CHAIN_GAP
     from cadcnc.ops.pencil.setups import AUTO, axis_tag, parse_setups, pencil_setups
     from cadcnc.core.units import parse_length
-    from cadcnc.workers import check_jobs
+    from cadcnc.parallel.pool import check_jobs, kept_pools
     from cadcnc.verification.judgement import judge, settle, worst
 
     from .options import gcode_keywords, pencil_job, wants_gcode
@@ -53,11 +52,9 @@ def setups_command(args) -> int:
         part.face(n)
     report = None if args.quiet else (lambda done, total, what: None)
     jobs = check_jobs(getattr(args, "jobs", None))
-    try:
+    with kept_pools():   # each setup's part has its own workers
         result = pencil_setups(part, job, args.setups, overlap, progress=report,
                                max_cycles=args.max_cycles, jobs=jobs)
-    finally:
-        workers.close()   # each setup's part has its own workers
     t_cut = time.monotonic() - t0
     name = Path(args.step).name
     gcode = gcode_keywords(args) if wants_gcode(args.output) else None
@@ -79,11 +76,11 @@ def setups_command(args) -> int:
             codes.append(EXIT_NOTHING)
             writes.append(False)
             continue
-        verdict = judge(program, run.part, f"cadcnc: {what}", gcode=gcode,
-                        allow_partial=args.allow_partial, allow_gouge=args.allow_gouge,
-                        progress=stage_progress(args, f"{what}: gouge check", after_s=1.0),
-                        jobs=jobs)
-        workers.close()
+        with kept_pools():
+            verdict = judge(program, run.part, f"cadcnc: {what}", gcode=gcode,
+                            allow_partial=args.allow_partial, allow_gouge=args.allow_gouge,
+                            progress=stage_progress(args, f"{what}: gouge check", after_s=1.0),
+                            jobs=jobs)
         for line in verdict.messages:
             say_error(line)
         codes.append(verdict.code)

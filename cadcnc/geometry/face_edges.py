@@ -5,17 +5,15 @@ direction, with OCCT's topology behind this one fence. Lengths mm.
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
 from OCP.GCPnts import GCPnts_AbscissaPoint
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
-from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopAbs import TopAbs_EDGE
+from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
 from .face_surface import FaceSurface
 from .part import Part
@@ -49,23 +47,10 @@ class BoundaryEdge:
         return bool(self.topods.IsSame(other.topods))
 
 
-_OWNERS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
-def _owners(part: Part) -> TopTools_IndexedDataMapOfShapeListOfShape:
-    """Edge -> the faces of ``part`` that contain it, built once per part."""
-    owners = _OWNERS.get(part)
-    if owners is None:
-        owners = TopTools_IndexedDataMapOfShapeListOfShape()
-        TopExp.MapShapesAndAncestors_s(part.shape, TopAbs_EDGE, TopAbs_FACE, owners)
-        _OWNERS[part] = owners
-    return owners
-
-
 def boundary_edges(part: Part, face: FaceSurface) -> list[BoundaryEdge]:
     """The face's boundary edges in its own order, without collapsed edges and seams
     (neither bounds the face)."""
-    owners = _owners(part)
+    owners = part.edge_map()   # edge -> the faces holding it
     out = []
     exp = TopExp_Explorer(face.topods, TopAbs_EDGE)
     while exp.More():

@@ -26,6 +26,7 @@ from OCP.GProp import GProp_GProps
 from OCP.ShapeAnalysis import ShapeAnalysis_Surface
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
 
+from .boxes import optimal_box
 from . import differential as dg
 from .surface_data import SURFACE_KINDS, SurfaceData, as_topods_face, surface_data
 from ..core.errors import GeometryError, InputError, SingularPointError
@@ -66,9 +67,20 @@ class FaceSurface:
         self.u_period = self._adaptor.UPeriod() if self._adaptor.IsUPeriodic() else None
         self.w_period = self._adaptor.VPeriod() if self._adaptor.IsVPeriodic() else None
         self.clear_caches()
+        self._box: tuple[np.ndarray, np.ndarray] | None = None
+        self.derived: dict = {}
+        """What other stages build once from this face (the guard's cells and trees), by
+        its owner's key: kept with the face, dropped with it."""
         # scratch objects reused by every evaluation (keeps allocation out of hot loops)
         self._p = gp_Pnt()
         self._v = [gp_Vec() for _ in range(9)]
+
+    def box(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lo (3,), hi (3,)) of OCCT's optimal box of the face's geometry, mm (computed
+        once; copies)."""
+        if self._box is None:
+            self._box = optimal_box(self.topods, use_triangulation=False)
+        return self._box[0].copy(), self._box[1].copy()
 
     def __repr__(self) -> str:
         name = f"Face{self.number}" if self.number else "face"

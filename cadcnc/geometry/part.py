@@ -24,7 +24,6 @@ from OCP.TopoDS import TopoDS, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
 from ..core.errors import FaceNumberError, InputError, StepFileError
-from .boxes import optimal_box
 from .differential import cross
 from .face_surface import FaceSurface
 from .material_side import FLIPPED, SOLID, SurfaceModel, material_sides
@@ -140,6 +139,10 @@ class Part:
         self._emap: TopTools_IndexedDataMapOfShapeListOfShape | None = None
         self._bbox: tuple[np.ndarray, np.ndarray] | None = None
         self._face_boxes: tuple[np.ndarray, np.ndarray] | None = None
+        self.derived: dict = {}
+        """What other stages build once from this part (its turned setups, the guards'
+        face data, the gates' shared work), by its owner's key (the owner's module name):
+        kept with the part, dropped with it."""
         self.warnings: list[str] = []  # what OCCT printed while reading the file
 
     @classmethod
@@ -183,8 +186,7 @@ class Part:
         """(lows (n, 3), highs (n, 3)) of every face's optimal box (mm; face k at row k - 1),
         computed once: the part's box is their union, and the guards share them."""
         if self._face_boxes is None:
-            boxes = [optimal_box(self.face(k).topods, use_triangulation=False)
-                     for k in range(1, len(self) + 1)]
+            boxes = [self.face(k).box() for k in range(1, len(self) + 1)]
             self._face_boxes = (np.array([b[0] for b in boxes]).reshape(-1, 3),
                                 np.array([b[1] for b in boxes]).reshape(-1, 3))
         return self._face_boxes

@@ -19,7 +19,6 @@ A/B angles give. Lengths mm.
 from __future__ import annotations
 
 import math
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -123,9 +122,6 @@ class SetupPart(Part):
         self.warnings = list(original.warnings)
 
 
-_TURNED: "weakref.WeakKeyDictionary[Part, dict]" = weakref.WeakKeyDictionary()
-
-
 def setup_of(part: Part, axis, origin=None) -> Setup:
     """The :class:`Setup` of ``axis`` on ``part``: work zero ``origin`` (part coordinates)
     or the centre of the part's top seen along the axis (identity for +Z without one)."""
@@ -154,7 +150,7 @@ def setup_part(part: Part, job: Job | Setup) -> Part:
     setup = job if isinstance(job, Setup) else setup_of(part, job.axis, job.origin)
     if setup.identity:
         return part
-    cache = _TURNED.setdefault(part, {})
+    cache = part.derived.setdefault(__name__, {})   # the part's turned copies
     key = (tuple(setup.rotation.ravel()), tuple(setup.origin))
     if key not in cache:
         shape = _moved(part.given_shape, setup.rotation, -setup.rotation @ setup.origin)

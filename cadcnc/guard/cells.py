@@ -33,7 +33,6 @@ check runs. Lengths mm.
 from __future__ import annotations
 
 import math
-import weakref
 
 import numba
 import numpy as np
@@ -225,13 +224,11 @@ class HeightCells:
         return self.budget(p) >= 0.0
 
 
-_SHARED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
 def shared(kind, face):
-    """The ``kind`` (HeightCells or BoxTree) of a face, built once and shared by every guard
-    of its part (pencil builds a guard per pair; a face is in several pairs)."""
-    per_face = _SHARED.setdefault(face, {})
+    """The ``kind`` (HeightCells or BoxTree) of a face, built once, kept on the face and
+    shared by every guard of its part (pencil builds a guard per pair; a face is in
+    several pairs)."""
+    per_face = face.derived.setdefault(__name__, {})
     if kind not in per_face:
         per_face[kind] = kind(face)
     return per_face[kind]

@@ -32,7 +32,6 @@ or near 0), otherwise a positive lower bound.
 from __future__ import annotations
 
 import math
-import weakref
 
 import numpy as np
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
@@ -314,20 +313,18 @@ class ClearanceGuard:
         return ext.Value() if ext.IsDone() and ext.NbSolution() else -math.inf
 
 
-_PART_DATA: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
 def _part_data(part) -> tuple:
     """(faces, closed forms, box lows (n, 3), box highs (n, 3)) of every face of a part,
-    computed once per part and shared by its guards (optimal boxes cost about 4 ms a face,
-    seconds on a part of hundreds of faces, and pencil builds a guard per pair)."""
-    data = _PART_DATA.get(part)
+    computed once per part, kept on it and shared by its guards (optimal boxes cost about
+    4 ms a face, seconds on a part of hundreds of faces, and pencil builds a guard per
+    pair)."""
+    data = part.derived.get(__name__)
     if data is None:
         faces = [part.face(k) for k in range(1, len(part) + 1)]
         analytic = [AnalyticFace(f) for f in faces]   # closed forms, or kind None
         lo, hi = part.face_boxes()   # shared with the part's own box
         data = (faces, analytic, lo - BOX_SLACK, hi + BOX_SLACK)
-        _PART_DATA[part] = data
+        part.derived[__name__] = data
     return data
 
 

@@ -19,7 +19,6 @@ normal box reaching the origin) takes n anywhere in [-1, 1]. Lengths mm.
 from __future__ import annotations
 
 import math
-import weakref
 
 import numpy as np
 from OCP.Bnd import Bnd_Box
@@ -70,9 +69,6 @@ def pole_support(flat: np.ndarray, degree: int, cuts: np.ndarray) -> tuple[np.nd
 
 ROUND_OFF = 1e-12
 """Relative widening of a normal box: the round-off of its products and divisions."""
-_BOUNDED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
 def bounded(face) -> bool:
     """Whether :class:`FaceBoxes` boxes ``face`` soundly: a kind of BOUNDED_KINDS, or an
     offset of a non-rational B-spline that evaluates as the face (module doc)."""
@@ -80,9 +76,10 @@ def bounded(face) -> bool:
         return True
     if face.kind != "offset":
         return False
-    if face not in _BOUNDED:
-        _BOUNDED[face] = FaceBoxes(face).offset is not None
-    return _BOUNDED[face]
+    kept = face.derived   # the answer is kept on the face
+    if __name__ not in kept:
+        kept[__name__] = FaceBoxes(face).offset is not None
+    return kept[__name__]
 
 
 class FaceBoxes:

@@ -20,8 +20,8 @@ from ..program.program import Program
 from ..program.transform import in_part_coordinates
 from .program_gcode import program_ngc
 from .program_json import join_pieces, json_pieces, program_json, segments_text
-from ..ops.parallel import on_workers
-from ..workers import check_jobs
+from ..parallel.pool import check_jobs
+from ..parallel.tasks import on_workers
 from .program_plot import program_picture_bytes
 from .output_set import check_destination
 from .toolpath_csv import CSV_COLUMNS, toolpath_rows

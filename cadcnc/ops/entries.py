@@ -36,8 +36,8 @@ from ..core.job import Job
 from ..program.linking import Visit, linked
 from ..program.program import CutSegment, LinkSegment, Skipped
 from ..program.toolpath import toolpath_piece
-from ..workers import check_jobs
-from .parallel import on_workers
+from ..parallel.pool import check_jobs
+from ..parallel.tasks import on_workers
 
 UNREACHABLE = "unreachable"
 SIDES = ((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, -1.0, 0.0))
@@ -256,15 +256,11 @@ def entered_program_segments(part, job: Job, cuts: list[CutSegment], z_safe: flo
     return linked(items, z_safe, join=join, stay_down=stay_down), skipped, notes
 
 
-_ACCESS: list = [None]
-"""In a worker: the last (part, job, z_safe, Access), kept for the next cut's entry."""
-
-
 def _plan_task(part, task, beat=None) -> tuple:
     """One cut's :func:`entry_plan` (an :func:`on_workers` task), its Access (and the
     guards it builds) shared with the process's next cut of the same part and job."""
     job, z_safe, cut = task
-    held = _ACCESS[0]
-    if held is None or held[0] is not part or held[1] != job or held[2] != z_safe:
-        held = _ACCESS[0] = (part, job, z_safe, Access(part, job, z_safe))
-    return entry_plan(cut, held[3])
+    held = part.derived.get(__name__)   # the last (job, z_safe, Access) on this part
+    if held is None or held[0] != job or held[1] != z_safe:
+        held = part.derived[__name__] = (job, z_safe, Access(part, job, z_safe))
+    return entry_plan(cut, held[2])

@@ -8,7 +8,7 @@ from ..geometry.setup import setup_part
 from ..core.job import Finish, Job, PairPath, Pencil
 from ..program.program import Program
 from ..core.work_limits import MAX_CYCLES
-from ..workers import start
+from ..parallel.pool import start
 from .path.pair_program import program_for_job
 from .pencil.pencil import CHAIN_GAP, pencil_program
 

@@ -9,25 +9,22 @@ the pair's checks by toolpath (keyed by content, so a worker process can be hand
 them). Every value kept is OCCT's answer for the same input, so a gate answers as it
 would from scratch; the reference gate (``reference=True``) keeps nothing.
 
-The work is kept only inside ``with shared_gates(part):`` (a command's cut-back step
-and program gate; a worker process for its pool's life); elsewhere each gate starts
-afresh, so nothing outlives the command that computed it.
+The work is kept on the part (``part.derived``), and only from :func:`open_shared` on or
+inside ``with shared_gates(part):`` (a command's cut-back step and program gate; a
+worker's part for its pool's life); elsewhere each gate starts afresh. Nothing outlives
+the part.
 """
 
 from __future__ import annotations
 
 import hashlib
 import itertools
-import weakref
 from contextlib import contextmanager
 
 import numpy as np
 
 from ..core.tolerances import Tolerances
 from .material import Material, PartFaces
-
-_CACHES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
 
 class GateCache:
     """What gates on ``part`` with tolerances ``tol`` share (module doc)."""
@@ -59,7 +56,7 @@ class GateCache:
 def cache_for(part, tol: Tolerances) -> GateCache:
     """The :class:`GateCache` of ``part`` and ``tol`` inside :func:`shared_gates` (made
     on first use), else a new one."""
-    per_part = _CACHES.get(part)
+    per_part = part.derived.get(__name__)
     if per_part is None:
         return GateCache(part, tol)
     if tol not in per_part:
@@ -69,19 +66,19 @@ def cache_for(part, tol: Tolerances) -> GateCache:
 
 def open_shared(part) -> None:
     """Keep the gates' work on ``part`` from now on (a worker's part: its pool's life)."""
-    _CACHES.setdefault(part, {})
+    part.derived.setdefault(__name__, {})
 
 
 @contextmanager
 def shared_gates(part):
     """Gates on ``part`` inside the block share their work (module doc)."""
-    fresh = part not in _CACHES
+    fresh = __name__ not in part.derived
     open_shared(part)
     try:
         yield
     finally:
         if fresh:
-            _CACHES.pop(part, None)
+            part.derived.pop(__name__, None)
 
 
 def toolpath_key(toolpath) -> str:

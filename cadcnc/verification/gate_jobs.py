@@ -1,4 +1,4 @@
-"""Gates of many cuts at once: one task per cut, on every core (:mod:`cadcnc.workers`).
+"""Gates of many cuts at once: one task per cut, on every core (:mod:`cadcnc.parallel`).
 
 :func:`gate_cuts` gates each ``(toolpath, moves, blend)`` on the part and returns the
 :class:`~cadcnc.verification.gate.GateResult` of each, in order, whatever the number of
@@ -11,9 +11,8 @@ it in whichever processes they run.
 
 from __future__ import annotations
 
-from ..geometry.part_bytes import part_blob, part_from_blob
 from ..core.tolerances import Tolerances
-from ..ops.parallel import on_workers
+from ..parallel.tasks import on_workers
 from .gate import GateResult, gouge_gate
 from .gate_cache import cache_for, open_shared, toolpath_key
 from .surface_checks import resolve_part

@@ -77,7 +77,8 @@ class PartFaces:
 
     def probe(self, n: int) -> FaceProbe:
         if n not in self.probes:
-            self.probes[n] = FaceProbe(self.part.face(n).topods, self.tol)
+            face = self.part.face(n)
+            self.probes[n] = FaceProbe(face.topods, self.tol, face.box)
         return self.probes[n]
 
     def distance(self, n: int, point) -> tuple[float, float]:

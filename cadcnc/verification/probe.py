@@ -65,8 +65,9 @@ class FaceProbe:
     ``state(..., loose=True)``, ``noise`` the distance below which a point is on the face.
     """
 
-    def __init__(self, topods_face, tol: Tolerances = DEFAULT):
+    def __init__(self, topods_face, tol: Tolerances = DEFAULT, box=None):
         self.face = topods_face
+        self._box_of = box   # () -> (lo, hi): where the face keeps its box (else computed)
         self.sign = -1.0 if topods_face.Orientation() == TopAbs_REVERSED else 1.0
         self.surface = BRep_Tool.Surface_s(topods_face)
         self.adaptor = GeomAdaptor_Surface(self.surface)
@@ -307,7 +308,8 @@ class FaceProbe:
     def bbox(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) corners of the face's optimal bounding box, mm (computed once)."""
         if self._bbox is None:
-            self._bbox = optimal_box(self.face, use_triangulation=False)
+            self._bbox = self._box_of() if self._box_of is not None else \
+                optimal_box(self.face, use_triangulation=False)
         return self._bbox
 
 

@@ -47,7 +47,7 @@ def prepare(toolpath, part, tol: Tolerances, probe_of=None):
     if None in named or not named:
         raise InputError("verify: the toolpath does not name its two faces")
     if probe_of is None:
-        return part, {n: FaceProbe(part.face(n).topods, tol) for n in named}
+        return part, {n: FaceProbe(part.face(n).topods, tol, part.face(n).box) for n in named}
     return part, {n: probe_of(n) for n in named}
 
 

@@ -36,8 +36,8 @@ from .plan import MAX_SAMPLES, centre_chord, plan_planes, sample_faces
 from .uncut import uncut_report
 from ..common import safe_height
 from ..entries import entered_program_segments
-from ..parallel import on_workers
-from ...workers import check_jobs
+from ...parallel.pool import check_jobs
+from ...parallel.tasks import on_workers
 from .setup import pass_setup
 from ...core.job import DEFAULT_FEED, DEFAULT_PERIOD
 
@@ -129,7 +129,7 @@ def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX
 
 
 def _plane(part: Part, task, beat=None) -> PassResult:
-    """One plane's pass (:func:`~cadcnc.ops.parallel.on_workers`' task)."""
+    """One plane's pass (:func:`~cadcnc.parallel.tasks.on_workers`' task)."""
     job, k, offset, reverse = task
     tell = None if beat is None else (lambda text: beat.beat(
         lambda: f"plane {k + 1}: " + (text() if callable(text) else text)))

@@ -10,7 +10,6 @@ surface. Lengths mm.
 from __future__ import annotations
 
 from typing import Sequence
-from weakref import WeakKeyDictionary
 
 import numpy as np
 
@@ -48,13 +47,10 @@ class PassSetup:
         return self._guards.get(face)
 
 
-_SETUPS: WeakKeyDictionary = WeakKeyDictionary()
-
-
 def pass_setup(part: Part, faces: Sequence[int], job: Job) -> PassSetup:
     """The :class:`PassSetup` of ``part``, ``faces`` and the job's tool, built once."""
     key = (tuple(dict.fromkeys(int(f) for f in faces)), job.tool, job.tolerances)
-    per_part = _SETUPS.setdefault(part, {})
+    per_part = part.derived.setdefault(__name__, {})   # kept with the part
     if key not in per_part:
         per_part[key] = PassSetup(part, faces, job)
     return per_part[key]

@@ -37,7 +37,7 @@ from .corners import BLEND, EDGE, Corner, find_corners
 from ...guard import guard_for
 from ..common import refuse_cycles, require_ball, run_stretch, safe_height
 from ..entries import UNREACHABLE, entered_program_segments
-from ..parallel import on_workers
+from ...parallel.tasks import on_workers
 from ..path.pair_program import CLIMB, stretch_cuts
 from ..path.pair_path import plan_path
 from ..path.stretches import (LIMIT_TOL, MIN_SAMPLES, SPACING, Feasibility,
@@ -154,7 +154,7 @@ def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = 
 def _pair_corners(part: Part, task, beat=None) -> tuple[list, dict, dict]:
     """The cuts and skips of the corners of one pair (they share its guard and stretch
     search): ``([(corner index, (cuts, skipped))], seconds per stage, work counts)``;
-    :func:`~cadcnc.ops.parallel.on_workers`' task."""
+    :func:`~cadcnc.parallel.tasks.on_workers`' task."""
     job, corners, max_cycles = task
     times: dict = {}
     stage = _Clock(times)

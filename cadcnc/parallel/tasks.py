@@ -2,7 +2,7 @@
 
 :func:`on_workers` runs ``fn(part, task, beat)`` for every task: here, in order, with the
 operation's heartbeat when ``jobs`` is 1; else in worker processes
-(:func:`cadcnc.workers.map_ordered`) that rebuild the part from BRep bytes once each
+(:func:`.pool.map_ordered`) that rebuild the part from BRep bytes once each
 (:mod:`cadcnc.geometry.part_bytes`) and run without the heartbeat (it cannot cross
 processes: ``on_result`` reports each piece as it ends). Results come back in task
 order, so the program does not depend on ``jobs``; given the tasks' ``sizes`` the
@@ -15,7 +15,8 @@ from functools import partial
 from typing import Callable, Sequence
 
 from ..geometry.part_bytes import part_blob, part_from_blob
-from ..workers import check_jobs, map_ordered
+from .pool import map_ordered
+
 
 def on_workers(fn: Callable, tasks: Sequence, part, jobs: int | None,
                on_result: Callable[[int, object], None] | None = None, what: str = "task",

@@ -16,9 +16,11 @@ tasks run here, in order, on the caller's part; else in a
   reads the part and plans;
 - *spawn* where there is no fork.
 
-The pool is kept for the part and reused by the next call with the same part (the gate
-after the computation) until :func:`close` or exit; a pool for another part shuts the
-kept ones down first.
+Pools are owned by a :class:`Pools` block: ``with kept_pools():`` (a command's run of
+one part) keeps each part's pool for the block, reused by the next call with the same
+part (the gate after the computation), and shuts every one down at its end; a pool for
+another part shuts the idle kept ones down first. Outside such a block, each
+:func:`map_ordered` call owns its pool for the call.
 
 Results come back in task order whatever the number of workers, so outputs do not
 depend on it. ``on_result(k, result)`` is called in the caller's process as each
@@ -29,7 +31,6 @@ naming the task, never a hang. No OCCT here: the part is opaque.
 
 from __future__ import annotations
 
-import atexit
 import multiprocessing
 import multiprocessing.forkserver
 import os
@@ -37,15 +38,16 @@ import signal
 import threading
 import time
 from contextlib import contextmanager
+from contextvars import ContextVar
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Sequence
 
-from .core.errors import CadcncError, InputError
+from ..core.errors import CadcncError, InputError
 
-PRELOAD = ["cadcnc.ops.run", "cadcnc.verification.gate_jobs", "cadcnc.ops.warm_up"]
-"""Modules the workers' server imports once (every worker starts with them loaded; the
-last runs a small job, so the compiled kernels are loaded too: :mod:`cadcnc.ops.warm`)."""
+PRELOAD = ["cadcnc.ops.run", "cadcnc.verification.gate_jobs", "cadcnc.parallel.server"]
+"""Modules the workers' server imports once, by name (every worker starts with them
+loaded; the last loads the compiled kernels of the others: :mod:`.server`)."""
 ENV = "CADCNC_JOBS"
 """The default number of processes when none is given (unset: every core)."""
 START_ENV = "CADCNC_START_METHOD"
@@ -54,9 +56,9 @@ WATCH_S = 0.5
 """How often (s) a worker checks that its parent process is still there."""
 KILL_AFTER_S = 2.0
 """How long (s) a terminated worker has to end before it is killed outright."""
-_STATE: dict[str, Any] = {}   # in a worker: the part it rebuilt
-_POOLS: dict[int, tuple[Any, int, ProcessPoolExecutor]] = {}  # id(part) -> (part, jobs, pool)
-_BUSY: set[int] = set()   # the keys of pools running a map_ordered now (another thread's)
+_IN_WORKER: dict[str, Any] = {}
+"""Owned by a worker process: the part its initializer rebuilt (or inherited), for its
+life. Empty in the caller's process."""
 
 
 class WorkerError(CadcncError):
@@ -119,7 +121,7 @@ def _init(build: Callable, args: tuple, parent: int) -> None:
     is gone (killed, or ended by ``os._exit``) ends too."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     threading.Thread(target=_watch, args=(parent,), daemon=True).start()
-    _STATE["part"] = build(*args)
+    _IN_WORKER["part"] = build(*args)
 
 
 def _watch(parent: int) -> None:
@@ -146,23 +148,7 @@ def process_alive(pid: int) -> bool:
 
 
 def _call(fn: Callable, task) -> Any:
-    return fn(_STATE["part"], task)
-
-
-def _pool(part, jobs: int, build: Callable, args: Callable[[], tuple]) -> ProcessPoolExecutor:
-    held = _POOLS.get(id(part))
-    if held is not None and held[0] is part and held[1] == jobs:
-        return held[2]
-    for key in [k for k in _POOLS if k not in _BUSY]:
-        _shutdown(key)   # idle pools: their threads gone, this one's workers can be forks
-    ctx = _context()
-    if ctx.get_start_method() == "fork":   # the part is not pickled: the fork copies it
-        initargs = (_inherited, (part,), os.getpid())
-    else:
-        initargs = (build, args(), os.getpid())
-    pool = ProcessPoolExecutor(jobs, mp_context=ctx, initializer=_init, initargs=initargs)
-    _POOLS[id(part)] = (part, jobs, pool)
-    return pool
+    return fn(_IN_WORKER["part"], task)
 
 
 def _inherited(part):
@@ -179,8 +165,8 @@ def _context():
     return ctx
 
 
-def _shutdown(key: int, kill: bool = False) -> None:
-    _, _, pool = _POOLS.pop(key)
+def _shutdown(pool: ProcessPoolExecutor, kill: bool = False) -> None:
+    """End a pool: after its running tasks, or (``kill``) now."""
     if not kill:
         pool.shutdown(wait=True, cancel_futures=True)
         return
@@ -224,13 +210,92 @@ def _ctrl_c_deferred() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
-def close() -> None:
-    """Shut every kept pool down (its workers exit)."""
-    for key in list(_POOLS):
-        _shutdown(key)
+class Pools:
+    """The worker pools of a block (module doc): one per part and worker count, kept until
+    :meth:`close` (the end of the ``with`` block)."""
+
+    def __init__(self) -> None:
+        self._held: dict[int, tuple[Any, int, ProcessPoolExecutor]] = {}  # id(part) -> ...
+        self._busy: set[int] = set()   # parts whose map_ordered runs now (another thread's)
+
+    def __enter__(self) -> "Pools":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def get(self, part, jobs: int, build: Callable, args: Callable[[], tuple]
+            ) -> ProcessPoolExecutor:
+        """The pool of ``part`` with ``jobs`` workers, started on first use."""
+        held = self._held.get(id(part))
+        if held is not None and held[0] is part and held[1] == jobs:
+            return held[2]
+        for key in [k for k in self._held if k not in self._busy]:
+            self.end(key)   # idle pools: their threads gone, this one's workers can be forks
+        ctx = _context()
+        if ctx.get_start_method() == "fork":   # the part is not pickled: the fork copies it
+            initargs = (_inherited, (part,), os.getpid())
+        else:
+            initargs = (build, args(), os.getpid())
+        pool = ProcessPoolExecutor(jobs, mp_context=ctx, initializer=_init, initargs=initargs)
+        self._held[id(part)] = (part, jobs, pool)
+        return pool
+
+    def held(self, part) -> bool:
+        """Whether a pool of ``part`` is kept."""
+        return id(part) in self._held
+
+    def end(self, key: int, kill: bool = False) -> None:
+        """Shut the pool of ``id(part)`` down (``kill``: now), if it is kept."""
+        held = self._held.pop(key, None)
+        if held is not None:
+            _shutdown(held[2], kill)
+
+    @contextmanager
+    def busy(self, part) -> Iterator[None]:
+        """Mark ``part``'s pool as running tasks: another part's call leaves it alone."""
+        self._busy.add(id(part))
+        try:
+            yield
+        finally:
+            self._busy.discard(id(part))
+
+    def close(self) -> None:
+        """Shut every kept pool down (its workers exit)."""
+        for key in list(self._held):
+            self.end(key)
 
 
-atexit.register(close)
+_KEPT: ContextVar[Pools | None] = ContextVar("cadcnc_kept_pools", default=None)
+"""The :class:`Pools` of the innermost :func:`kept_pools` block (None outside any)."""
+
+
+@contextmanager
+def kept_pools() -> Iterator[Pools]:
+    """Keep each part's worker pool for the block and shut them all down at its end
+    (module doc); blocks nest (the outer one keeps the pools)."""
+    outer = _KEPT.get()
+    if outer is not None:
+        yield outer
+        return
+    pools = Pools()
+    token = _KEPT.set(pools)
+    try:
+        with pools:
+            yield pools
+    finally:
+        _KEPT.reset(token)
+
+
+@contextmanager
+def _pools() -> Iterator[Pools]:
+    """The kept pools of the current block, else pools for this call only."""
+    kept = _KEPT.get()
+    if kept is not None:
+        yield kept
+        return
+    with Pools() as pools:
+        yield pools
 
 
 def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: int | None,
@@ -254,9 +319,16 @@ def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: i
             if on_result is not None:
                 on_result(k, out[-1])
         return out
-    pool = _pool(part, jobs, build, build_args)
+    with _pools() as pools, pools.busy(part):
+        return _run(pools, fn, tasks, part, jobs, build, build_args, on_result, what, numbers)
+
+
+def _run(pools: Pools, fn: Callable, tasks: list, part, jobs: int, build: Callable,
+         build_args: Callable[[], tuple], on_result, what: str,
+         numbers: Sequence[int] | None) -> list:
+    """:func:`map_ordered` on the pool of ``part`` in ``pools``."""
+    pool = pools.get(part, jobs, build, build_args)
     futures = {}
-    _BUSY.add(id(part))
     try:
         with _ctrl_c_deferred():  # the pool starts its workers here: all or none registered
             futures = {pool.submit(_call, fn, t): k for k, t in enumerate(tasks)}
@@ -271,13 +343,10 @@ def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: i
         return out
     except BrokenProcessPool as e:
         bad = sorted(k for f, k in futures.items() if not f.done() or f.exception())
-        _shutdown(id(part), kill=True)
+        pools.end(id(part), kill=True)
         raise WorkerError(f"a worker process died during {what} {_number(bad, numbers)} "
                           f"of {len(tasks)} (killed, out of memory, or a crash in native "
                           "code); nothing written. --jobs 1 runs in one process") from e
     except BaseException:  # Ctrl-C, or an error in a task: stop every worker
-        if id(part) in _POOLS:
-            _shutdown(id(part), kill=True)
+        pools.end(id(part), kill=True)
         raise
-    finally:
-        _BUSY.discard(id(part))

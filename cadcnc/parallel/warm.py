@@ -3,8 +3,8 @@
 numba loads each compiled function from its on-disk cache (``cache=True``) at its first
 call: about 1.5 s for a process's first finishing plane or pencil corner, which every
 worker would pay again at its first task. The workers' server imports
-:mod:`cadcnc.ops.warm_up` (:data:`cadcnc.workers.PRELOAD`), which runs :func:`warm` once,
-so every worker forked from the server starts with them loaded.
+:mod:`.server` (:data:`.pool.PRELOAD`), which runs :func:`warm` once, so every worker
+forked from the server starts with them loaded.
 
 numba keeps no public list of a function's cached signatures: its index file is read
 through the dispatcher's cache object (numba 0.60 to 0.68), and only entries compiled
