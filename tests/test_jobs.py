@@ -23,7 +23,7 @@ import cadcnc
 from cadcnc.core.errors import EXIT_INTERNAL, EXIT_INTERRUPTED
 from cadcnc.geometry.part_bytes import part_blob, part_from_blob
 from cadcnc.core.errors import InputError
-from cadcnc.parallel.pool import START_ENV, WorkerError, kept_pools, map_ordered, start_method
+from cadcnc.parallel.pool import START_ENV, WorkerError, map_ordered, start_method
 from conftest import FIXTURES, cadcnc_cli
 
 BOSS = str(FIXTURES / "finish_boss.step")
@@ -114,29 +114,6 @@ def test_tasks_come_back_in_order_from_the_part_in_each_worker(method, monkeypat
 
 def _kind(part, n):
     return part.face(n).kind
-
-
-def _pid(part, task):
-    return os.getpid()
-
-
-def test_a_pool_lives_for_its_block_or_its_call(monkeypatch):
-    """Inside ``kept_pools()`` a part's pool serves every call and ends with the block;
-    outside, each call's pool ends with the call."""
-    monkeypatch.setenv(START_ENV, "fork")
-    part = cadcnc.load_step(FIXTURES / "step_block.step")
-    run = lambda: set(map_ordered(_pid, range(4), part=part, jobs=2, build=part_from_blob,  # noqa: E731
-                                  build_args=lambda: part_blob(part)))
-    with kept_pools() as pools:
-        first, second = run(), run()
-        assert len(first | second) <= 2 and pools.held(part)
-    assert not pools.held(part)
-    assert not {p for p in first | second if Path(f"/proc/{p}").exists()
-                and _parent_of(str(p)) == os.getpid()}
-    alone = run()
-    assert not alone & (first | second)
-    assert not {p for p in alone if Path(f"/proc/{p}").exists()
-                and _parent_of(str(p)) == os.getpid()}
 
 
 THREADED = ("import threading, time; from cadcnc.parallel.pool import start_method; "

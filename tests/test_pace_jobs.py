@@ -13,7 +13,7 @@ import signal
 import pytest
 
 import cadcnc
-from cadcnc.parallel.pool import WorkerError, kept_pools
+from cadcnc.parallel.pool import START_ENV, WorkerError, kept_pools
 from cadcnc.parallel.tasks import on_workers
 from conftest import FIXTURES
 
@@ -63,3 +63,33 @@ def test_a_dead_worker_is_named_by_the_callers_task_number(part):
     sizes = [0, 0, 0, 0, 0, 0, 0, 9]          # task 8 (index 7) goes first
     with pytest.raises(WorkerError, match=r"died during corner 8 of 8"):
         on_workers(_die_on_7, list(range(8)), part, 2, what="corner", sizes=sizes)
+
+
+def _children() -> set[int]:
+    """This process's live child processes."""
+    out = set()
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            stat = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):   # gone meanwhile
+            continue
+        if int(stat[1]) == os.getpid() and stat[0] != "Z":
+            out.add(int(pid))
+    return out
+
+
+def test_a_pool_lives_for_its_block_or_its_call(part, monkeypatch):
+    """Inside ``kept_pools()`` a part's pool serves every call and ends with the block;
+    outside, each call's pool ends with the call."""
+    monkeypatch.setenv(START_ENV, "fork")
+    before = _children()
+
+    def pids() -> set[int]:
+        return {r[2] for r in on_workers(_where, list(range(4)), part, 2)}
+
+    with kept_pools() as pools:
+        first, second = pids(), pids()
+        assert len(first | second) <= 2 and pools.held(part)
+        assert first | second <= _children()
+    assert not pools.held(part) and _children() <= before
+    assert pids() and _children() <= before

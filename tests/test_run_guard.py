@@ -36,10 +36,12 @@ def _faces(role: str) -> int:
 
 @pytest.mark.parametrize("compiled", [True, False])
 def test_a_cut_stops_where_its_guard_says(compiled, monkeypatch):
-    from cadcnc.interp.stepper import Stepper
+    from functools import partial
 
-    if not compiled:
-        monkeypatch.setattr(Stepper, "compiled_class", None)
+    from cadcnc.interp.compiled import new_stepper
+    from cadcnc.ops.path import pair_path
+
+    monkeypatch.setattr(pair_path, "new_stepper", partial(new_stepper, compiled=compiled))
     part = load_fixture("pocket")
     s1, s2, job = pair_job(part.face(_faces("pocket planar wall x=-30")),
                            part.face(_faces("pocket floor z=15")), radius=3.0, feed=1500.0,
