@@ -2,11 +2,11 @@
 
 :func:`new_stepper` builds a :class:`CompiledStepper` when both surfaces offer compiled
 data (``surface.kernel`` = (surface data, trim grid), see cadcnc.geometry.face_surface)
-and ``compiled`` is True, else the reference :class:`Stepper`. Each period is one call of ``kernel.step.step`` (track,
-accurate step, end landing, trial cycle on the compiled evaluators, O(1) trim check,
-commit, record row); Python is entered only for what the kernel leaves to it: an exact
-trim classification where a contact's grid cell is MIXED, the guard, a landing (the same
-``landing.land`` as the reference) and the messages. ``run`` loops in the kernel
+and ``compiled`` is True, else the reference :class:`Stepper`. Each period is one call
+of ``kernel.step.step`` (track, accurate step, end landing, trial cycle on the compiled
+evaluators, O(1) trim check, commit, record row); Python is entered only for what the
+kernel leaves to it: an exact trim classification where a contact's grid cell is MIXED,
+the guard, a landing (the same ``landing.land`` as the reference) and the messages. ``run`` loops in the kernel
 (``kernel.entry.run``) between such events, ``follow`` likewise with a per-period step
 plan (``kernel.follow``). The plain-Python Stepper stays the reference:
 tests compare the two paths point for point. No OCCT here.

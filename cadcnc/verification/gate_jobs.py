@@ -3,8 +3,8 @@
 :func:`gate_cuts` gates each ``(toolpath, moves, blend)`` on the part and returns the
 :class:`~cadcnc.verification.gate.GateResult` of each, in order, whatever the number of
 processes; the workers take the longest cuts first. In a worker the part is rebuilt
-from BRep bytes once (:mod:`cadcnc.geometry.part_bytes`). What a gate found that the next gate of the same
-cut can reuse (the pair's checks, exact distances: :mod:`.gate_cache`) comes back with
+from BRep bytes once (:mod:`cadcnc.geometry.part_bytes`). What a gate found that the
+next gate of the same cut can reuse (the pair's checks, exact distances: :mod:`.gate_cache`) comes back with
 its result and is handed to the next one: the cut-back step and the program gate share
 it in whichever processes they run.
 """
