@@ -26,7 +26,7 @@ from cadcnc.interp.tangency import _solve4
 from cadcnc.core.trim_labels import CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, SEGMENTS
 from cadcnc.interp.kernel.trim_lookup import lookup
 
-FIXTURES = Path(__file__).resolve().parents[1] / "fixtures"
+FIXTURES = Path(__file__).resolve().parents[2] / "fixtures"
 NAMES = ["bspline_boss", "crossing_cylinders", "sphere_cylinder", "torus_cone"]
 
 

@@ -58,7 +58,7 @@ from cadcnc.geometry.face_surface import FaceSurface
 from cadcnc.geometry.surface_data import surface_data
 from cadcnc.interp.kernel import evaluators as ev
 
-FIXTURES = sorted((Path(__file__).resolve().parents[1] / "fixtures").glob("*.step"))
+FIXTURES = sorted((Path(__file__).resolve().parents[2] / "fixtures").glob("*.step"))
 SAMPLES = 50
 TOL = 1e-12
 

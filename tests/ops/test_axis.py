@@ -24,7 +24,7 @@ from OCP.gp import gp_Pnt
 
 from conftest import cadcnc_cli
 
-FIXTURES = Path(__file__).resolve().parents[1] / "fixtures"
+FIXTURES = Path(__file__).resolve().parents[2] / "fixtures"
 STEP = FIXTURES / "six_pockets.step"
 FACTS = json.loads((FIXTURES / "setup_fixtures.json").read_text())
 R = FACTS["radius"]

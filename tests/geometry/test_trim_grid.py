@@ -23,7 +23,7 @@ from cadcnc.geometry.trim_grid import CELL_MIXED, TrimGrid, classifier_tolerance
 from cadcnc.interp.kernel import trim_lookup
 from cadcnc.interp.kernel.trim_lookup import lookup, wrap
 
-FIXTURES = Path(__file__).resolve().parents[1] / "fixtures"
+FIXTURES = Path(__file__).resolve().parents[2] / "fixtures"
 STEPS = sorted(FIXTURES.glob("*.step"))
 N_RANDOM = 10_000
 N_SHARE = 3_000  # of the random points, for the O(1) share

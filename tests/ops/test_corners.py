@@ -14,7 +14,7 @@ import cadcnc
 from cadcnc.core.errors import FaceNumberError
 from cadcnc.ops.pencil.corners import BLEND, EDGE, NOT_SELECTED, TANGENT_FACES, find_corners
 
-FIX = Path(__file__).resolve().parent.parent / "fixtures"
+FIX = Path(__file__).resolve().parents[2] / "fixtures"
 SIDECAR = json.loads((FIX / "pencil_fixtures.json").read_text())
 CASES = [(name, rp) for name, d in SIDECAR.items() for rp in d["corners_by_offset"]]
 _parts: dict = {}

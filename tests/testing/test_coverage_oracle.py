@@ -15,7 +15,7 @@ import pytest
 
 from benchmarks.coverage import coverage_oracle as _oracle, coverage_paths as _paths
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 Oracle, read_shape = _oracle.Oracle, _oracle.read_shape

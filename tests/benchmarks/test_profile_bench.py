@@ -12,7 +12,7 @@ from pathlib import Path
 
 from conftest import FIXTURES
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_child_reports_stages_and_occt_calls(tmp_path):
