@@ -10,7 +10,7 @@ from cadcnc.core.errors import FacePairError, InputError, ProgramSyntaxError, St
 from cadcnc.core.job import Job
 from cadcnc.core.tolerances import DEFAULT, Tolerances
 
-from conftest import FIXTURES, fixture_path, load_fixture
+from helpers.fixtures import FIXTURES, fixture_path, load_fixture
 
 GOOD = f"""$$ both saddle edges, then part of one at a higher feed
 PARTNO/'saddle'

@@ -25,7 +25,11 @@ from pathlib import Path
 
 import pytest
 
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+
+from helpers.fixtures import FIXTURES
+
+pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
 
 GOOD = ("step_block", "fillet_block")
 JOB = """# two good parts and a broken one

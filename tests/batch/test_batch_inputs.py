@@ -7,7 +7,9 @@ from __future__ import annotations
 import json
 import shutil
 
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+
+from helpers.fixtures import FIXTURES
 
 STEP = FIXTURES / "step_block.step"
 

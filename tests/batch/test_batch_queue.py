@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 
 import cadcnc
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 # cadcnc.batch's engine and task import dask.distributed (about 1 s of CPU): imported in
 # the tests, so that the xdist workers that do not run them do not pay for it at collection

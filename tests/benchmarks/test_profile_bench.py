@@ -10,7 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -18,7 +18,9 @@ import cadcnc
 from cadcnc.cli.app import main
 from cadcnc.io import read_csv, read_json
 
-from conftest import FIXTURES, _cwd, cadcnc_cli, fixture_path, load_fixture
+from helpers.cli import cadcnc_cli, in_folder
+
+from helpers.fixtures import FIXTURES, fixture_path, load_fixture
 
 BOSS = str(FIXTURES / "bspline_boss.step")
 SADDLE = str(FIXTURES / "crossing_cylinders.step")
@@ -97,11 +99,11 @@ def test_path_csv_agrees_with_the_api(boss_outputs, boss_api):
 
 @pytest.mark.skipif(shutil.which("rs274") is None, reason="LinuxCNC rs274 not installed")
 def test_path_ngc_through_rs274(boss_outputs, boss_api, tmp_path):
-    from test_gcode import rs274
+    from cadcnc.testing.rs274 import feed_points
 
     d, _ = boss_outputs
     text = (d / "p.ngc").read_text()
-    feeds = rs274(tmp_path, text)
+    feeds = feed_points(tmp_path, text)
     np.testing.assert_allclose(feeds, boss_api.points, rtol=0, atol=0.5e-4 + 1e-9)
     # rapids at the part's top (z 45) plus 10 mm
     assert "G0 Z55\n" in text
@@ -134,7 +136,7 @@ def test_errors_are_one_line_with_exit_codes(tmp_path, args, code, message):
 
 
 def test_debug_raises_instead_of_one_line(tmp_path):
-    with _cwd(tmp_path), pytest.raises(cadcnc.StepFileError, match="nope.step"):
+    with in_folder(tmp_path), pytest.raises(cadcnc.StepFileError, match="nope.step"):
         main(["faces", "nope.step", "--debug"])
 
 
@@ -174,10 +176,10 @@ def test_run_writes_every_path(program_run, boss_api):
 
 @pytest.mark.skipif(shutil.which("rs274") is None, reason="LinuxCNC rs274 not installed")
 def test_run_ngc_through_rs274(program_run, tmp_path):
-    from test_gcode import rs274
+    from cadcnc.testing.rs274 import feed_points
 
     d, _ = program_run
-    feeds = rs274(tmp_path, (d / "job.ngc").read_text())
+    feeds = feed_points(tmp_path, (d / "job.ngc").read_text())
     expected = np.vstack([read_json(d / f"job-{n}.json").points for n in ("BOSS", "SADDLE")])
     np.testing.assert_allclose(feeds, expected, rtol=0, atol=0.5e-4 + 1e-9)
 
@@ -294,9 +296,9 @@ def test_docs_examples_run(example, tmp_path):
     out = tmp_path / "prog.ngc"
     cadcnc_cli("run", program, "-o", out, "--tool-tip", "--quiet", check=0)
     if shutil.which("rs274") is not None:
-        from test_gcode import rs274
+        from cadcnc.testing.rs274 import feed_points
 
-        assert len(rs274(tmp_path, out.read_text())) > 400
+        assert len(feed_points(tmp_path, out.read_text())) > 400
 
 
 def test_path_refuses_a_pair_with_no_feasible_position(tmp_path):

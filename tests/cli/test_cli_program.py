@@ -23,7 +23,8 @@ from cadcnc.io.outputs import PROGRAM_CSV_COLUMNS
 from cadcnc.core.job import Job, PairPath, Tool
 from cadcnc.ops import common
 from cadcnc.ops.path import pair_program
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
 SHELF = FIXTURES / FACTS["shelf"]["file"]
@@ -94,11 +95,11 @@ def test_gcode_segments_are_the_program_moves(shelf, shelf_api):
 def test_rs274_reads_the_program(shelf, shelf_api, tmp_path):
     """rs274's feed moves are the cuts' points and the links' plunges, its traverses the
     links' rapids, in order, with the plunge feed then the cutting feed."""
-    from test_gcode import rs274
+    from cadcnc.testing.rs274 import feed_points
 
     d, _, _ = shelf
     text = (d / "s.ngc").read_text()
-    feeds = rs274(tmp_path, text)
+    feeds = feed_points(tmp_path, text)
     canon = (tmp_path / "canon.txt").read_text()
     traverses = np.array([[float(v) for v in m.group(1).split(",")[:3]]
                           for m in re.finditer(r"STRAIGHT_TRAVERSE\(([^)]*)\)", canon)])

@@ -8,7 +8,9 @@ import shutil
 import numpy as np
 import pytest
 
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+
+from helpers.fixtures import FIXTURES
 
 BLOCK = FIXTURES / "step_block.step"
 # 4 mm of the block's straight corner (faces 3 and 8): a short program, fast to gate
@@ -89,7 +91,7 @@ def test_hal_executes_the_planned_stream_unclipped(program, tmp_path):
 def test_a_constant_feed_stream_over_the_limits_is_refused_before_hal(program, monkeypatch):
     """At constant 10 000 mm/min the stream asks 167 mm/s of axes limited to 57 mm/s: the
     stream check refuses it before HAL starts (exit 5, nothing executed; limit3's clipping
-    of such a stream: tests/test_hal_loop.py)."""
+    of such a stream: tests/controller/test_hal_loop.py)."""
     import cadcnc.controller.hal as hal
 
     def never(*args, **kwargs):

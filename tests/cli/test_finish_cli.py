@@ -10,9 +10,11 @@ import numpy as np
 import pytest
 
 from cadcnc.io.program_json import read_program
-from conftest import FIXTURES
-from test_cli import cadcnc_cli
-from test_pencil_cli import commanded, rs274_moves
+from cadcnc.testing.rs274 import move_points
+from helpers.cli import cadcnc_cli
+from helpers.fixtures import FIXTURES
+from helpers.marks import needs_rs274
+from helpers.programs import commanded
 
 SLAB = str(FIXTURES / "finish_slab.step")
 
@@ -48,9 +50,10 @@ def test_outputs_agree(slab_run):
     assert png.read_bytes()[:4] == b"\x89PNG"
 
 
+@needs_rs274
 def test_rs274_reads_the_finish_program(slab_run, tmp_path):
     _, (js, ngc, _, _) = slab_run
-    got = rs274_moves(ngc, tmp_path)
+    got = move_points(ngc, tmp_path)
     np.testing.assert_allclose(got[1:], commanded(read_program(js)), atol=1e-3)
 
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import json
 
-from conftest import FIXTURES
-from test_cli import cadcnc_cli
+from helpers.cli import cadcnc_cli
+from helpers.fixtures import FIXTURES
 
 
 def test_path_defaults_to_1500_mm_min_and_4_ms(tmp_path):

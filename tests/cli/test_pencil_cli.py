@@ -16,8 +16,11 @@ from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_json import read_program
 from cadcnc.core import job as job_module
 from cadcnc.core.units import parse_duration, parse_feed
-from conftest import FIXTURES
-from test_cli import cadcnc_cli
+from cadcnc.testing.rs274 import move_points
+from helpers.cli import cadcnc_cli
+from helpers.fixtures import FIXTURES
+from helpers.marks import needs_rs274
+from helpers.programs import commanded
 
 BLOCK = str(FIXTURES / "step_block.step")
 
@@ -29,12 +32,6 @@ def block_run(tmp_path_factory):
     run = cadcnc_cli("pencil", BLOCK, "--radius", "3", "--plunge-feed", "300",
                      *[a for o in outs for a in ("-o", o)], check=0)
     return run, outs
-
-
-def commanded(prog) -> np.ndarray:
-    """(M, 3) the program's positions in order, each joint once (a segment starts where the
-    last ended)."""
-    return np.vstack([prog.segments[0].points[:1]] + [s.points[1:] for s in prog.segments])
 
 
 def test_defaults_are_the_operations():
@@ -58,24 +55,10 @@ def test_outputs_agree(block_run):
     assert png.read_bytes()[:4] == b"\x89PNG"
 
 
-def rs274_moves(ngc, tmp_path) -> np.ndarray:
-    """(M, 3) the STRAIGHT_FEED and STRAIGHT_TRAVERSE end points rs274 reads in ``ngc``
-    (the first is the machine's home); skips the test without rs274."""
-    from test_gcode import RS274
-
-    if RS274 is None:
-        pytest.skip("LinuxCNC rs274 not installed")
-    canon = tmp_path / "canon.txt"
-    run = subprocess.run([RS274, "-g", str(ngc), str(canon)], capture_output=True,
-                         text=True, timeout=60)
-    assert run.returncode == 0, run.stderr
-    return np.array([[float(v) for v in m.group(1).split(",")[:3]] for m in re.finditer(
-        r"STRAIGHT_(?:FEED|TRAVERSE)\(([^)]*)\)", canon.read_text())])
-
-
+@needs_rs274
 def test_rs274_reads_the_pencil_program(block_run, tmp_path):
     _, (js, ngc, _, _) = block_run
-    got = rs274_moves(ngc, tmp_path)
+    got = move_points(ngc, tmp_path)
     want = commanded(read_program(js))
     np.testing.assert_allclose(got[1:], want, atol=1e-3)  # got[0]: the machine's home
 

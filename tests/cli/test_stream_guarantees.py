@@ -16,7 +16,9 @@ from cadcnc.controller.hal.session import remove_stale
 from cadcnc.verification.stream_check import check_stream
 from cadcnc.core.work_limits import Ticker
 
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+
+from helpers.fixtures import FIXTURES
 
 BLOCK = FIXTURES / "step_block.step"
 SHORT = ["--faces", "3", "8", "--radius", "3", "--start", "19.0919,-23.3345,11",

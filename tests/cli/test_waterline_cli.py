@@ -13,9 +13,13 @@ import pytest
 import cadcnc
 from cadcnc.io.program_json import read_program
 from cadcnc.ops.finish import steep_shallow
-from conftest import FIXTURES
-from test_cli import cadcnc_cli
-from test_pencil_cli import commanded, rs274_moves
+from cadcnc.testing.rs274 import move_points
+from helpers.cli import cadcnc_cli
+from helpers.fixtures import FIXTURES
+from helpers.marks import needs_rs274
+from helpers.programs import commanded
+
+pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
 
 BOSS = str(FIXTURES / "wl_boss.step")
 FACTS = json.loads((FIXTURES / "waterline_fixtures.json").read_text())
@@ -50,9 +54,10 @@ def test_the_program_is_gated_complete_and_top_to_bottom(boss_run):
     assert downs, "no stay-down link between levels"
 
 
+@needs_rs274
 def test_rs274_reads_the_waterline_program(boss_run, tmp_path):
     _, (js, ngc) = boss_run
-    got = rs274_moves(ngc, tmp_path)
+    got = move_points(ngc, tmp_path)
     np.testing.assert_allclose(got[1:], commanded(read_program(js)), atol=1e-3)
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.controller.contour import Arc, Line, Offsets, PathReference, fit_arc, fit_line
+from cadcnc.testing.contour_reference import Arc, Line, Offsets, PathReference, fit_arc, fit_line
 
 UM = 1e-3   # mm
 

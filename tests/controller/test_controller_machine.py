@@ -9,7 +9,7 @@ import pytest
 from cadcnc.controller.machine import Machine, read_machine_ini
 from cadcnc.core.errors import InputError
 
-from conftest import cadcnc_cli
+from helpers.cli import cadcnc_cli
 
 SAMPLE = Path("/usr/share/doc/linuxcnc/examples/sample-configs/by_machine/tormach/pcnc-770.ini")
 

@@ -19,8 +19,8 @@ from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.ops.pencil.pencil import pencil
 from cadcnc.ops.stream_steppers import stepper_factory
 
-from benchmarks.controller.bound import va_bound
-from conftest import FIXTURES
+from cadcnc.testing.topp_bound import va_bound
+from helpers.fixtures import FIXTURES
 
 pytestmark = pytest.mark.slow
 

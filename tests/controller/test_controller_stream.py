@@ -19,7 +19,9 @@ from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.ops.pencil.pencil import pencil
 from cadcnc.ops.stream_steppers import stepper_factory
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
+
+pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
 
 SLACK = 1e-6      # relative, on every limit
 NEAR = 1e-3       # mm: every position within 1 um of the kernel's path

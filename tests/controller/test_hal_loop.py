@@ -21,8 +21,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytestmark = pytest.mark.skipif(shutil.which("halrun") is None,
-                                reason="halrun not installed (apt install linuxcnc-uspace)")
+pytestmark = [pytest.mark.slow,  # over about 5 s a test (pyproject.toml)
+              pytest.mark.skipif(shutil.which("halrun") is None,
+                                 reason="halrun not installed (apt install linuxcnc-uspace)")]
 
 from cadcnc.controller.hal import (  # noqa: E402
     HalError, HalSession, rtapi_pids, run_hal_loop, write_stream_txt,

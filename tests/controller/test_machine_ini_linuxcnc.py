@@ -16,7 +16,9 @@ from cadcnc.controller.ini_file import leading_number
 from cadcnc.controller.machine import IniWarning, read_machine_ini
 from cadcnc.core.errors import InputError
 
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+
+from helpers.fixtures import FIXTURES
 
 # 4 mm of the block's straight corner (faces 3 and 8), as in test_controller_cli.py
 SHORT = ["--faces", "3", "8", "--radius", "3", "--start", "19.0919,-23.3345,11",

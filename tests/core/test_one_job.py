@@ -14,7 +14,9 @@ from cadcnc.io.outputs import PROGRAM_CSV_COLUMNS
 from cadcnc.io.program_json import program_json, read_program
 from cadcnc.core.job import Finish, Job, PairPath, Pencil, Tool
 
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+
+from helpers.fixtures import FIXTURES
 
 _PARTS: dict = {}
 

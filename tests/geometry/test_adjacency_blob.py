@@ -26,7 +26,7 @@ from cadcnc.geometry.part_bytes import (adjacency_record, part_blob, part_from_b
                                         take_adjacency_record)
 from cadcnc.geometry.setup import setup_in, setup_of, setup_part
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 EXACT = ("faces", "edge_class", "length", "closed")
 ARRAYS = ("angles_deg", "points", "start", "end", "start_tangent", "end_tangent")

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import FIXTURES as FOLDER
-from conftest import load_fixture
+from helpers.fixtures import FIXTURES as FOLDER
+from helpers.fixtures import load_fixture
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d
 from OCP.Geom import Geom_BSplineSurface

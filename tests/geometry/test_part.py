@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import cadquery as cq
 import pytest
-from conftest import FIXTURE_NAMES, FIXTURES, SIDECAR, load_fixture
+from helpers.fixtures import FIXTURES, FIXTURE_NAMES, SIDECAR, load_fixture
 from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.STEPControl import STEPControl_Reader
 from OCP.TopAbs import TopAbs_FACE

@@ -30,7 +30,8 @@ from cadcnc.geometry.step_file import read_step
 from cadcnc.core.tolerances import DEFAULT
 from cadcnc.verification import gouge_gate
 from cadcnc.verification.material import IN, OUT, Material, PartFaces
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+from helpers.fixtures import FIXTURES
 
 SIDE = json.loads((FIXTURES / "surface_models.json").read_text())
 BOSS = ["surf_boss_solid", "surf_boss_shell", "surf_boss_faces"]

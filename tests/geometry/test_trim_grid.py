@@ -23,6 +23,8 @@ from cadcnc.geometry.trim_grid import CELL_MIXED, TrimGrid, classifier_tolerance
 from cadcnc.interp.kernel import trim_lookup
 from cadcnc.interp.kernel.trim_lookup import lookup, wrap
 
+pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
+
 FIXTURES = Path(__file__).resolve().parents[2] / "fixtures"
 STEPS = sorted(FIXTURES.glob("*.step"))
 N_RANDOM = 10_000

@@ -24,7 +24,7 @@ from cadcnc.guard.analytic import AnalyticFace
 from cadcnc.geometry.boxes import optimal_box
 from cadcnc.geometry.part import Part
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 FIXTURE_FACES = ["pocket", "torus_cone", "sphere_cylinder", "crossing_cylinders"]
 

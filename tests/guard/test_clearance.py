@@ -17,7 +17,7 @@ import pytest
 import cadcnc
 from cadcnc.guard.clearance import ClearanceGuard
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 SIDECAR = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
 TOL = 1e-6

@@ -13,7 +13,9 @@ from cadcnc.guard.box_tree import BoxTree
 from cadcnc.guard.cells import FaceBoxes, HeightCells
 from cadcnc.guard.guard import OperationGuard
 
-from conftest import FIXTURES, random_cell_boxes
+from helpers.face_cells import random_cell_boxes
+
+from helpers.fixtures import FIXTURES
 
 
 @pytest.fixture(scope="module")

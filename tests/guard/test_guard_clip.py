@@ -14,7 +14,7 @@ from OCP.gp import gp_Pnt
 import cadcnc
 from cadcnc.guard.clearance import ClearanceGuard
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 
 @pytest.mark.parametrize("face,cap", [(4, None), (4, 3.0), (2, None), (5, 6.0)])

@@ -24,7 +24,7 @@ from cadcnc.guard.face_distance import FaceDistance
 from cadcnc.io.program_json import program_json
 from cadcnc.core.job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 
 def without_new_proofs(monkeypatch) -> None:

@@ -20,7 +20,9 @@ from cadcnc.guard.clearance import ClearanceGuard
 from cadcnc.guard.face_boxes import face_cells, normal_box
 from cadcnc.guard.guard import OperationGuard
 
-from conftest import FIXTURES, random_cell_boxes
+from helpers.face_cells import random_cell_boxes
+
+from helpers.fixtures import FIXTURES
 
 
 @pytest.fixture(scope="module")

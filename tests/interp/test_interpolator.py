@@ -7,7 +7,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import CONCAVE_PAIRS, load_fixture
+from helpers.fixtures import CONCAVE_PAIRS, load_fixture
 from OCP.BRep import BRep_Tool
 from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt

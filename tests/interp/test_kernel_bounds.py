@@ -15,7 +15,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from conftest import load_fixture
+from helpers.fixtures import load_fixture
 
 from cadcnc.interp.error_bounds import pair_bounds
 from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for

@@ -9,13 +9,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import load_fixture
+from helpers.fixtures import load_fixture
 
 from cadcnc.interp.compiled import CompiledStepper
 from cadcnc.interp.stepper import Stepper
 from cadcnc.ops.path.pair_path import pair_job, plan_path
-from test_pinned_paths import CASES
-from build_pinned_paths import radius_for  # noqa: E402 (fixtures/ on sys.path)
+from helpers.pinned import CASES, radius_for
 
 
 def plan_for(name, i, j):

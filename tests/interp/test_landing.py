@@ -6,14 +6,13 @@ import math
 
 import numpy as np
 import pytest
-from conftest import load_fixture
+from helpers.fixtures import load_fixture
 
 from cadcnc.interp.cycle import BOUNDARY, COLLISION, STOP_REASONS
 from cadcnc.interp.landing import LANDING_TOL, MAX_TRIALS, land
 from cadcnc.interp.stepper import Stepper
 from cadcnc.ops.path.pair_path import pair_job, plan_path
-from test_pinned_paths import CASES
-from build_pinned_paths import radius_for  # noqa: E402 (fixtures/ on sys.path)
+from helpers.pinned import CASES, radius_for
 
 F = 0.1  # mm: feed 1500 mm/min, period 4 ms
 

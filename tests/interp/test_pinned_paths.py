@@ -9,18 +9,13 @@ regenerates the file in the same commit.
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 import pytest
 
-from conftest import FIXTURES, load_fixture
-
-sys.path.insert(0, str(FIXTURES))
-from build_pinned_paths import compute, pinned_cases  # noqa: E402
+from helpers.fixtures import FIXTURES, load_fixture
+from helpers.pinned import CASES, compute
 
 PINNED = np.load(FIXTURES / "pinned_paths.npz")
-CASES = list(pinned_cases())
 
 
 def test_every_concave_pair_is_pinned():

@@ -7,7 +7,7 @@ import math
 import cadquery as cq
 import numpy as np
 import pytest
-from conftest import SIDECAR, load_fixture
+from helpers.fixtures import SIDECAR, load_fixture
 
 import cadcnc
 from cadcnc.interp.cycle import BOUNDARY, CLOSED, CURVATURE, END, MAX_CYCLES, SINGULAR, TANGENT

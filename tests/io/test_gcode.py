@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import math
 import re
-import shutil
-import subprocess
 
 import numpy as np
 import pytest
@@ -14,13 +12,10 @@ import cadcnc
 from cadcnc.io.gcode import DEFAULT_TOLERANCE, digits_for, programmed_points, simplify
 from cadcnc.io.program_gcode import to_ngc
 
-from conftest import fixture_path, load_fixture
+from cadcnc.testing.rs274 import DECIMALS as RS274_DECIMALS, feed_points
+from helpers.fixtures import fixture_path, load_fixture
+from helpers.marks import needs_rs274
 
-RS274 = shutil.which("rs274")
-needs_rs274 = pytest.mark.skipif(RS274 is None, reason="LinuxCNC rs274 not installed "
-                                 "(Debian package linuxcnc-uspace; .ci/run installs it)")
-FEED_RE = re.compile(r"STRAIGHT_FEED\(([^)]*)\)")
-RS274_DECIMALS = 4  # rs274's canonical output prints 4 decimals in mm
 
 
 @pytest.fixture(scope="module")
@@ -77,26 +72,12 @@ def test_program_structure(paths):
     assert not re.search(r"\d[eE][+-]?\d", text)  # no exponent notation
 
 
-def rs274(tmp_path, text: str) -> np.ndarray:
-    """rs274's STRAIGHT_FEED end points (k, 3) for the program ``text``."""
-    src, out = tmp_path / "prog.ngc", tmp_path / "canon.txt"
-    src.write_text(text)
-    run = subprocess.run([RS274, "-g", str(src), str(out)], capture_output=True, text=True,
-                         timeout=60)
-    errors = [ln for ln in run.stderr.splitlines() if ln.strip() and ln.strip() != "executing"]
-    assert run.returncode == 0 and not errors, run.stderr
-    canon = out.read_text()
-    assert "PROGRAM_END()" in canon
-    return np.array([[float(v) for v in m.group(1).split(",")[:3]]
-                     for m in FEED_RE.finditer(canon)])
-
-
 @needs_rs274
 @pytest.mark.parametrize("which", ["boss", "saddles"])
 @pytest.mark.parametrize("tool_tip", [False, True])
 def test_rs274_reads_every_point(paths, tmp_path, which, tool_tip):
     tps = paths[which]
-    feeds = rs274(tmp_path, to_ngc(tps, tool_tip=tool_tip))
+    feeds = feed_points(tmp_path, to_ngc(tps, tool_tip=tool_tip))
     expected = np.vstack([programmed_points(tp, tool_tip) for tp in tps])
     # a path starting where the last one ended continues it: the joint is fed once
     joint = np.r_[False, np.linalg.norm(np.diff(expected, axis=0), axis=1) < 1e-9]
@@ -115,7 +96,7 @@ def test_rs274_reads_every_point(paths, tmp_path, which, tool_tip):
 @pytest.mark.parametrize("tol", [0.001, 0.01])
 def test_rs274_reads_dropped_points(paths, tmp_path, tol):
     tp = paths["boss"][0]
-    feeds = rs274(tmp_path, to_ngc([tp], tolerance=tol))
+    feeds = feed_points(tmp_path, to_ngc([tp], tolerance=tol))
     keep = simplify(tp.points, tol)
     assert len(feeds) == len(keep) < len(tp)
     decimals = digits_for(tol)

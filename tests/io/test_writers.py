@@ -16,23 +16,13 @@ from cadcnc.io import (
 )
 from cadcnc.io.program_gcode import write_ngc
 
-from conftest import fixture_path
+from helpers.fixtures import fixture_path
+from helpers.programs import assert_same_path
 
 
 @pytest.fixture(scope="module")
 def saddle():
     return fixture_path("crossing_cylinders", 1, 2)
-
-
-def assert_same_path(a, b):
-    for name in ARRAYS:
-        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
-    assert a.offsets == b.offsets and a.faces == b.faces
-    assert (a.stop_reason, a.stop_detail) == (b.stop_reason, b.stop_detail)
-    assert a.job == b.job
-    for ba, bb in zip(a.bounds, b.bounds):
-        for f in fields(SurfaceBounds):
-            np.testing.assert_array_equal(getattr(ba, f.name), getattr(bb, f.name))
 
 
 def test_json_round_trip_is_exact(saddle, tmp_path):

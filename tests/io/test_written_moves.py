@@ -12,7 +12,7 @@ import cadcnc
 from cadcnc.core.errors import InputError
 from cadcnc.io.program_gcode import program_ngc, program_written_moves, segment_moves
 from cadcnc.core.job import Finish, Job, Pencil, Tool
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 pytestmark = pytest.mark.slow
 

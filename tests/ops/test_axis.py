@@ -22,19 +22,10 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVerte
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.gp import gp_Pnt
 
-from conftest import cadcnc_cli
-
-FIXTURES = Path(__file__).resolve().parents[2] / "fixtures"
-STEP = FIXTURES / "six_pockets.step"
-FACTS = json.loads((FIXTURES / "setup_fixtures.json").read_text())
-R = FACTS["radius"]
-SHANK = 10 * R
-GOUGE = 1e-3      # mm: the default gouge limit
-DIGITS = 1e-4     # mm: the G-code's 4 decimals (rounding 5e-5 per coordinate)
-RS274 = shutil.which("rs274")
-MOVE_RE = re.compile(r"(STRAIGHT_FEED|STRAIGHT_TRAVERSE)\(([^)]*)\)")
-AXES = {"+X": (1, 0, 0), "-X": (-1, 0, 0), "+Y": (0, 1, 0), "-Y": (0, -1, 0),
-        "+Z": (0, 0, 1), "-Z": (0, 0, -1)}
+from cadcnc.testing.rs274 import RS274, moves as rs274_moves
+from helpers.cli import cadcnc_cli
+from helpers.six_pockets import (AXES, DIGITS, FACTS, GOUGE, R, SHANK, STEP, distance,
+                                 face_distance, written_transform)
 
 
 @pytest.fixture(scope="module")
@@ -42,42 +33,6 @@ def part():
     import cadcnc
 
     return cadcnc.load_step(STEP)
-
-
-def written_transform(ngc: str) -> tuple[np.ndarray, np.ndarray]:
-    """(R (3, 3), work zero (3,)) as the G-code's comments state them."""
-    zero = re.search(r"work zero at part \[([^\]]*)\] mm", ngc)
-    rows = re.search(r"R rows \[([^\]]*)\]", ngc)
-    assert zero and rows, ngc[:600]
-    r = np.array([[float(v) for v in row.split()] for row in rows.group(1).split(";")])
-    return r, np.array([float(v) for v in zero.group(1).split(",")])
-
-
-def rs274_moves(ngc_file: Path) -> list[tuple[str, np.ndarray]]:
-    """rs274's moves in order: (kind, end point (3,) in work coordinates)."""
-    canon = ngc_file.with_suffix(".canon")
-    run = subprocess.run([RS274, "-g", str(ngc_file), str(canon)], capture_output=True,
-                         text=True, timeout=60)
-    assert run.returncode == 0, run.stderr
-    text = canon.read_text()
-    assert "PROGRAM_END()" in text
-    return [(m.group(1), np.array([float(v) for v in m.group(2).split(",")[:3]]))
-            for m in MOVE_RE.finditer(text)]
-
-
-def distance(shape, a, b=None) -> float:
-    """OCCT's distance from point a (or segment a-b) to ``shape``, mm."""
-    if b is None:
-        probe = BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, a))).Vertex()
-    else:
-        probe = BRepBuilderAPI_MakeEdge(gp_Pnt(*map(float, a)), gp_Pnt(*map(float, b))).Edge()
-    d = BRepExtrema_DistShapeShape(probe, shape)
-    assert d.IsDone()
-    return d.Value()
-
-
-def face_distance(part, n: int, p) -> float:
-    return distance(part.face(n).topods, p)
 
 
 @pytest.mark.skipif(RS274 is None, reason="LinuxCNC rs274 not installed")

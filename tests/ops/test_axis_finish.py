@@ -15,9 +15,10 @@ import json
 import numpy as np
 import pytest
 
-from conftest import cadcnc_cli
-from test_axis import (AXES, DIGITS, FACTS, GOUGE, R, RS274, SHANK, STEP, distance,
-                       face_distance, rs274_moves, written_transform)
+from cadcnc.testing.rs274 import RS274, moves as rs274_moves
+from helpers.cli import cadcnc_cli
+from helpers.six_pockets import (AXES, DIGITS, FACTS, GOUGE, R, SHANK, STEP, distance,
+                                 face_distance, written_transform)
 
 SIDE = "+X"
 FLOOR_AT = 15.0   # mm: the pockets' floors lie 15 mm from the cube's centre (the builder)

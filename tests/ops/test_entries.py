@@ -14,8 +14,8 @@ import re
 import numpy as np
 import pytest
 
-from benchmarks.coverage.coverage_oracle import Oracle, read_shape
-from benchmarks.entries.sweeps import TOL, entries_at, entry_exists, links_check
+from cadcnc.testing.coverage_oracle import Oracle, read_shape
+from cadcnc.testing.tool_sweeps import TOL, entries_at, entry_exists, links_check
 import cadcnc
 from cadcnc.core.errors import EXIT_GOUGE, EXIT_NOTHING, EXIT_OK
 from cadcnc.core.job import Job, PairPath, Tool
@@ -24,7 +24,8 @@ from cadcnc.program.linking import linked
 from cadcnc.program.program import Program
 from cadcnc.program.toolpath import toolpath_piece
 from cadcnc.verification.judgement import judge
-from conftest import FIXTURES, cadcnc_cli, fixture_path
+from helpers.cli import cadcnc_cli
+from helpers.fixtures import FIXTURES, fixture_path
 
 pytestmark = [pytest.mark.slow, pytest.mark.cli]
 

@@ -15,7 +15,9 @@ from cadcnc.ops.finish.plan import centre_chord, plan_planes, sample_faces
 from cadcnc.ops.finish.uncut import uncut_report
 from cadcnc.verification import gate_program
 from cadcnc.verification.probe import shape_distances
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
+
+pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
 
 R = 3.0
 _runs: dict = {}

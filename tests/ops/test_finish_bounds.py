@@ -27,7 +27,9 @@ from cadcnc.ops.finish.setup import pass_setup
 from cadcnc.program.program import FAILED, STOPPED_SHORT
 from cadcnc.core.work_limits import HEARTBEAT_S, MAX_PLANES, WorkLimitError
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
+
+pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
 
 FACTS = json.loads((FIXTURES / "finish_fixtures.json").read_text())
 R = 3.0

@@ -27,7 +27,7 @@ from cadcnc.verification.probe import FaceProbe
 from cadcnc.verification.surface_checks import check_surface
 from cadcnc.verification.whole_part import check_whole_part
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "finish_fixtures.json").read_text())
 R = 3.0

@@ -7,7 +7,7 @@ import numpy as np
 import cadcnc
 from cadcnc.ops.finish.polish import face_derivatives
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 
 def test_compiled_derivatives_are_occts():

@@ -23,7 +23,7 @@ from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
 from cadcnc.ops.finish.setup import pass_setup
 from cadcnc.program.program import FAILED, CutSegment
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "finish_fixtures.json").read_text())
 UM = 1e-3

@@ -11,7 +11,7 @@ import cadcnc
 from cadcnc.core.errors import EXIT_NOTHING, InputError, NothingToCutError
 from cadcnc.core.job import Job, PairPath, Tool
 from cadcnc.ops.path.pair_program import LIMIT_SLACK, program_for_job, safe_height
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
 _parts: dict = {}

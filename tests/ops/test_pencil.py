@@ -9,7 +9,7 @@ import cadcnc
 from cadcnc.ops.path.pair_program import CLIMB, climb_measure
 from cadcnc.ops.pencil.pencil import pencil
 from cadcnc.verification import gouge_gate
-from conftest import FIXTURES, load_fixture
+from helpers.fixtures import FIXTURES, load_fixture
 
 _programs: dict = {}
 
@@ -76,7 +76,7 @@ def test_cadquery_example_runs_as_script_and_under_cq_editor(capsys):
     """docs/examples/pencil_example.py: a Workplane in, wires out through the cut points."""
     import runpy
 
-    from conftest import ROOT
+    from helpers.fixtures import ROOT
 
     example = str(ROOT / "docs" / "examples" / "pencil_example.py")
     shown = {}

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from benchmarks.reliability.judge import polyline_depths
+from cadcnc.testing.moves_judge import polyline_depths
 from cadcnc.core.errors import EXIT_NOTHING, InputError, NothingToCutError
 from cadcnc.core.job import Job, PairPath, Pencil, Tool
 from cadcnc.ops.path.pair_path import plan_path

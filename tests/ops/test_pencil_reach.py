@@ -26,7 +26,7 @@ def shape():
 
 
 def _oracle():
-    from benchmarks.coverage import coverage_oracle
+    from cadcnc.testing import coverage_oracle
 
     return coverage_oracle
 

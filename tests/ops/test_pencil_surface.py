@@ -12,8 +12,8 @@ from OCP.gp import gp_Pnt
 import cadcnc
 from cadcnc.io.program_json import read_program
 from cadcnc.verification import gouge_gate
-from conftest import FIXTURES
-from test_cli import cadcnc_cli
+from helpers.cli import cadcnc_cli
+from helpers.fixtures import FIXTURES
 
 RADIUS = 2.0
 

@@ -32,7 +32,9 @@ from cadcnc.interp.cycle import Contact
 from cadcnc.ops.path.stretches import TANGENT, pair_stretches
 from cadcnc.core.tolerances import DEFAULT
 
-from conftest import FIXTURES, occt_distance as distance
+from cadcnc.testing.occt import occt_distance as distance
+
+from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "r0901_corners.json").read_text())
 _cache: dict = {}

@@ -14,7 +14,7 @@ import pytest
 from cadcnc.interp.cycle import COLLISION
 from cadcnc.ops.path.pair_path import pair_job, plan_path
 from cadcnc.ops.common import run_stretch
-from conftest import SIDECAR, load_fixture
+from helpers.fixtures import SIDECAR, load_fixture
 
 
 class FiveMillimetres:

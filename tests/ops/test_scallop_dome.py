@@ -20,7 +20,7 @@ from scipy.optimize import fsolve
 
 import cadcnc
 from cadcnc.ops.finish.plan import centre_chord, plan_planes, sample_faces
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "waterline_fixtures.json").read_text())
 R, H = 3.0, 0.05

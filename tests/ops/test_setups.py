@@ -22,7 +22,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import cadcnc_cli
+from helpers.cli import cadcnc_cli
 
 R = 3.0
 SPACING = 0.5   # mm: the setups' positions along a corner (cadcnc.ops.pencil.setups)

@@ -25,7 +25,7 @@ from cadcnc.core.job import Finish, Job, Tool
 from cadcnc.ops.finish.finish import plan_for_job
 from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
 from cadcnc.program.program import FAILED
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "waterline_fixtures.json").read_text())["boss"]
 R, H = 2.0, 0.05                                        # ball radius, scallop limit (mm)

@@ -15,7 +15,7 @@ import pytest
 import cadcnc
 from cadcnc.ops.finish import steep_shallow
 from cadcnc.ops.finish.plan import across, along_edges, centre_chord, plan_planes, sample_faces
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "waterline_fixtures.json").read_text())
 

@@ -25,7 +25,9 @@ from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.stretch_split import split_at_stop
 from cadcnc.ops.path.stretches import pair_stretches
 
-from conftest import FIXTURES, occt_distance as distance
+from cadcnc.testing.occt import occt_distance as distance
+
+from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "grazed_hole.json").read_text())
 R = FACTS["radius"]

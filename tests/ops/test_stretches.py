@@ -24,7 +24,7 @@ from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.stretch_paths import nearest_start, stretch_paths
 from cadcnc.ops.path.stretches import COLLISION, REASONS, Feasibility, pair_stretches
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 SIDECAR = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
 UM = 1e-6

@@ -20,7 +20,7 @@ from cadcnc.ops.finish.plan import sample_faces
 from cadcnc.ops.finish.setup import pass_setup
 from cadcnc.verification.probe import shape_distances
 from cadcnc.core.work_limits import WorkLimitError
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "waterline_fixtures.json").read_text())
 RADIUS = {"dome": 3.0, "wall": 3.0, "boss": 2.0}

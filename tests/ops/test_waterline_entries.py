@@ -16,7 +16,7 @@ import numpy as np
 
 import cadcnc
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "entry_fixtures.json").read_text())["entry_side"]
 

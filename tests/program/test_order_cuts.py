@@ -19,7 +19,7 @@ from cadcnc.core.job import Job, Pencil, Tool
 from cadcnc.ops.pencil import pencil
 from cadcnc.program.linking import TWO_OPT_MAX, order_cuts
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 
 @dataclass

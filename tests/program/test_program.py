@@ -12,8 +12,8 @@ from cadcnc.io.program_json import program_to_dict, read_program, write_program_
 from cadcnc.io.toolpath_json import write_json
 from cadcnc.program.linking import APPROACH, link, linked
 from cadcnc.program.program import CutSegment, Program, Skipped
-from conftest import fixture_path
-from test_writers import assert_same_path
+from helpers.fixtures import fixture_path
+from helpers.programs import assert_same_path
 
 
 @pytest.fixture(scope="module")
@@ -129,7 +129,7 @@ def test_rs274_reads_the_program_moves(two_cuts, tmp_path):
     import subprocess
 
     from cadcnc.io.program_gcode import program_ngc
-    from test_gcode import RS274, RS274_DECIMALS
+    from cadcnc.testing.rs274 import DECIMALS as RS274_DECIMALS, RS274
 
     if RS274 is None:
         pytest.skip("LinuxCNC rs274 not installed")
@@ -154,7 +154,7 @@ def test_rs274_reads_the_program_moves(two_cuts, tmp_path):
 def test_program_pictures(two_cuts, tmp_path, suffix):
     """The picture shows the part, one line per cut and the links."""
     from cadcnc.io.program_plot import program_scene, write_program_picture
-    from conftest import load_fixture
+    from helpers.fixtures import load_fixture
 
     part = load_fixture("pocket")
     prog = Program(two_cuts[0].job, linked([CutSegment(p) for p in two_cuts], 60.0))

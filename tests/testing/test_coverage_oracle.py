@@ -1,4 +1,4 @@
-"""The coverage benchmark's judge (benchmarks/coverage/coverage_oracle.py) against closed forms.
+"""The coverage benchmark's judge (cadcnc/testing/coverage_oracle.py) against closed forms.
 
 The judge decides which ball positions are feasible along concave edges; coverage figures
 are only as good as it is. On the pocket fixture the floor (z = 15) meets the planar wall
@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks.coverage import coverage_oracle as _oracle, coverage_paths as _paths
+from benchmarks.coverage import coverage_paths as _paths
+from cadcnc.testing import coverage_oracle as _oracle
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -9,7 +9,7 @@ from cadcnc.program.linking import linked
 from cadcnc.program.program import CutSegment, Program
 from cadcnc.verification import gouge_gate
 from cadcnc.verification.cut_back import CUT_BACK, GOUGE, cut_back
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 
 def test_a_cut_running_into_a_wall_is_cut_back_where_the_ball_reaches_it():

@@ -28,8 +28,8 @@ from cadcnc.verification.gate_cache import shared_gates
 from cadcnc.verification.planar import planar_twin
 from cadcnc.verification.probe import FaceProbe
 from cadcnc.verification.whole_part import _match, window_match
-from conftest import FIXTURES
-from test_gate_shared import DEPTH, same
+from helpers.fixtures import FIXTURES
+from helpers.gate_results import DEPTH, same
 
 
 

@@ -22,32 +22,15 @@ from cadcnc.verification.cut_back import cut_back
 from cadcnc.verification.gate_cache import shared_gates
 from cadcnc.verification.probe import FaceProbe
 from cadcnc.verification.surface_checks import check_surface
-from conftest import FIXTURES, fixture_path, load_fixture
+from helpers.fixtures import FIXTURES, fixture_path, load_fixture
+from helpers.gate_results import DEPTH, same
 
-DEPTH = 1e-9  # mm: the same OCCT distances, reached by other roads
 _PARTS: dict = {}
-
-
-def same(ref, fast) -> None:
-    """Two GateResults agree: verdict, message, failing faces, cycles and moves, depths."""
-    assert (ref.ok, ref.message, ref.in_material) == (fast.ok, fast.message, fast.in_material)
-    assert ref.depth_mm == pytest.approx(fast.depth_mm, abs=DEPTH, nan_ok=True)
-    assert [(h.face, h.n_cycles, h.cycles, h.worst_cycle) for h in ref.hits] == \
-        [(h.face, h.n_cycles, h.cycles, h.worst_cycle) for h in fast.hits]
-    for a, b in zip(ref.hits, fast.hits):
-        assert a.depth_mm == pytest.approx(b.depth_mm, abs=DEPTH, nan_ok=True)
-    if ref.sweep is None:
-        assert fast.sweep is None
-        return
-    assert ref.sweep.proven == fast.sweep.proven
-    assert ref.sweep.depth_mm == pytest.approx(fast.sweep.depth_mm, abs=DEPTH, nan_ok=True)
-    assert [(h.face, h.moves, h.n_moves) for h in ref.sweep.hits] == \
-        [(h.face, h.moves, h.n_moves) for h in fast.sweep.hits]
 
 
 def wall_path(end_x: float):
     """stretch_pocket's floor-wall corner run to ``end_x`` without the guard: past x = 32
-    the ball cuts the end wall (tests/test_cut_back.py)."""
+    the ball cuts the end wall (tests/verification/test_cut_back.py)."""
     if "pocket" not in _PARTS:
         _PARTS["pocket"] = cadcnc.load_step(FIXTURES / "stretch_pocket.step")
     part = _PARTS["pocket"]

@@ -29,7 +29,7 @@ import cadcnc
 from cadcnc.core.trim_labels import INSIDE
 from cadcnc.verification.probe import INNER_MARGIN, FaceProbe, project_on_curve
 
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 PARTS = ["finish_slab", "bspline_boss", "finish_boss", "r0901_fillet"]
 

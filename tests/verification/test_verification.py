@@ -30,7 +30,7 @@ from cadcnc.verification import (
     WholePartHit, gouge_gate, verify,
 )
 from cadcnc.verification.probe import FaceProbe
-from conftest import CONCAVE_PAIRS, FIXTURES, fixture_path, load_fixture
+from helpers.fixtures import CONCAVE_PAIRS, FIXTURES, fixture_path, load_fixture
 
 VSIDE = json.loads((FIXTURES / "verification_fixtures.json").read_text())["third_face"]
 F = 0.1  # mm per cycle: feed 1500 mm/min, period 4 ms (the paper's numbers)

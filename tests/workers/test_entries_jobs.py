@@ -16,7 +16,7 @@ from cadcnc.ops.common import safe_height
 from cadcnc.ops.entries import entered_program_segments
 from cadcnc.ops.path import pair_program
 from cadcnc.workers import close
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 pytestmark = pytest.mark.slow
 

@@ -24,7 +24,10 @@ from cadcnc.core.errors import EXIT_INTERNAL, EXIT_INTERRUPTED
 from cadcnc.geometry.part_bytes import part_blob, part_from_blob
 from cadcnc.core.errors import InputError
 from cadcnc.workers import START_ENV, WorkerError, close, map_ordered, start_method
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+from helpers.fixtures import FIXTURES
+
+pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
 
 BOSS = str(FIXTURES / "finish_boss.step")
 FINISH = ["finish", BOSS, "--faces", "6", "--radius", "3", "--stepover", "4"]

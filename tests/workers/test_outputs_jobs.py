@@ -14,7 +14,7 @@ from cadcnc.io.gcode import blend_for
 from cadcnc.io.outputs import render, render_all
 from cadcnc.io.program_json import RUNS_PER_JOB, _runs
 from cadcnc.workers import START_ENV, close
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 
 @pytest.fixture(scope="module")

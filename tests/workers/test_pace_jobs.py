@@ -15,7 +15,7 @@ import pytest
 import cadcnc
 from cadcnc.ops.parallel import on_workers
 from cadcnc.workers import WorkerError, close
-from conftest import FIXTURES
+from helpers.fixtures import FIXTURES
 
 
 def _where(part, task, beat=None):

@@ -5,7 +5,7 @@ The tool is the ball of radius R' on a shank of radius R' and length L along +Z.
 the ball centre from a to b sweeps every point within R' of the parallelogram a, b,
 b + L z, a + L z (a segment when the move is vertical or L = 0). The move is clear when
 BRepExtrema's distance from that parallelogram to every face of the part (the judge's
-faces, :class:`benchmarks.coverage.coverage_oracle.Oracle`) is at least R' - TOL. A path
+faces, :class:`cadcnc.testing.coverage_oracle.Oracle`) is at least R' - TOL. A path
 that starts and ends outside the material and crosses it meets a face (distance 0), so
 faces alone decide. Lengths mm.
 """

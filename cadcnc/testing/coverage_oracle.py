@@ -53,7 +53,7 @@ from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
-from benchmarks.coverage.coverage_sewing import sew_model
+from cadcnc.testing.coverage_sewing import sew_model
 
 SPACING = 0.2        # mm between edge samples (the spec)
 MIN_SAMPLES = 9      # per edge (the spec)
