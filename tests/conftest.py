@@ -40,6 +40,22 @@ def _runs_the_cli(item) -> bool:
             or getattr(item.module, "cadcnc_cli", None) is cli.cadcnc_cli)
 
 
+def _recorded(config) -> dict:
+    """The modules' recorded times: read from the cache by the controller, handed to each
+    xdist worker with its input (so that every worker collects in one order)."""
+    worker = getattr(config, "workerinput", None)
+    if worker is not None and DURATIONS in worker:
+        return worker[DURATIONS]
+    cache = getattr(config, "cache", None)
+    return cache.get(DURATIONS, {}) if cache is not None else {}
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):
+    """xdist, on the controller: a worker's input carries the recorded times."""
+    node.workerinput[DURATIONS] = _recorded(node.config)
+
+
 def pytest_collection_modifyitems(config, items):
     """The ``cli`` marker where a module runs the command line; the modules longest first
     (a module's tests stay together, in their order), so that xdist (``--dist loadscope
@@ -49,8 +65,7 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if _runs_the_cli(item):
             item.add_marker(pytest.mark.cli)
-    cache = getattr(config, "cache", None)
-    recorded = cache.get(DURATIONS, {}) if cache is not None else {}
+    recorded = _recorded(config)
     count: dict = {}
     slow: dict = {}
     for item in items:
