@@ -3,7 +3,8 @@
 - The interpolation core (``cadcnc/interp/``) imports no OCCT: only itself, the kernel-free
   top-level modules, the standard library, numpy and numba.
 - No import cycles between cadcnc modules, function-local imports included.
-- No module over 400 lines; no flat ``verification_*`` modules.
+- No function body over 80 lines (a few named, with their reasons); a module over 400
+  lines is noted, not failed; no flat ``verification_*`` modules.
 - OCCT (OCP, cadquery) only in the geometry, guard and verification stages (and the
   writers' pictures and CadQuery wires): never in ``ops/``, ``program/`` or ``controller/``.
 - No private name (``_x``) imported from another module.
@@ -13,7 +14,9 @@
 from __future__ import annotations
 
 import ast
+import re
 import sys
+import warnings
 from pathlib import Path
 
 import pytest
@@ -123,9 +126,65 @@ def test_no_import_cycles():
             visit(n)
 
 
-def test_modules_are_small():
+FUNCTION_LINES = 80
+"""The longest function or method body (lines, from its first statement to its last)."""
+LONG_FUNCTIONS = {
+    # name: (lines today, why it stays whole)
+    "cadcnc.verification.reference.check_reference": (
+        112, "one sequential comparison with OCCT's intersection curves (match, resample, "
+             "measure, judge the ends), every step reading the state the last one left"),
+    "cadcnc.cli.setups.setups_command": (
+        87, "settles, judges and writes beside batch/operate.py: it goes when the pipeline "
+            "stage owns a part's run (issue 38, item 1)"),
+    "cadcnc.verification.table.format_table": (
+        86, "the report's text, one line of the table after another: a split would cut "
+            "one table in two places"),
+    "cadcnc.cli.app.build_parser": (
+        86, "the command line's subcommands declared in one place, in the order --help "
+            "shows them"),
+}
+"""Functions allowed over FUNCTION_LINES, each at most as long as it is today."""
+MODULE_LINES = 400
+"""A module over this many lines gets a warning, not a failure: split it where it has two
+subjects, not to pass a count."""
+
+
+def function_lengths() -> dict[str, int]:
+    """Every function and method of the package: its body's length in lines."""
+    out = {}
+    for name, path in MODULES.items():
+        tree = ast.parse(path.read_text())
+        parents = {child: node for node in ast.walk(tree) for child in ast.iter_child_nodes(node)}
+        for node in ast.walk(tree):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                qual, up = [node.name], parents.get(node)
+                while up is not None and not isinstance(up, ast.Module):
+                    if isinstance(up, (ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+                        qual.insert(0, up.name)
+                    up = parents.get(up)
+                out[f"{name}.{'.'.join(qual)}"] = node.end_lineno - node.body[0].lineno + 1
+    return out
+
+
+def test_functions_are_short():
+    """No function body over FUNCTION_LINES lines, but for LONG_FUNCTIONS (none growing)."""
+    long = {n: k for n, k in function_lengths().items() if k > FUNCTION_LINES}
+    assert {n: k for n, k in long.items()
+            if n not in LONG_FUNCTIONS or k > LONG_FUNCTIONS[n][0]} == {}
+
+
+def test_long_function_allowances_are_still_needed():
+    """An allowance goes when its function is split (or renamed, or gone)."""
+    lengths = function_lengths()
+    assert [n for n in LONG_FUNCTIONS if lengths.get(n, 0) <= FUNCTION_LINES] == []
+
+
+def test_long_modules_are_noted():
+    """Modules over MODULE_LINES lines: a warning in the summary (``-ra``), not a failure."""
     long = {n: len(p.read_text().splitlines()) for n, p in MODULES.items()}
-    assert {n: k for n, k in long.items() if k > 400} == {}
+    over = sorted(f"{n} ({k})" for n, k in long.items() if k > MODULE_LINES)
+    if over:
+        warnings.warn(f"modules over {MODULE_LINES} lines: " + ", ".join(over), stacklevel=1)
 
 
 def test_no_flat_verification_modules():
@@ -160,9 +219,10 @@ def test_no_private_name_imported_across_modules():
 
 
 STAGES = ["core", "interp", "geometry", "parallel", "guard", "program", "ops", "controller",
-          "io", "verification", "apt", "batch", "cli"]
+          "io", "verification", "apt", "batch", "cli", "testing"]
 """The data flow, in the order the code has (docs/architecture.md): a stage imports only from
-itself and the stages before it."""
+itself and the stages before it. ``testing`` (the independent references the tests and the
+benchmarks share) comes last: nothing in cadcnc imports it."""
 TOP = {"cadcnc", "cadcnc.__main__"}
 """The modules outside any stage: the package's API and its ``python -m`` entry."""
 
@@ -204,3 +264,12 @@ def test_exit_codes_come_from_their_one_definition():
             literal += [f"{name}:{node.lineno}: {b.value}" for b in branches
                         if isinstance(b, ast.Constant) and type(b.value) is int and b.value]
     assert literal == []
+
+
+def test_the_map_lists_the_stages_in_order():
+    """docs/architecture.md's map names every stage of STAGES, in that order (its table's
+    first column, ``core/`` ...). A stage the map lists before its folder exists (one being
+    built on another branch) is passed over until the folder comes."""
+    doc = (PKG.parent / "docs" / "architecture.md").read_text()
+    listed = re.findall(r"^\| `(\w+)/` \|", doc, re.M)
+    assert [s for s in listed if (PKG / s).is_dir()] == STAGES

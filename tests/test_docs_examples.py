@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 import re
 
-from conftest import ROOT
+from helpers.fixtures import ROOT
 
 
 def test_api_examples_run(monkeypatch):
@@ -47,7 +47,7 @@ def test_show_program_shows_a_part_as_a_cadquery_shape():
     import cadquery as cq
 
     import cadcnc
-    from conftest import load_fixture
+    from helpers.fixtures import load_fixture
 
     part = load_fixture("bspline_boss")
     program = cadcnc.pencil(part, radius=3.0)

@@ -1,8 +1,9 @@
 """Throughput of ``cadcnc batch`` (issue 25): pencil on a folder of parts with 1 and 2
 workers of the embedded Dask cluster, the scheduling overhead per task, and what the
-per-part times predict for more cores and machines.
+per-part times predict for more cores and machines. FOLDER: STEP parts, e.g. the public
+parts of OCCT's test data (Open-Cascade-SAS/OCCT, ``data/step/``).
 
-    nice .venv/bin/python -m benchmarks.batch.throughput [--parts ../shared/parts]
+    nice .venv/bin/python -m benchmarks.batch.throughput [--parts FOLDER]
         [--radius 3] [--workers 1 2] [--noop 200] [--json OUT]
 
 Both batches run in this process, one after the other, with ``force`` (every part

@@ -46,8 +46,8 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.controller.bound import va_bound
-from benchmarks.controller.contour import Arc, Offsets, PathReference
+from cadcnc.testing.topp_bound import va_bound
+from cadcnc.testing.contour_reference import Arc, Offsets, PathReference
 from benchmarks.controller.linuxcnc_baseline import violations
 from benchmarks.controller.stream_cost import programs
 from cadcnc.controller import Machine, stream_program

@@ -19,7 +19,7 @@ from cadcnc.controller import Machine, stream_program  # noqa: E402
 from cadcnc.controller.pieces import constant_speed  # noqa: E402
 from cadcnc.ops.stream_steppers import stepper_factory  # noqa: E402
 
-from benchmarks.controller.bound import bound_feed, va_bound
+from cadcnc.testing.topp_bound import bound_feed, va_bound
 from benchmarks.controller.stream_cost import programs
 
 OUT = Path(__file__).resolve().parents[2] / "docs" / "img" / "controller_feed.png"

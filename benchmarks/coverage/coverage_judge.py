@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from cadcnc.testing import coverage_oracle, coverage_sewing
+
 from benchmarks.coverage.coverage_paths import distance_to_polylines
 
 COVERED = 5e-3  # mm: a feasible position within this of a cut polyline is covered
@@ -27,17 +29,18 @@ CACHE_ENV = "COVERAGE_JUDGE_CACHE"
 """A folder named by this environment variable keeps each pair's verdicts (one JSON file
 per part, radius, pair and cap), so that pair_coverage.py and pencil_coverage.py judge a
 part once. The key holds the file's size and mtime, VERSION and a digest of the judge's
-source (this file, coverage_oracle.py and coverage_sewing.py): any change to the judge makes a new key."""
+source (this file, cadcnc/testing/coverage_oracle.py and coverage_sewing.py): any change
+to the judge makes a new key."""
 VERSION = 2  # of the judge's verdicts (2: `unreachable`)
-_HERE = Path(__file__).resolve().parent
 
 
 def judge_digest() -> str:
     """sha1 (12 hex digits) of the judge's source: coverage_oracle.py, coverage_sewing.py
     and this file."""
     h = hashlib.sha1()
-    for name in ("coverage_oracle.py", "coverage_judge.py", "coverage_sewing.py"):
-        h.update((_HERE / name).read_bytes())
+    for path in (Path(coverage_oracle.__file__), Path(__file__),
+                 Path(coverage_sewing.__file__)):
+        h.update(path.read_bytes())
     return h.hexdigest()[:12]
 
 

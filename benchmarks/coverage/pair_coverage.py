@@ -33,7 +33,7 @@ import numpy as np
 
 from benchmarks import ROOT
 from benchmarks.coverage.coverage_judge import covered, judge_pair_cached, missed_runs
-from benchmarks.coverage.coverage_oracle import TOL, Oracle, read_shape
+from cadcnc.testing.coverage_oracle import TOL, Oracle, read_shape
 from benchmarks.coverage.coverage_paths import classify, run_faces, run_path
 
 

@@ -29,8 +29,8 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.coverage.coverage_judge import covered, judge_pair_cached
-from benchmarks.coverage.coverage_oracle import Oracle, read_shape
-from benchmarks.entries.sweeps import entries_at, entry_exists, links_check
+from cadcnc.testing.coverage_oracle import Oracle, read_shape
+from cadcnc.testing.tool_sweeps import entries_at, entry_exists, links_check
 
 ROOT = Path(__file__).resolve().parents[2]
 PARTS = ROOT.parent / "shared" / "parts"

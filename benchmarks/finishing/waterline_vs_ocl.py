@@ -1,7 +1,7 @@
 """Waterline finishing against OpenCAMLib's Waterline and AdaptiveWaterline (issue 26).
 
 The same faces (fixtures/wl_*.step, fixtures/waterline_fixtures.json), the same levels
-(cadcnc's plan at a 2 mm stepdown), ball R as in tests/test_waterline.py, 0.1 mm point
+(cadcnc's plan at a 2 mm stepdown), ball R as in tests/ops/test_waterline.py, 0.1 mm point
 spacing (cadcnc's step f = F Ts; OCL's fibre sampling 0.1 mm, AdaptiveWaterline's finest
 0.01 mm), OCL on OCCT tessellations of the selected faces at ``--tol`` (1e-2, 1e-3 mm),
 one thread, in a subprocess (ocl_waterline_worker.py). Measured:

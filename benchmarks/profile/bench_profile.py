@@ -9,7 +9,7 @@ Cases (``--part`` and ``--radius`` change a case's part and ball radius):
   ``BRepOffsetAPI_MakeOffsetShape``: its B-spline faces become offset surfaces), faces
   4 and 5, R 2;
 - ``pencil``: ``cadcnc pencil`` on a real part with B-spline faces and edges
-  (``../shared/parts/bug32596_abc_0_13.step``, 99 faces), R 3;
+  (``bug32596_abc_0_13.step`` of OCCT's test data, ``data/step/``, 99 faces), R 3;
 - ``setups``: ``cadcnc pencil --setups auto`` on the same part, R 3 (six candidate axes).
 
 ``--base DIR``: a checkout of the previous code (``git worktree add DIR COMMIT``); every

@@ -1,5 +1,5 @@
 """The operation fuzz, longer: `pencil` and `finish` through the CLI on random settings,
-every exit 0 and 5 judged independently (benchmarks.reliability.judge).
+every exit 0 and 5 judged independently (cadcnc.testing.moves_judge).
 
     python -m benchmarks.reliability.fuzz_operations --trials 500 --out fuzz.json
 
@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 
 from benchmarks import FIXTURES
-from benchmarks.reliability.judge import deepest
+from cadcnc.testing.moves_judge import deepest
 
 CASES = [   # (command, part file, extra options)
     ("pencil", "step_block.step", []),

@@ -9,7 +9,7 @@ decades (log-uniform, per axis, in mm or inch; the jerk key present or missing, 
 given with ``--jerk`` or not at all), and a feed (or the program's). The judge reads the
 written ``.npy`` only: finite differences of the positions against the INI's limits
 (1e-6 relative slack), the ends against the program's first and last points, and OCCT's
-distance from the positions to the part (:mod:`benchmarks.reliability.judge`): no position
+distance from the positions to the part (:mod:`cadcnc.testing.moves_judge`): no position
 deeper than 1 um into the part's offset (R' - d <= 1 um), and every position near a cut on
 it (d - R' <= 1 um). Every exit is one of the defined codes, nothing is written unless 0,
 no traceback, and a draw either finishes or says something on stderr at least every 5 s.
@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks import FIXTURES
-from benchmarks.reliability.judge import boundary_distances
+from cadcnc.testing.moves_judge import boundary_distances
 
 PROGRAMS = {   # name: (part, the command that writes the program)
     "corner": ("step_block.step", ["path", "--faces", "3", "8", "--radius", "3", "--start",

@@ -13,8 +13,11 @@ it), and a position is covered when it lies within 5 um of a cut of any setup's 
 faces, no face nearer than R' - 1 um), and each G-code is read by LinuxCNC's rs274 and
 mapped back through the setup it records (largest distance to the JSON's moves).
 
-    nice .venv/bin/python -m benchmarks.setups.setup_coverage ../shared/parts --radius 3 \\
+    nice .venv/bin/python -m benchmarks.setups.setup_coverage PARTS --radius 3 \\
         --max-pairs 40 --json benchmarks/setups/setups_R3.json
+
+PARTS: a folder of STEP parts, e.g. the public parts of OCCT's test data
+(Open-Cascade-SAS/OCCT, ``data/step/``).
 
 ``--table JSON`` prints the table of an earlier run (docs/setups.md).
 """
@@ -35,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.coverage.coverage_judge import covered, judge_pair
-from benchmarks.coverage.coverage_oracle import Oracle
+from cadcnc.testing.coverage_oracle import Oracle
 from benchmarks.coverage.coverage_paths import cadcnc_command, classify, distance_to_polylines
 from benchmarks.coverage.pair_coverage import judge_path, spread
 from benchmarks.coverage.pencil_coverage import MOVE_RE

@@ -1,6 +1,6 @@
 """The paper's error bounds for both surfaces of a path in one compiled pass.
 
-Mirrors ``error_bounds.pair_bounds`` (numpy, the reference; tests/test_kernel_bounds.py
+Mirrors ``error_bounds.pair_bounds`` (numpy, the reference; tests/interp/test_kernel_bounds.py
 compares the two on fixture paths) element by element, operation for operation in numpy's
 order, so the numbers are the same (numpy's vectorised ``x ** 3`` may round its last bit
 differently from ``math.pow``: eq11 only). numpy's version costs about 0.4 ms on a

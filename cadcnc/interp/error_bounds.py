@@ -46,7 +46,7 @@ def surface_curvatures(ru, rw, n, ff, t):
 
     ``ru``, ``rw``, ``n``, ``t`` (..., 3) and ``ff`` (..., 6): E, F, G, L, M, N (leading
     axes broadcast: (N, 3) for one surface, (2, N, 3) for both with t (N, 3)). Vectorised
-    forms of cadcnc.geometry.differential (tests/test_curvature_copies.py ties them
+    forms of cadcnc.geometry.differential (tests/interp/test_curvature_copies.py ties them
     together).
     """
     E, F, G, L, M, N = np.moveaxis(ff, -1, 0)

@@ -1,7 +1,7 @@
 """The verification report: every check's record, and the JSON of ``cadcnc verify --json``.
 
 :meth:`VerificationReport.to_dict` writes the documented JSON (its keys are those of
-format 1: tests/test_verification.py pins them). Sign convention: a deviation is the
+format 1: tests/verification/test_verification.py pins them). Sign convention: a deviation is the
 cutter centre's signed distance from a surface (+ out of the material) minus the
 surface's offset R', so a negative deviation is an over-cut (a gouge). Lengths in mm,
 times in s.

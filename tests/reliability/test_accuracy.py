@@ -30,7 +30,7 @@ from cadcnc.core.job import MIN_STEP, Job, PairPath, Tool
 from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for
 from cadcnc.core.tolerances import DEFAULT
 
-from conftest import FIXTURES, load_fixture
+from helpers.fixtures import FIXTURES, load_fixture
 
 ACC = DEFAULT.accuracy   # 1e-3 mm
 KW = dict(feed=1500.0, period=0.004)  # f = 0.1 mm

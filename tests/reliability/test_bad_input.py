@@ -16,7 +16,9 @@ import pytest
 import cadcnc
 from cadcnc.core.job import Job, PairPath, Tool
 
-from conftest import FIXTURES, cadcnc_cli, load_fixture
+from helpers.cli import cadcnc_cli
+
+from helpers.fixtures import FIXTURES, load_fixture
 
 BOSS = FIXTURES / "bspline_boss.step"
 JOB = ["--radius", "3", "--feed", "1500", "--period", "4ms"]

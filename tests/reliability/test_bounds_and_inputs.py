@@ -20,7 +20,9 @@ from cadcnc.core.errors import InputError
 from cadcnc.core.job import Finish, Job, PairPath, Pencil, Tool
 from cadcnc.core.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT
 
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+
+from helpers.fixtures import FIXTURES
 
 POCKET = FIXTURES / "pocket.step"   # faces 10 17: a straight edge, a program in ~0.2 s
 PATH = ["path", POCKET, "--faces", "10", "17", "--radius", "3"]

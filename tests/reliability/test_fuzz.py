@@ -30,9 +30,11 @@ from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_gcode import to_ngc
 from cadcnc.verification import gouge_gate
 
-from benchmarks.reliability.judge import polyline_depths
-from conftest import FIXTURES, load_fixture
-from test_gcode import rs274
+from cadcnc.testing.moves_judge import polyline_depths
+from helpers.fixtures import FIXTURES, load_fixture
+from cadcnc.testing.rs274 import feed_points
+
+pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
 
 # (part, face i, face j, smallest and largest ball radius in mm)
 PAIRS = [
@@ -99,7 +101,7 @@ def test_an_accepted_path_never_gouges_along_its_moves(pair, r, step, period, st
     worst = float(polyline_depths(part, dense, ball).max())
     if shutil.which("rs274"):   # LinuxCNC's interpreter reads every file we would write
         with tempfile.TemporaryDirectory() as tmp:
-            assert len(rs274(Path(tmp), text)) > 0
+            assert len(feed_points(Path(tmp), text)) > 0
     ACCEPTED.append((pair, radius, worst))
     SEEN.append((name, radius, step, f"accepted, worst {worst:.2e} mm"))
     assert worst <= limit, (pair, kw, drop, worst)

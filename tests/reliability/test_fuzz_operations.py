@@ -4,7 +4,7 @@ Hypothesis draws an operation on a fixture, a ball radius (1e-3 to 1e3 mm, log-u
 a stepover, the gouge limit and chord tolerance (within their bounds), and a clearance.
 Every exit 0 is judged independently on the G-code as written: OCCT's distance from each
 move's samples to the part's faces and OCCT's solid classifier give the ball's depth
-(benchmarks.reliability.judge); none may be deeper than the gouge limit. Every exit 5 is
+(cadcnc.testing.moves_judge); none may be deeper than the gouge limit. Every exit 5 is
 judged by the same judge, which must find such a depth (the refusal is backed). Every
 other exit is one of the defined codes, and nothing is written then. Examples are
 derandomized, so a failure reproduces; `python -m benchmarks.reliability.fuzz_operations`
@@ -20,7 +20,10 @@ from hypothesis import strategies as st
 import cadcnc
 
 from benchmarks.reliability.fuzz_operations import CASES, judged, trial_args
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+from helpers.fixtures import FIXTURES
+
+pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
 
 EXAMPLES = 6
 """Draws in the suite (about 15 s); benchmarks.reliability.fuzz_operations runs more."""

@@ -35,7 +35,11 @@ from cadcnc.verification.bounds import point_box_distance, segment_lower_bound
 from cadcnc.verification.material import IN, OUT, Material, PartFaces
 from cadcnc.verification.probe import FaceProbe
 
-from conftest import BOSS_JOB, FIXTURES, cadcnc_cli, fixture_path, load_fixture
+from helpers.cli import BOSS_JOB, cadcnc_cli
+
+from helpers.fixtures import FIXTURES, fixture_path, load_fixture
+
+pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
 
 SIDE = json.loads((FIXTURES / "reliability_fixtures.json").read_text())
 CASES = [(name, case) for name, rec in SIDE.items() for case in rec["cases"]]

@@ -15,7 +15,9 @@ import time
 
 import pytest
 
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+
+from helpers.fixtures import FIXTURES
 
 BOSS = FIXTURES / "bspline_boss.step"
 POCKET = FIXTURES / "pocket.step"  # faces 10 17: a straight edge, a program in ~0.2 s
@@ -142,7 +144,7 @@ def test_stream_is_gated_before_the_first_increment(tmp_path):
 def test_a_path_ending_at_its_stretch_limit_is_complete(tmp_path):
     """The ramp's wall ends 12 mm before the edge does: the stretch ends there (a contact
     reaches its face's boundary), an intended end, so the program is complete (exit 0).
-    A program stopped short exits 6: tests/test_cli_program.py."""
+    A program stopped short exits 6: tests/cli/test_cli_program.py."""
     out = tmp_path / "ramp.json"
     args = ["path", FIXTURES / "ramp_wall.step", "--faces", "3", "7", *JOB, "-o", out]
     run = cadcnc_cli(*args)

@@ -1,0 +1,56 @@
+"""A program's outputs made on worker processes (issue 24): the same bytes as made here,
+with a setup too; a JSON in ordered runs of segments of similar size, every other output
+whole beside them."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+import cadcnc
+from cadcnc.geometry.setup import setup_part
+from cadcnc.io.gcode import blend_for
+from cadcnc.io.outputs import render, render_all
+from cadcnc.io.program_json import RUNS_PER_JOB, _runs
+from cadcnc.parallel.pool import START_ENV
+from helpers.fixtures import FIXTURES
+
+
+@pytest.fixture(scope="module")
+def programs():
+    """{origin: (part, program)}: step_slot's pencil R 3, in part coordinates and with a
+    work zero (a setup)."""
+    out = {}
+    for origin in (None, (5.0, -2.0, 1.0)):
+        job = cadcnc.Job(cadcnc.Tool(3.0), 1500, 0.004, cadcnc.Pencil(), origin=origin)
+        part = setup_part(cadcnc.load_step(FIXTURES / "step_slot.step"), job)
+        out[origin] = (part, cadcnc.run(part, job))
+    return out
+
+
+@pytest.mark.parametrize("origin", [None, (5.0, -2.0, 1.0)], ids=["part", "work-zero"])
+def test_the_json_made_on_two_processes_is_the_same_bytes(origin, programs, monkeypatch):
+    monkeypatch.setenv(START_ENV, "fork")
+    part, program = programs[origin]
+    assert len(program.segments) >= 8
+    one = render(program, "p.json", part)
+    two = render_all(program, ["p.json"], part, jobs=2)["p.json"]
+    assert two == one and ("setup" in json.loads(one)) == (origin is not None)
+    runs = _runs(program.segments, 2)
+    assert 2 <= len(runs) <= 2 * RUNS_PER_JOB and all(runs)
+    assert [s for run in runs for s in run] == list(program.segments)
+    assert _runs(program.segments, 1) == [list(program.segments)]
+
+
+def test_every_output_made_on_two_processes_is_the_same_bytes(programs, monkeypatch):
+    monkeypatch.setenv(START_ENV, "fork")
+    part, program = programs[(5.0, -2.0, 1.0)]
+    outs = ["p.json", "p.ngc", "p.csv", "p.png", "q.json"]
+    gcode = dict(blend=blend_for(program.job.tolerances.gouge))
+    one = render_all(program, outs, part, "slot", **gcode)
+    two = render_all(program, outs, part, "slot", 2, **gcode)
+    assert list(two) == outs and two == one
+    assert one["p.ngc"] == render(program, "p.ngc", part, "slot", **gcode)
+    with pytest.raises(cadcnc.OutputError, match="unknown output format"):
+        render_all(program, ["p.json", "p.txt"], part, "slot", 2)
