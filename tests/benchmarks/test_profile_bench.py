@@ -4,6 +4,8 @@ they wrap shows here rather than as a silently empty table."""
 
 from __future__ import annotations
 
+import pytest
+
 import json
 import os
 import subprocess
@@ -11,6 +13,8 @@ import sys
 from pathlib import Path
 
 from helpers.fixtures import FIXTURES
+
+pytestmark = pytest.mark.slow  # runs the profile benchmark's children: about 15 s
 
 ROOT = Path(__file__).resolve().parents[2]
 

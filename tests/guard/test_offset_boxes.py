@@ -73,6 +73,7 @@ def test_normal_box_contains_the_normal(offset_boss):
                 assert (n >= lo).all() and (n <= hi).all()
 
 
+@pytest.mark.slow  # about 17 s
 def test_offset_cells_never_clear_a_hit(offset_boss):
     """Ball centres around the offset corner (faces 4 and 5, R' 2, a 30 mm shank): where the
     height cells prove the own-face rule, OCCT's exact margin of face 4 is >= 0; and the

@@ -20,6 +20,8 @@ from helpers.cli import cadcnc_cli
 from helpers.six_pockets import (AXES, DIGITS, FACTS, GOUGE, R, SHANK, STEP, distance,
                                  face_distance, written_transform)
 
+pytestmark = pytest.mark.slow  # about 48 s of CPU: a quarter of the fast tier
+
 SIDE = "+X"
 FLOOR_AT = 15.0   # mm: the pockets' floors lie 15 mm from the cube's centre (the builder)
 

@@ -4,8 +4,12 @@ nothing afresh."""
 
 from __future__ import annotations
 
+import pytest
+
 import subprocess
 import sys
+
+pytestmark = pytest.mark.slow  # two subprocesses that start and warm workers: about 26 s
 
 CALL = ("from cadcnc.interp.kernel.cycle_math import dot; "
         "assert dot((1.0, 2.0, 3.0), (1.0, 1.0, 1.0)) == 6.0")
