@@ -17,7 +17,7 @@ from .core.errors import (
     CadcncError, FaceNumberError, FacePairError, GeometryError, InputError, OutputError,
     SingularPointError, StartPointError, StepFileError,
 )
-from .core.job import Finish, Job, PairPath, Pencil, Tool
+from .core.job import Job, PairPath, Pencil, Raster, SteepShallow, Tool, Waterline
 from .batch import batch  # the function: the name `cadcnc.batch` is not the package
 from .core.tolerances import Tolerances
 
@@ -32,11 +32,11 @@ _LAZY = {
     "Toolpath": "program.toolpath",
     "VerificationReport": "verification", "verify": "verification",
     "gouge_gate": "verification",
-    "pencil": "ops.pencil.setups", "finish": "ops.finish.finish", "Program": "program.program",
+    "pencil": "ops.pencil.setups", "finish": "ops.finish.shortcut", "Program": "program.program",
     "to_cq": "io.program_cq", "to_cq_compound": "io.program_cq",
     "show_program": "io.program_cq",
     "run": "ops.run", "program_for_job": "ops.path.pair_program",
-    "pencil_program": "ops.pencil.pencil", "finish_program": "ops.finish.finish",
+    "pencil_program": "ops.pencil.pencil",
     "gate_program": "verification", "read_program": "io.program_json",
     "BatchPart": "batch.task", "BatchOperation": "batch.task", "Settings": "batch.operate",
 }
@@ -44,7 +44,7 @@ _LAZY = {
 __all__ = [
     "CadcncError", "FaceNumberError", "FacePairError", "GeometryError", "InputError",
     "OutputError", "SingularPointError", "StartPointError", "StepFileError", "Job",
-    "PairPath", "Pencil", "Finish", "Tool", "Tolerances", "batch", *_LAZY,
+    "PairPath", "Pencil", "Raster", "Waterline", "SteepShallow", "Tool", "Tolerances", "batch", *_LAZY,
 ]
 
 

@@ -13,7 +13,7 @@ import pytest
 import cadcnc
 from cadcnc.controller import Machine, stream_program
 from cadcnc.controller.feed_plan import PlanError
-from cadcnc.ops.finish.finish import finish
+from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.ops.pencil.pencil import pencil

@@ -13,7 +13,7 @@ from scipy.spatial import cKDTree
 import cadcnc
 from cadcnc.controller import Machine, stream_program
 from cadcnc.interp.follow import follow
-from cadcnc.ops.finish.finish import finish
+from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.ops.pencil.pencil import pencil

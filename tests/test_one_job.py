@@ -12,7 +12,7 @@ import cadcnc
 from cadcnc.core.errors import InputError
 from cadcnc.io.outputs import PROGRAM_CSV_COLUMNS
 from cadcnc.io.program_json import program_json, read_program
-from cadcnc.core.job import Finish, Job, PairPath, Pencil, Tool
+from cadcnc.core.job import Raster, Job, PairPath, Pencil, Tool
 
 from conftest import FIXTURES, cadcnc_cli
 
@@ -29,7 +29,7 @@ JOBS = {
     "path": ("pocket", Job(Tool(3.0), 1500.0, 0.004, PairPath(faces=(10, 17)),
                            plunge_feed=300.0, spindle=9000.0)),
     "pencil": ("step_block", Job(Tool(3.0), 1500.0, 0.004, Pencil(side="conventional"))),
-    "finish": ("finish_slab", Job(Tool(3.0), 1500.0, 0.004, Finish((5,), stepover=4.0))),
+    "finish": ("finish_slab", Job(Tool(3.0), 1500.0, 0.004, Raster((5,), stepover=4.0))),
 }
 
 

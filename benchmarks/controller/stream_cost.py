@@ -31,7 +31,7 @@ from cadcnc.controller.feed_plan import plan_feed
 from cadcnc.controller.pieces import pieces_of
 from cadcnc.controller.stream import LANDING, follow_plan
 from cadcnc.interp.follow import follow
-from cadcnc.ops.finish.finish import finish
+from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.ops.pencil.pencil import pencil

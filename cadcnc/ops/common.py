@@ -11,6 +11,10 @@ from ..program.toolpath import Toolpath, toolpath_from_record
 from ..core.work_limits import MAX_CYCLES, refuse_over
 from .path.pair_path import PathPlan, stepper_for
 
+FINISH_JOIN = 1e-6
+"""mm: a finishing cut starting this near the last one's end continues it (one pass or
+level, chained); also the gap of a finishing program relinked once cut back."""
+
 
 def require_ball(job: Job) -> None:
     """InputError unless the ball has a size: R' = R + C > 0 mm. A ball of R' = 0 runs its

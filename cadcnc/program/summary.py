@@ -4,7 +4,7 @@ count), the links, what was skipped and why, the notes, the totals and complete 
 
 from __future__ import annotations
 
-from ..core.job import Finish, PairPath, Pencil
+from ..core.job import Finishing, PairPath, Pencil
 from ..core.units import format_duration
 
 CUT_LINES = 12
@@ -34,9 +34,9 @@ def _operation(job) -> str:
         which = "every corner" if op.faces is None else \
             "corners of faces " + " ".join(map(str, op.faces))
         return f"pencil, {which}, {op.side}"
-    if isinstance(op, Finish):
+    if isinstance(op, Finishing):
         spacing = ", ".join(f"{k} {getattr(op, k):g} mm" for k in (
-            "stepover", "stepdown", "scallop") if getattr(op, k) is not None)
+            "stepover", "stepdown", "scallop") if getattr(op, k, None) is not None)
         if op.strategy != "raster":
             how = (f"{op.side}" if op.strategy == "waterline" else
                    f"threshold {op.threshold:g} deg, overlap {op.overlap:g} mm, {op.side}")

@@ -17,7 +17,7 @@ import pytest
 
 import cadcnc
 from cadcnc.core.errors import InputError
-from cadcnc.core.job import Finish, Job, PairPath, Pencil, Tool
+from cadcnc.core.job import Raster, Job, PairPath, Pencil, Tool
 from cadcnc.core.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT
 
 from conftest import FIXTURES, cadcnc_cli
@@ -125,7 +125,7 @@ API_CASES = {
     "Job operation": (lambda p: Job(Tool(3.0), 1500.0, 0.004, "pencil"), "operation"),
     "PairPath faces": (lambda p: PairPath(faces=5), "two faces"),
     "Pencil faces": (lambda p: Pencil(faces=[0]), "face numbers"),
-    "Finish faces": (lambda p: Finish(None, stepover=1.0), "faces"),
+    "Finish faces": (lambda p: Raster(None, stepover=1.0), "faces"),
     "load_step": (lambda p: cadcnc.load_step(123), "path"),
     "verify": (lambda p: cadcnc.verify(None, p), "toolpath"),
     "gouge_gate": (lambda p: cadcnc.gouge_gate("x", p), "toolpath"),
