@@ -16,7 +16,7 @@ from cadcnc.controller.feed_plan import PlanError
 from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
-from cadcnc.ops.pencil.pencil import pencil
+from cadcnc.ops.pencil.pencil_program import pencil
 from cadcnc.ops.stream_steppers import stepper_factory
 
 from benchmarks.controller.bound import va_bound

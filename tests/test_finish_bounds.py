@@ -23,7 +23,7 @@ from cadcnc.ops.finish.check import planned_intervals
 from cadcnc.ops.finish.raster import raster_program
 from cadcnc.ops.finish.passes import GuidePlane, _Pass
 from cadcnc.ops.finish.plan import centre_chord
-from cadcnc.ops.finish.setup import pass_setup
+from cadcnc.ops.finish.pass_setup import pass_setup
 from cadcnc.program.program import FAILED, STOPPED_SHORT
 from cadcnc.core.work_limits import HEARTBEAT_S, MAX_PLANES, WorkLimitError
 

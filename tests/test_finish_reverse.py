@@ -21,7 +21,7 @@ from cadcnc.ops.finish.raster import plan_for_job
 from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.finish.check import pass_problems
 from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
-from cadcnc.ops.finish.setup import pass_setup
+from cadcnc.ops.finish.pass_setup import pass_setup
 from cadcnc.program.program import FAILED, CutSegment
 
 from conftest import FIXTURES

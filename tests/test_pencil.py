@@ -7,7 +7,7 @@ import pytest
 
 import cadcnc
 from cadcnc.ops.path.pair_program import CLIMB, climb_measure
-from cadcnc.ops.pencil.pencil import pencil
+from cadcnc.ops.pencil.pencil_program import pencil
 from cadcnc.verification import gouge_gate
 from conftest import FIXTURES, load_fixture
 

@@ -9,7 +9,7 @@ import pytest
 
 import cadcnc
 from cadcnc.geometry.part import Part
-from cadcnc.ops.pencil.pencil import NOT_REACHABLE
+from cadcnc.ops.pencil.pencil_program import NOT_REACHABLE
 from cadcnc.verification import gouge_gate
 
 RADIUS = 1.0   # shank 10 mm, shorter than the 30 mm void

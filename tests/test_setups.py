@@ -25,7 +25,7 @@ import pytest
 from conftest import cadcnc_cli
 
 R = 3.0
-SPACING = 0.5   # mm: the setups' positions along a corner (cadcnc.ops.pencil.setups)
+SPACING = 0.5   # mm: the setups' positions along a corner (cadcnc.ops.pencil.fewest_setups)
 RS274 = shutil.which("rs274")
 
 

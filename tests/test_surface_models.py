@@ -24,7 +24,7 @@ from OCP.TopoDS import TopoDS_Compound
 
 import cadcnc
 from cadcnc.geometry.material_side import CLOSED_SHELL, FLIPPED, OPEN_LEVEL, OPEN_SHELL, VOID
-from cadcnc.geometry.report import faces_report
+from cadcnc.geometry.faces_report import faces_report
 from cadcnc.geometry.sewing import file_faces, inconsistent_edges, sew
 from cadcnc.geometry.step_file import read_step
 from cadcnc.core.tolerances import DEFAULT

@@ -17,7 +17,7 @@ from cadcnc.core.job import Job, SteepShallow, Tool, Waterline, finishing
 from cadcnc.ops.finish.levels import CRITICAL_MM, critical_heights, plan_levels
 from cadcnc.ops.finish.loops import level_cuts
 from cadcnc.ops.finish.plan import sample_faces
-from cadcnc.ops.finish.setup import pass_setup
+from cadcnc.ops.finish.pass_setup import pass_setup
 from cadcnc.verification.probe import shape_distances
 from cadcnc.core.work_limits import WorkLimitError
 from conftest import FIXTURES

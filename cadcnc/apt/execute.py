@@ -13,7 +13,7 @@ from dataclasses import replace
 from ..core.errors import CadcncError, InputError
 from ..geometry.part import load_step
 from ..ops.path.pair_path import path_for_job, plan_path, shared_edge_for, stepper_for
-from .program import ProgramEntry
+from .program_entries import ProgramEntry
 
 
 def _at(entry: ProgramEntry, e: CadcncError, source: str) -> CadcncError:

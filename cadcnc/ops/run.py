@@ -23,7 +23,7 @@ from ..program.program import Program
 from ..workers import start
 from .common import FINISH_JOIN
 from .path.pair_program import program_for_job
-from .pencil.pencil import CHAIN_GAP, pencil_program
+from .pencil.pencil_program import CHAIN_GAP, pencil_program
 
 
 @dataclass(frozen=True)

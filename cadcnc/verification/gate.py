@@ -19,7 +19,7 @@ from ..core.errors import require
 from dataclasses import dataclass, field
 
 from ..core.tolerances import Tolerances
-from .records import SweepCheck, WholePartHit, strict_max
+from .check_records import SweepCheck, WholePartHit, strict_max
 from .gate_cache import cache_for, toolpath_key
 from .surface_checks import SAMPLE_UNSEEDED, check_pair, prepare, resolve_part
 from .whole_part import check_whole_part

@@ -15,7 +15,7 @@ from ..geometry.setup import setup_part
 from ..core.tolerances import Tolerances
 from ..core.trim_labels import OUTSIDE
 from .probe import FaceProbe
-from .records import SurfaceCheck, cycle_ranges
+from .check_records import SurfaceCheck, cycle_ranges
 
 PERCENTILES = (50, 95, 99)
 SAMPLE_UNSEEDED = 64  # cycles per face re-projected without seeds (plus the worst ones)

@@ -33,7 +33,7 @@ from ..entries import entered_program_segments
 from ..parallel import on_workers
 from .passes import GuidePlane, PassResult, pass_cuts
 from .plan import MAX_SAMPLES, centre_chord, plan_planes, sample_faces
-from .setup import pass_setup
+from .pass_setup import pass_setup
 from .uncut import uncut_report
 from .waterline import stay_down_links
 

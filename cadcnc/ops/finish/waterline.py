@@ -33,7 +33,7 @@ from ..entries import entered_program_segments
 from .levels import CRITICAL_MM, LevelPlan, check_stepdown, critical_heights, plan_levels
 from .loops import level_cuts
 from .plan import MAX_SAMPLES, FaceSamples, centre_chord, sample_faces
-from .setup import pass_setup
+from .pass_setup import pass_setup
 from .uncut import uncut_report
 
 SAMPLES_PER_SPACING = 4

@@ -19,7 +19,7 @@ from ..core.tolerances import Tolerances
 from .path_checks import check_feed, check_stop, check_theory, followed_edge, intended_span
 from .probe import offset_surface, shape_distances
 from .reference import check_reference
-from .records import WholePartCheck
+from .check_records import WholePartCheck
 from .report import VerificationReport
 from .surface_checks import SAMPLE_UNSEEDED, check_pair, prepare
 from .whole_part import check_whole_part
