@@ -120,11 +120,11 @@ def fixture_path(name: str, i: int, j: int, *, radius: float = 3.0, feed: float 
     """The toolpath of a fixture pair, computed once per test session (do not modify it)."""
     key = (name, i, j, radius, feed, period, tuple(sorted(kwargs.items())))
     if key not in _paths:
-        import cadcnc
+        from cadcnc.ops.path.pair_path import intersection_path
 
         part = load_fixture(name)
-        _paths[key] = cadcnc.intersection_path(part.face(i), part.face(j), radius=radius,
-                                               feed=feed, period=period, **kwargs)
+        _paths[key] = intersection_path(part.face(i), part.face(j), radius=radius,
+                                        feed=feed, period=period, **kwargs)
     return _paths[key]
 
 
@@ -175,3 +175,15 @@ def boss_cli_outputs(tmp_path_factory):
     run = cadcnc_cli("path", FIXTURES / "bspline_boss.step", *BOSS_JOB, "-o", d / "p.json",
                      "-o", d / "p.csv", "-o", d / "p.ngc", check=0)
     return d, run
+
+
+def pencil_run(part, *, radius, faces=None, side="climb", feed=1500.0, axis="+Z", **options):
+    """The pencil program of ``part`` (a Part, Workplane or Shape) with a ball of
+    ``radius`` mm: ``cadcnc.run`` of a Pencil job (feed mm/min, period 4 ms)."""
+    import cadcnc
+
+    if not isinstance(part, cadcnc.Part):
+        part = cadcnc.Part.from_cadquery(part)
+    job = cadcnc.Job(cadcnc.Tool(radius), feed, 0.004, cadcnc.Pencil(faces, side),
+                     source=part.source, axis=axis)
+    return cadcnc.run(part, job, **options)

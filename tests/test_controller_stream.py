@@ -16,10 +16,9 @@ from cadcnc.interp.follow import follow
 from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
-from cadcnc.ops.pencil.pencil_program import pencil
 from cadcnc.ops.stream_steppers import stepper_factory
 
-from conftest import FIXTURES
+from conftest import FIXTURES, pencil_run
 
 SLACK = 1e-6      # relative, on every limit
 NEAR = 1e-3       # mm: every position within 1 um of the kernel's path
@@ -45,7 +44,7 @@ def _corner(feed=1500.0):
 
 def _pencil(feed=None):
     part = _part("step_block.step")
-    return part, pencil(part, radius=3.0, **({} if feed is None else {"feed": feed}))
+    return part, pencil_run(part, radius=3.0, **({} if feed is None else {"feed": feed}))
 
 
 def _finish(feed=None):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 import re
 
-from conftest import ROOT
+from conftest import ROOT, pencil_run
 
 
 def test_api_examples_run(monkeypatch):
@@ -18,8 +18,8 @@ def test_api_examples_run(monkeypatch):
     for block in blocks:
         exec(compile(block, "docs/api.md", "exec"), namespace)
     assert namespace["path"].stop_reason == "closed"
-    assert (namespace["same"].points == namespace["path"].points).all()
-    assert namespace["job"].step == 0.1 and namespace["same"].job.operation.faces == (4, 5)
+    assert namespace["job"].step == 0.1 and namespace["corner"].job.operation.faces == (4, 5)
+    assert namespace["program"].complete and namespace["program"].cuts
     assert namespace["stepper"].stop_reason == "closed"
     assert len(sent) == namespace["stepper"].cycles
     assert os.path.exists(ROOT / "fixtures" / "bspline_boss.step")
@@ -50,7 +50,7 @@ def test_show_program_shows_a_part_as_a_cadquery_shape():
     from conftest import load_fixture
 
     part = load_fixture("bspline_boss")
-    program = cadcnc.pencil(part, radius=3.0)
+    program = pencil_run(part, radius=3.0)
     shown = {}
     cadcnc.show_program(lambda obj, name="", options=None: shown.__setitem__(name, obj),
                         program, part)

@@ -72,7 +72,7 @@ def _checked(entry: ProgramEntry, source: str):
 def run_job(entry: ProgramEntry, part, progress=None, source: str = "<program>"):
     """The :class:`~cadcnc.program.toolpath.Toolpath` of one checked entry.
 
-    ``progress(cycles, mm)`` is called every 10 000 cycles.
+    ``progress(cycles, 0, "<mm> mm")`` is called every 10 000 cycles.
     """
     _checked(entry, source)
     try:

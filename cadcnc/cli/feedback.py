@@ -11,12 +11,13 @@ def say_error(text: str) -> None:
 
 
 def progress(args, label: str):
-    """A progress(cycles, mm) callback printing to stderr, or None with --quiet."""
+    """A path's :data:`~cadcnc.core.progress.Progress` (``done`` cycles, ``what`` the mm
+    travelled) printing to stderr, or None with --quiet."""
     if args.quiet:
         return None
 
-    def report(cycles: int, mm: float) -> None:
-        say_error(f"cadcnc: {label}: {cycles} cycles, {mm:.1f} mm")
+    def report(done: int, total: int, what: str) -> None:
+        say_error(f"cadcnc: {label}: {done} cycles, {what}")
 
     return report
 

@@ -82,6 +82,10 @@ class PairPath:
         """Each surface's offset in mm, None resolved to the tool's R'."""
         return tuple(tool.offset if o is None else o for o in self.offsets)
 
+    def describe(self) -> str:
+        """The operation in a program's summary."""
+        return f"path along faces {self.faces[0]} and {self.faces[1]}"
+
     def to_inputs(self) -> dict:
         return dict(operation="path", faces=list(self.faces),
                     start=None if self.start is None else list(self.start),
@@ -114,6 +118,12 @@ class Pencil:
     def resolved_offsets(self, tool: Tool) -> tuple[float, float]:
         """(R', R'): the ball touches both faces of every corner."""
         return (tool.offset, tool.offset)
+
+    def describe(self) -> str:
+        """The operation in a program's summary."""
+        which = "every corner" if self.faces is None else \
+            "corners of faces " + " ".join(map(str, self.faces))
+        return f"pencil, {which}, {self.side}"
 
     def to_inputs(self) -> dict:
         return dict(operation="pencil",
@@ -196,6 +206,17 @@ class Finishing:
     def resolved_offsets(self, tool: Tool) -> tuple[float, float]:
         """(R', 0): the faces at the tool's offset, the guide surface carrying the centre."""
         return (tool.offset, 0.0)
+
+    def describe(self) -> str:
+        """The operation in a program's summary: faces, strategy, spacing and the rest."""
+        spacing = ", ".join(f"{k} {getattr(self, k):g} mm" for k in (
+            "stepover", "stepdown", "scallop") if getattr(self, k, None) is not None)
+        faces = " ".join(map(str, self.faces))
+        if self.strategy == "raster":
+            return f"finish faces {faces}, {spacing}, angle {self.angle:g} deg, {self.pattern}"
+        how = (f"{self.side}" if self.strategy == "waterline" else
+               f"threshold {self.threshold:g} deg, overlap {self.overlap:g} mm, {self.side}")
+        return f"finish faces {faces}, {self.strategy}, {spacing}, {how}"
 
     def to_inputs(self) -> dict:
         """The program JSON's finishing keys: every field of FINISH_FIELDS (a field the

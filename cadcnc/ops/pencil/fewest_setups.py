@@ -34,7 +34,7 @@ from ...program.transform import in_part_coordinates
 from ...core.units import check_axis
 from ..common import safe_height
 from ..entries import entered_program_segments
-from .pencil_program import CHAIN_GAP, keyword_job, pencil as pencil_one, pencil_program
+from .pencil_program import CHAIN_GAP, pencil_program
 
 SPACING = 0.5      # mm between two positions along a concave edge
 REACH_RADII = 5.0  # a ball centre farther than this many R' from its corner's edge counts nothing
@@ -157,20 +157,6 @@ def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
         taken |= reach_sets[k]
         result.runs.append(run)
     return result
-
-
-def pencil(part, *, setups=None, setup_overlap: float = 0.0, **keywords):
-    """``cadcnc.pencil``: the pencil program of ``part`` (keywords of
-    :func:`cadcnc.ops.pencil.pencil_program.pencil`, ``axis`` among them), or with ``setups``
-    (AUTO or a list of axes) the :class:`SetupsResult` of :func:`pencil_setups`, each
-    chosen setup's program in ``result.runs`` (not yet gated: :func:`cadcnc.gate_program`
-    with ``run.part``), ``setup_overlap`` mm of lap at their boundaries."""
-    if setups is None:
-        return pencil_one(part, **keywords)
-    progress = keywords.pop("progress", None)
-    keywords.pop("times", None)
-    part, job = keyword_job(part, **keywords)
-    return pencil_setups(part, job, setups, setup_overlap, progress=progress)
 
 
 def _fewest(reach: list[set], universe: set) -> tuple[list[int], int]:
