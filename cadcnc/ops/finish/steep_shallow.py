@@ -6,7 +6,8 @@ acos(N_z). With ``--threshold A`` (deg):
 - the **waterline** cuts (:mod:`.waterline`, levels planned over the samples steeper than
   A) are kept where their contact's slope exceeds A;
 - the **raster** cuts (the existing passes, :func:`~.raster.raster_program` of the
-  record's :meth:`~cadcnc.core.operations.SteepShallow.raster`, planes planned over the samples at most A steep) are kept where it does not;
+  record's :meth:`~cadcnc.core.operations.SteepShallow.raster`, planes planned over the
+  samples at most A steep) are kept where it does not;
 - ``--overlap MM``: each keeps also what lies within MM (over the surface, measured to
   the nearest sample of the other region, so to within the samples' spacing) of its
   region, so that the two overlap at the boundary.

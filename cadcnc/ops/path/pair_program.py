@@ -64,8 +64,9 @@ def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000,
     """The :class:`Program` of a pair job on ``part`` (see the module doc).
 
     ``progress(cycles, 0, "<mm> mm")`` as for a path; ``found``: the pair's stretches
-    when already computed (``pair_stretches``). Raises NothingToCutError (exit 3) naming the reason per
-    edge when no edge has a feasible position; InputError for a ball of R' = 0.
+    when already computed (``pair_stretches``). Raises NothingToCutError (exit 3) naming
+    the reason per edge when no edge has a feasible position; InputError for a ball of
+    R' = 0.
     """
     op = job.operation
     i, j = op.faces

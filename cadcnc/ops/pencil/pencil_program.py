@@ -1,8 +1,8 @@
 """Pencil milling: every inner corner of a part a ball can reach, in one linked program.
 
 :func:`pencil_program` finds the corners (:func:`~cadcnc.ops.pencil.corners.find_corners`:
-concave shared edges, and blends smaller than the ball, which the ball bridges on the two faces across
-them), cuts every feasible stretch of each (edge corners: :mod:`.stretches` and
+concave shared edges, and blends smaller than the ball, which the ball bridges on the two
+faces across them), cuts every feasible stretch of each (edge corners: :mod:`.stretches` and
 :func:`~cadcnc.ops.path.pair_program.stretch_cuts`; blend corners: the stepper from one seed
 to the other), with the third-face and shank guard inside the stepper, then orders the
 cuts (chains first, where one stops tri-tangent or on a boundary exactly where the next
