@@ -57,3 +57,14 @@ def test_show_program_shows_a_part_as_a_cadquery_shape():
     assert set(shown) == {"part", "cuts", "links"}
     assert isinstance(shown["part"], cq.Shape) and shown["part"].isValid()
     assert all(isinstance(shown[k], cq.Compound) for k in ("cuts", "links"))
+
+
+def test_the_top_level_names_are_the_ones_docs_api_lists():
+    """``cadcnc``'s public names (about 15) are those of docs/api.md's table, each loads."""
+    import cadcnc
+
+    table = (ROOT / "docs" / "api.md").read_text().split("## The names")[1].split("\n## ")[0]
+    listed = {name for row in table.splitlines() if row.startswith("| `")
+              for name in re.findall(r"`(\w+)`", row.split("|")[1])}
+    assert listed == set(cadcnc.__all__) and len(listed) <= 20
+    assert all(getattr(cadcnc, name) is not None for name in listed)
