@@ -245,7 +245,7 @@ def test_part_defaults_to_the_toolpath_source_and_progress_is_called(cylinders):
     calls = []
     rep = verify(tp, progress=lambda *a: calls.append(a))
     assert rep.max_overcut_mm == clean.max_overcut_mm
-    assert {c[0] for c in calls} >= {"surfaces", "reference", "whole part"}
+    assert {c[2] for c in calls} >= {"surfaces", "reference", "whole part"}
     text = rep.format_table()
     assert "face 1" in text and "OK" in text
 

@@ -52,7 +52,7 @@ def measure(case: str, cycles: int) -> dict:
     return {"case": case, "faces": (i, j), "radius": radius, "step": step, "feed": feed,
             "cycles": len(tp), "stop": tp.stop_reason, "path_s": t1 - t0, "gate_s": t2 - t1,
             "ok": gate.ok, "depth_mm": gate.depth_mm, "progress": len(calls),
-            "stages": sorted({c[0] for c in calls}),
+            "stages": sorted({c[2] for c in calls}),
             "peak_mb": (base, after_path, peak_mb())}
 
 

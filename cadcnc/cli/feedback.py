@@ -23,7 +23,7 @@ def progress(args, label: str):
 
 
 def stage_progress(args, label: str, after_s: float = 0.0, clock=time.monotonic):
-    """A progress(stage, done, total) callback: one stderr line when a stage starts (once
+    """A :data:`~cadcnc.core.progress.Progress` ``(done, total, stage)``: one stderr line when a stage starts (once
     ``after_s`` seconds have passed) and then at least every HEARTBEAT_S seconds while
     it runs, with its count; None with --quiet. ``clock`` is injectable for tests."""
     if args.quiet:
@@ -34,7 +34,7 @@ def stage_progress(args, label: str, after_s: float = 0.0, clock=time.monotonic)
     start = clock()
     beat = Heartbeat(say_error, HEARTBEAT_S, clock)
 
-    def report(stage: str, done: int, total: int) -> None:
+    def report(done: int, total: int, stage: str) -> None:
         if clock() - start < after_s:
             return
         text = f"cadcnc: {label}: {stage} ..." if stage not in seen else \

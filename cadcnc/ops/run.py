@@ -42,6 +42,9 @@ class RunOptions:
 
 
 class Planner(Protocol):
+    """``plan(part, job, options) -> Program``: one operation's program of ``job`` on
+    ``part`` (already in the job's setup, its clearance checked)."""
+
     def __call__(self, part: Part, job: Job, options: RunOptions) -> Program: ...
 
 

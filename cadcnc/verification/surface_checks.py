@@ -60,11 +60,11 @@ def check_pair(toolpath, probes: dict[int, FaceProbe], tol: Tolerances, n_unseed
         if n is None:  # a guide surface: the centres lie on it by construction
             continue
         if progress:
-            progress("surfaces", side, 2)
+            progress(side, 2, "surfaces")
         tick = None
         if progress:
             def tick(k, n_points, side=side):
-                progress("surfaces", side * n_points + k, 2 * n_points)
+                progress(side * n_points + k, 2 * n_points, "surfaces")
         out.append(check_surface(probes[n], n, float(toolpath.offsets[side]),
                                  toolpath.points, toolpath.uv[:, side], n_unseeded, tol,
                                  tick, bounded))

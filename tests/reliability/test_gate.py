@@ -229,8 +229,8 @@ def test_the_gate_reports_progress():
     part, tp = boss()
     calls = []
     gouge_gate(tp, part, moves=tp.points[:50], progress=lambda *a: calls.append(a))
-    assert {c[0] for c in calls} == {"surfaces", "whole part", "moves"}
-    assert all(0 <= done <= total for _, done, total in calls)
+    assert {c[2] for c in calls} == {"surfaces", "whole part", "moves"}
+    assert all(0 <= done <= total for done, total, _ in calls)
 
 
 # -- defect 8: verify's verdict ---------------------------------------------------------------
