@@ -173,8 +173,8 @@ class Finishing:
     strategy: ClassVar[str]
     NEEDS: ClassVar[tuple[tuple[frozenset, ...], str]]
 
-    def _check(self) -> None:
-        """Validate and normalise every field in place (called by ``__post_init__``)."""
+    def __post_init__(self):
+        """Validate and normalise every field in place (the records' dataclass calls it)."""
         if isinstance(self.faces, (tuple, list)) and not self.faces:
             raise InputError("finishing needs at least one face")
         self._set("faces", check_faces(self.faces))
@@ -256,9 +256,6 @@ class Raster(Finishing):
     NEEDS: ClassVar = ((frozenset({"stepover"}), frozenset({"scallop"})),
                        "stepover or scallop (stepdown is for waterline)")
 
-    def __post_init__(self):
-        self._check()
-
     def _check_spacings(self) -> None:
         if (self.stepover is None) == (self.scallop is None):
             raise InputError("give exactly one of stepover (the planes' spacing, mm) and "
@@ -283,9 +280,6 @@ class Waterline(Finishing):
     NEEDS: ClassVar = ((frozenset({"stepdown"}), frozenset({"scallop"})),
                        "exactly one of stepdown and scallop")
 
-    def __post_init__(self):
-        self._check()
-
 
 @dataclass(frozen=True)
 class SteepShallow(Finishing):
@@ -307,9 +301,6 @@ class SteepShallow(Finishing):
     strategy: ClassVar[str] = "steep-shallow"
     NEEDS: ClassVar = ((frozenset({"scallop"}), frozenset({"stepover", "stepdown"})),
                        "scallop alone, or both stepover (raster) and stepdown (waterline)")
-
-    def __post_init__(self):
-        self._check()
 
     def raster(self) -> Raster:
         """The raster of the shallow region: the same faces, spacing, angle and pattern."""

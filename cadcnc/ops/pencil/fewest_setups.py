@@ -34,7 +34,8 @@ from ...program.transform import in_part_coordinates
 from ...core.units import check_axis
 from ..common import safe_height
 from ..entries import entered_program_segments
-from .pencil_program import CHAIN_GAP, pencil_program
+from ..run import RunOptions, operation_of
+from .pencil_program import CHAIN_GAP
 
 SPACING = 0.5      # mm between two positions along a concave edge
 REACH_RADII = 5.0  # a ball centre farther than this many R' from its corner's edge counts nothing
@@ -121,13 +122,14 @@ def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
     part = original_part(part)
     samples = _positions(part, job)
     runs, keys = [], []
+    extra = {} if max_cycles is None else {"max_cycles": max_cycles}
+    options = RunOptions(progress=progress, jobs=jobs, **extra)
     for axis in axes:
         sub = replace(job, axis=axis, origin=None if axis != job.axis else job.origin)
         sp = setup_part(part, sub)
         setup = setup_in(sp) or Setup(np.asarray(axis), np.eye(3), np.zeros(3))
-        extra = {} if max_cycles is None else {"max_cycles": max_cycles}
         try:
-            program = pencil_program(sp, sub, progress=progress, jobs=jobs, **extra)
+            program = operation_of(sub).plan(sp, sub, options)   # the Pencil's planner
             error = ""
         except NothingToCutError as e:
             program, error = Program(sub), str(e)
