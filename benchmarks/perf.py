@@ -13,7 +13,7 @@ sections not run keep their text. Sections:
   latency, whole path against GeomAPI_IntSS, memory, landing);
 - ``operations``: ``cadcnc.finish`` on the free-form slab (``benchmarks.finishing``; with
   ``--ocl`` OpenCAMLib's drop-cutter beside it, needs ``pip install -e '.[bench]'``), the
-  gouge gate (``benchmarks.kernel.bench_gate``), ``cadcnc.pencil`` on fixtures and on any
+  gouge gate (``benchmarks.kernel.bench_gate``), ``cadcnc.run`` of a Pencil on fixtures and on any
   ``--part``;
 - ``coverage``: path coverage judged independently (``benchmarks.coverage.pair_coverage``):
   every concave pair of pocket.step at R 3 (quick), of every fixture at R 3 and R 2 (full).
@@ -170,10 +170,11 @@ def pencil(names: list[str], parts: list[Path]) -> list[str]:
         log(f"operations: pencil on {path.name}")
         t0 = clock()
         part = cadcnc.load_step(path)
-        program = cadcnc.pencil(part, radius=3.0)
+        program = cadcnc.run(part, cadcnc.Job(cadcnc.Tool(3.0), 1500.0, 0.004,
+                                              cadcnc.Pencil(), source=part.source))
         wall = clock() - t0
         skipped = f", {len(program.skipped)} skipped" if program.skipped else ""
-        rows.append(f"| `cadcnc.pencil` on {path.name} ({len(part.faces)} faces), R 3 "
+        rows.append(f"| `cadcnc.run` of a Pencil on {path.name} ({len(part.faces)} faces), R 3 "
                     f"| {wall:.1f} s wall, {len(program.cuts)} cuts{skipped} "
                     "| [pencil.md](pencil.md#current-figures) |")
     return rows

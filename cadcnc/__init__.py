@@ -1,11 +1,15 @@
 """cadcnc: direct interpolation of ball-end cutter paths along the intersection of two faces.
 
-Data flow (docs/architecture.md): STEP/CadQuery shape -> :class:`Part` (faces, adjacency)
--> :class:`FaceSurface` (derivatives, normals, curvature, trims) -> interpolation core
-(one cycle at a time, :class:`Stepper`) -> :class:`Toolpath` -> writers, verification,
-plots. Units: mm, mm/min, s.
+The public API (docs/api.md): a part (:class:`Part`, :func:`load_step`), a job
+(:class:`Job`, :class:`Tool` and one operation record: :class:`PairPath`,
+:class:`Pencil`, :class:`Raster`, :class:`Waterline`, :class:`SteepShallow`), the one way
+to run every operation (:func:`run`; :func:`finish`, the finishing shortcut of a CadQuery
+script), the :class:`Program` it returns (:func:`read_program`), the gate
+(:func:`gate_program`), CQ-editor (:func:`show_program`), the real-time stepper
+(:func:`make_stepper`) and the errors' root (:class:`CadcncError`, :class:`InputError`).
+Everything else is in its stage's module (docs/architecture.md). Units: mm, mm/min, s.
 
-The names below are loaded on first use: importing OCCT takes about 1.5 s, which
+The names that need OCCT are loaded on first use: importing OCCT takes about 1.5 s, which
 ``import cadcnc`` (and ``cadcnc --help``) should not pay before it is needed.
 """
 
@@ -13,39 +17,21 @@ from __future__ import annotations
 
 import importlib
 
-from .core.errors import (
-    CadcncError, FaceNumberError, FacePairError, GeometryError, InputError, OutputError,
-    SingularPointError, StartPointError, StepFileError,
-)
-from .core.job import Finish, Job, PairPath, Pencil, Tool
-from .batch import batch  # the function: the name `cadcnc.batch` is not the package
-from .core.tolerances import Tolerances
+from .core.errors import CadcncError, InputError
+from .core.job import Job, PairPath, Pencil, Raster, SteepShallow, Tool, Waterline
 
 __version__ = "0.1.0"
 
 _LAZY = {
-    "FaceSurface": "geometry.face_surface",
-    "Part": "geometry.part", "SharedEdge": "geometry.part", "load_step": "geometry.part",
-    "Stepper": "interp.stepper", "Tangency": "interp.stepper",
-    "intersection_path": "ops.path.pair_path", "intersection_paths": "ops.path.pair_path",
-    "make_stepper": "ops.path.pair_path", "path_for_job": "ops.path.pair_path",
-    "Toolpath": "program.toolpath",
-    "VerificationReport": "verification", "verify": "verification",
-    "gouge_gate": "verification",
-    "pencil": "ops.pencil.setups", "finish": "ops.finish.finish", "Program": "program.program",
-    "to_cq": "io.program_cq", "to_cq_compound": "io.program_cq",
-    "show_program": "io.program_cq",
-    "run": "ops.run", "program_for_job": "ops.path.pair_program",
-    "pencil_program": "ops.pencil.pencil", "finish_program": "ops.finish.finish",
-    "gate_program": "verification", "read_program": "io.program_json",
-    "BatchPart": "batch.task", "BatchOperation": "batch.task", "Settings": "batch.operate",
+    "Part": "geometry.part", "load_step": "geometry.part",
+    "run": "ops.run", "finish": "ops.finish.shortcut",
+    "Program": "program.program", "read_program": "io.program_json",
+    "gate_program": "verification", "show_program": "io.program_cq",
+    "make_stepper": "ops.path.pair_path",
 }
 
-__all__ = [
-    "CadcncError", "FaceNumberError", "FacePairError", "GeometryError", "InputError",
-    "OutputError", "SingularPointError", "StartPointError", "StepFileError", "Job",
-    "PairPath", "Pencil", "Finish", "Tool", "Tolerances", "batch", *_LAZY,
-]
+__all__ = ["CadcncError", "InputError", "Job", "Tool", "PairPath", "Pencil", "Raster",
+           "Waterline", "SteepShallow", *_LAZY]
 
 
 def __getattr__(name: str):

@@ -6,6 +6,7 @@ import os
 import re
 
 from helpers.fixtures import ROOT
+from helpers.programs import pencil_run
 
 
 def test_api_examples_run(monkeypatch):
@@ -18,8 +19,8 @@ def test_api_examples_run(monkeypatch):
     for block in blocks:
         exec(compile(block, "docs/api.md", "exec"), namespace)
     assert namespace["path"].stop_reason == "closed"
-    assert (namespace["same"].points == namespace["path"].points).all()
-    assert namespace["job"].step == 0.1 and namespace["same"].job.operation.faces == (4, 5)
+    assert namespace["job"].step == 0.1 and namespace["corner"].job.operation.faces == (4, 5)
+    assert namespace["program"].complete and namespace["program"].cuts
     assert namespace["stepper"].stop_reason == "closed"
     assert len(sent) == namespace["stepper"].cycles
     assert os.path.exists(ROOT / "fixtures" / "bspline_boss.step")
@@ -50,10 +51,21 @@ def test_show_program_shows_a_part_as_a_cadquery_shape():
     from helpers.fixtures import load_fixture
 
     part = load_fixture("bspline_boss")
-    program = cadcnc.pencil(part, radius=3.0)
+    program = pencil_run(part, radius=3.0)
     shown = {}
     cadcnc.show_program(lambda obj, name="", options=None: shown.__setitem__(name, obj),
                         program, part)
     assert set(shown) == {"part", "cuts", "links"}
     assert isinstance(shown["part"], cq.Shape) and shown["part"].isValid()
     assert all(isinstance(shown[k], cq.Compound) for k in ("cuts", "links"))
+
+
+def test_the_top_level_names_are_the_ones_docs_api_lists():
+    """``cadcnc``'s public names (about 15) are those of docs/api.md's table, each loads."""
+    import cadcnc
+
+    table = (ROOT / "docs" / "api.md").read_text().split("## The names")[1].split("\n## ")[0]
+    listed = {name for row in table.splitlines() if row.startswith("| `")
+              for name in re.findall(r"`(\w+)`", row.split("|")[1])}
+    assert listed == set(cadcnc.__all__) and len(listed) <= 20
+    assert all(getattr(cadcnc, name) is not None for name in listed)

@@ -23,6 +23,8 @@ MUTATORS = {"append", "extend", "insert", "add", "update", "setdefault", "pop", 
 OWNED = {
     "cadcnc.parallel.pool._IN_WORKER":
         "a worker process: the part its pool's initializer rebuilt, for the worker's life",
+    "cadcnc.ops.run.REGISTRY":
+        "the operations module: each record type's planner, registered once at its import",
 }
 """Module-level containers that functions change, with their owner and lifetime."""
 

@@ -26,6 +26,7 @@ import time
 from pathlib import Path
 
 import cadcnc
+from cadcnc.core.tolerances import Tolerances
 from cadcnc.batch.engine import batch, connect
 from cadcnc.batch.operate import Settings
 from cadcnc.batch.task import BatchOperation, BatchPart
@@ -38,7 +39,7 @@ STEP_SUFFIXES = (".step", ".stp")
 
 def parts_of(folder: Path, radius: float) -> list[BatchPart]:
     """Pencil R ``radius`` at 1500 mm/min, 4 ms, on every STEP file of ``folder``."""
-    tol = cadcnc.Tolerances()
+    tol = Tolerances()
     settings = Settings(gcode=dict(tolerance=None, tool_tip=False, blend=blend_for(tol.gouge)))
     out = []
     for path in sorted(p for p in folder.iterdir() if p.suffix.lower() in STEP_SUFFIXES):

@@ -31,10 +31,9 @@ from cadcnc.controller.feed_plan import plan_feed
 from cadcnc.controller.pieces import pieces_of
 from cadcnc.controller.stream import LANDING, follow_plan
 from cadcnc.interp.follow import follow
-from cadcnc.ops.finish.finish import finish
+from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
-from cadcnc.ops.pencil.pencil import pencil
 from cadcnc.ops.stream_steppers import stepper_factory
 
 FIXTURES = Path(__file__).resolve().parents[2] / "fixtures"
@@ -45,7 +44,8 @@ def programs():
     _, _, job = pair_job(part.face(4), part.face(5), radius=3.0, feed=1500.0, period=0.004)
     yield "corner bspline_boss 4 5", part, program_for_job(part, job)
     part = cadcnc.load_step(FIXTURES / "step_block.step")
-    yield "pencil step_block", part, pencil(part, radius=3.0)
+    yield "pencil step_block", part, cadcnc.run(part, cadcnc.Job(
+        cadcnc.Tool(3.0), 1500.0, 0.004, cadcnc.Pencil(), source=part.source))
     part = cadcnc.load_step(FIXTURES / "finish_fillet.step")
     yield "finish finish_fillet 6 3", part, finish(part, [6, 3], radius=3.0, stepover=10.0)
 

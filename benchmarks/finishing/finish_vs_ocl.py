@@ -68,17 +68,17 @@ class Stopwatch:
     """Seconds spent in named functions of cadcnc's finishing (wrapped in place while a
     run is timed; a wrapper costs about 0.3 µs a call): where cadcnc's time goes."""
 
-    WATCHED = [("cadcnc.ops.finish.finish", "plan_for_job", "planning (planes, face sampling)"),
-               ("cadcnc.ops.finish.finish", "uncut_report", "uncut report"),
+    WATCHED = [("cadcnc.ops.finish.raster", "plan_for_job", "planning (planes, face sampling)"),
+               ("cadcnc.ops.finish.raster", "uncut_report", "uncut report"),
                ("cadcnc.ops.finish.uncut", "_reasons",
                 "of which reasons (guard on samples)"),
-               ("cadcnc.ops.finish.finish", "entered_program_segments",
+               ("cadcnc.ops.finish.raster", "entered_program_segments",
                 "entries and links (zigzag links verified)"),
                ("cadcnc.guard.stay_down", "witness",
                 "of which stay-down witnesses (refutations)"),
                ("cadcnc.guard.moves", "MoveClearance.distance",
                 "of which stay-down checks (OCCT)"),
-               ("cadcnc.ops.finish.finish", "pass_cuts", "passes (stepping, guard, exact step)"),
+               ("cadcnc.ops.finish.raster", "pass_cuts", "passes (stepping, guard, exact step)"),
                ("cadcnc.ops.finish.passes", "_Pass.exact", "points onto the exact offset"),
                ("cadcnc.guard.clearance", "ClearanceGuard.margin",
                 "clearance guard (every face, ball and shank)"),

@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 import cadcnc
-from cadcnc.ops.finish.finish import finish
+from cadcnc.ops.finish.shortcut import finish
 from cadcnc.geometry.offset_section import loop_count, offset_face
 from cadcnc.verification import gate_program
 from benchmarks import ROOT

@@ -17,6 +17,7 @@ import resource
 import time
 
 import cadcnc
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.verification import gouge_gate
 
 from benchmarks import ROOT
@@ -41,7 +42,7 @@ def measure(case: str, cycles: int) -> dict:
     feed = 60.0 * step / PERIOD
     base = peak_mb()
     t0 = time.perf_counter()
-    tp = cadcnc.intersection_path(part.face(i), part.face(j), radius=radius, feed=feed,
+    tp = intersection_path(part.face(i), part.face(j), radius=radius, feed=feed,
                                   period=PERIOD, max_cycles=10 * cycles)
     t1 = time.perf_counter()
     after_path = peak_mb()
@@ -51,7 +52,7 @@ def measure(case: str, cycles: int) -> dict:
     return {"case": case, "faces": (i, j), "radius": radius, "step": step, "feed": feed,
             "cycles": len(tp), "stop": tp.stop_reason, "path_s": t1 - t0, "gate_s": t2 - t1,
             "ok": gate.ok, "depth_mm": gate.depth_mm, "progress": len(calls),
-            "stages": sorted({c[0] for c in calls}),
+            "stages": sorted({c[2] for c in calls}),
             "peak_mb": (base, after_path, peak_mb())}
 
 

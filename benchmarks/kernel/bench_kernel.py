@@ -35,6 +35,7 @@ from OCP.gp import gp_Pnt, gp_Vec
 
 import cadcnc
 from cadcnc.interp.compiled import new_stepper
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.ops.path.pair_path import pair_job, plan_path
 
 from benchmarks import ROOT
@@ -130,7 +131,7 @@ def whole_path(part, i: int, j: int, cold: bool = True) -> dict:
         for f in (fa, fb):
             f.clear_caches()
     t0, c0 = clock(), cpu_clock()
-    tp = cadcnc.intersection_path(fa, fb, radius=R, feed=FEED, period=PERIOD)
+    tp = intersection_path(fa, fb, radius=R, feed=FEED, period=PERIOD)
     cpu, wall = cpu_clock() - c0, clock() - t0
     grids = sum(f.kernel[1].stats["build_s"] for f in (fa, fb)) * 1e9 if cold else 0.0
     return {"wall": wall / 1000.0, "cpu": cpu / 1000.0, "grids": grids / 1000.0,

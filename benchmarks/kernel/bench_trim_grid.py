@@ -28,6 +28,7 @@ from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
 import cadcnc
+from cadcnc.core.errors import StepFileError
 from cadcnc.geometry.face_surface import FaceSurface
 from cadcnc.geometry.trim_grid import CELL_MIXED, TrimGrid, classifier_tolerance
 from cadcnc.interp.kernel.trim_lookup import lookup, wrap
@@ -42,7 +43,7 @@ def faces_of(path: Path) -> list[FaceSurface]:
     """The part's faces; a surface model (no solid) is read with OCCT directly."""
     try:
         return cadcnc.load_step(path).faces
-    except cadcnc.StepFileError:
+    except StepFileError:
         reader = STEPControl_Reader()
         if reader.ReadFile(str(path)) != IFSelect_RetDone:
             raise

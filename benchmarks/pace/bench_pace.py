@@ -32,7 +32,7 @@ import cadcnc
 from cadcnc.io.gcode import blend_for
 from cadcnc.io.outputs import render
 from cadcnc.io.program_gcode import program_written_moves
-from cadcnc.core.job import Finish, Job, Pencil, Tool
+from cadcnc.core.job import Raster, Job, Pencil, Tool
 from cadcnc.ops.common import safe_height
 from cadcnc.ops.run import cut_back_gap
 from cadcnc.verification import gate_program
@@ -53,7 +53,7 @@ def slab_case(folder: str) -> tuple[str, Job]:
     writer.Transfer(freeform_slab.slab_shape(), STEPControl_AsIs)
     writer.Write(path)
     top = freeform_slab.top_face_number(cadcnc.load_step(path))
-    return path, Job(Tool(3.0, 0.0), 1500.0, 0.004, Finish((top,), 1.0, None, 0.0, "zigzag"),
+    return path, Job(Tool(3.0, 0.0), 1500.0, 0.004, Raster((top,), 1.0, None, 0.0, "zigzag"),
                      source=path)
 
 

@@ -21,7 +21,7 @@ import time
 import cadcnc
 from cadcnc.io.outputs import render
 from cadcnc.ops.finish import finish
-from cadcnc.ops.pencil import pencil
+from cadcnc.ops.pencil import pencil_program as pencil  # the module
 from benchmarks.pace.bench_pace import pencil_case, slab_case
 
 

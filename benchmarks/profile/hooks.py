@@ -19,8 +19,8 @@ import time
 STAGES = {   # stage name: (module, attribute path)
     "load": ("cadcnc.geometry.part", "load_step"),
     "run": ("cadcnc.ops.run", "run"),
-    "setups": ("cadcnc.ops.pencil.setups", "pencil_setups"),
-    "finish": ("cadcnc.ops.finish.finish", "finish_program"),
+    "setups": ("cadcnc.ops.pencil.fewest_setups", "pencil_setups"),
+    "finish": ("cadcnc.ops.finish.raster", "raster_program"),
     "corners": ("cadcnc.ops.pencil.corners", "find_corners"),
     "stretches": ("cadcnc.ops.path.stretches", "pair_stretches"),
     "limits": ("cadcnc.ops.path.stretches", "locate_limit"),

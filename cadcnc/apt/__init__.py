@@ -21,7 +21,7 @@ Three stages, each complete before the next, one module each:
 
 - :mod:`~cadcnc.apt.grammar`: :func:`parse`, text to statements (syntax only; errors
   name line and column);
-- :mod:`~cadcnc.apt.program`: :func:`entries` / :func:`read_program`, statements to one
+- :mod:`~cadcnc.apt.program_entries`: :func:`entries` / :func:`read_program`, statements to one
   :class:`ProgramEntry` per PATH (its name, line and validated :class:`~cadcnc.core.job.Job`);
 - :mod:`~cadcnc.apt.execute`: :func:`check` loads the parts and checks face numbers and
   EDGE ends before any path is computed, then :func:`run_job` / :func:`stream_job` per
@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from .execute import check, run_job, stream_job
 from .grammar import Endpoint, Statement, Token, parse, tokenize
-from .program import ProgramEntry, entries, read_program, title
+from .program_entries import ProgramEntry, entries, read_program, title
 
 __all__ = ["Endpoint", "ProgramEntry", "Statement", "Token", "check", "entries", "parse",
            "read_program", "run_job", "stream_job", "title", "tokenize"]

@@ -13,7 +13,7 @@ from dataclasses import replace
 from ..core.errors import CadcncError, InputError
 from ..geometry.part import load_step
 from ..ops.path.pair_path import path_for_job, plan_path, shared_edge_for, stepper_for
-from .program import ProgramEntry
+from .program_entries import ProgramEntry
 
 
 def _at(entry: ProgramEntry, e: CadcncError, source: str) -> CadcncError:
@@ -72,7 +72,7 @@ def _checked(entry: ProgramEntry, source: str):
 def run_job(entry: ProgramEntry, part, progress=None, source: str = "<program>"):
     """The :class:`~cadcnc.program.toolpath.Toolpath` of one checked entry.
 
-    ``progress(cycles, mm)`` is called every 10 000 cycles.
+    ``progress(cycles, 0, "<mm> mm")`` is called every 10 000 cycles.
     """
     _checked(entry, source)
     try:

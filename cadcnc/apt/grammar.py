@@ -2,7 +2,7 @@
 
 Pure syntax: no file system, no geometry, no ranges. A statement carries its values in
 user units (mm, mm/min, s) and, in ``where``, the (line, column) of each value, so that
-the program stage (:mod:`cadcnc.apt.program`) can report a value the :class:`~cadcnc.core.job.Job`
+the program stage (:mod:`cadcnc.apt.program_entries`) can report a value the :class:`~cadcnc.core.job.Job`
 refuses at the place it was written. The checks here are the grammar's own: token kinds,
 the period's unit, face and edge numbers being whole numbers, edges numbered from 1.
 """
@@ -288,6 +288,6 @@ def parse(text: str, source: str = "<program>") -> list[Statement]:
     """Statements of a program; :class:`ProgramSyntaxError` names line and column.
 
     Syntax only: a value out of range (R < 0, FEED/0) is refused when the program's jobs
-    are built (:func:`cadcnc.apt.program.entries`), at the value's line and column.
+    are built (:func:`cadcnc.apt.program_entries.entries`), at the value's line and column.
     """
     return _Parser(tokenize(text, source), source).program()

@@ -2,8 +2,8 @@
 operations as one task on an embedded local cluster or an existing one, writes each
 part's outputs to its own folder and returns the summary's records.
 
-:func:`cadcnc.batch` is this package's :func:`batch` (``import cadcnc`` binds the name to
-the function; the modules stay importable as ``cadcnc.batch.engine`` and so on).
+:func:`cadcnc.batch.batch` is the entry (``from cadcnc.batch import batch``); the modules
+are ``cadcnc.batch.engine`` and so on.
 """
 
 from __future__ import annotations

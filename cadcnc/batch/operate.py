@@ -81,7 +81,7 @@ def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progr
             times: dict | None = None, gate_progress=None) -> Outcome:
     """Run ``job`` on the STEP file ``step`` and judge it (module doc). ``what``: the
     command's name in messages ("pencil"); ``progress`` and ``times``: as
-    :func:`cadcnc.run`; ``gate_progress``: the gate's ``(stage, done, total)`` callback.
+    :func:`cadcnc.run`; ``gate_progress``: the gate's ``(done, total, stage)`` callback.
     Raises the library's errors (bad face number, nothing to cut, ...)."""
     if settings.max_cycles < 1:
         raise InputError(f"--max-cycles must be at least 1, got {settings.max_cycles}")

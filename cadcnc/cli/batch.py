@@ -35,7 +35,7 @@ def add_parser(add, commands) -> None:
 
 
 def batch_command(args) -> int:
-    import cadcnc
+    from cadcnc.batch import batch
     from cadcnc.batch.records import batch_exit, summary_table
     from cadcnc.core.work_limits import sigterm_as_interrupt
 
@@ -46,9 +46,9 @@ def batch_command(args) -> int:
     parts = batch_parts(job, args.commands)
     report = None if args.quiet else (lambda p: say_error(f"cadcnc: batch: {p}"))
     with sigterm_as_interrupt():   # the local cluster shut down as after Ctrl-C
-        records = cadcnc.batch(parts, job.out, scheduler=args.scheduler,
-                               workers=args.workers, force=args.force, progress=report,
-                               inputs=[args.jobfile])
+        records = batch(parts, job.out, scheduler=args.scheduler,
+                        workers=args.workers, force=args.force, progress=report,
+                        inputs=[args.jobfile])
     code = batch_exit(records)
     if not args.quiet:
         print(summary_table(records))

@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 
 from cadcnc.geometry.part import load_step
-from cadcnc.geometry.report import concave_edges, faces_report
+from cadcnc.geometry.faces_report import concave_edges, faces_report
 
 from .feedback import say_error
 

@@ -11,18 +11,19 @@ def say_error(text: str) -> None:
 
 
 def progress(args, label: str):
-    """A progress(cycles, mm) callback printing to stderr, or None with --quiet."""
+    """A path's :data:`~cadcnc.core.progress.Progress` (``done`` cycles, ``what`` the mm
+    travelled) printing to stderr, or None with --quiet."""
     if args.quiet:
         return None
 
-    def report(cycles: int, mm: float) -> None:
-        say_error(f"cadcnc: {label}: {cycles} cycles, {mm:.1f} mm")
+    def report(done: int, total: int, what: str) -> None:
+        say_error(f"cadcnc: {label}: {done} cycles, {what}")
 
     return report
 
 
 def stage_progress(args, label: str, after_s: float = 0.0, clock=time.monotonic):
-    """A progress(stage, done, total) callback: one stderr line when a stage starts (once
+    """A :data:`~cadcnc.core.progress.Progress` ``(done, total, stage)``: one stderr line when a stage starts (once
     ``after_s`` seconds have passed) and then at least every HEARTBEAT_S seconds while
     it runs, with its count; None with --quiet. ``clock`` is injectable for tests."""
     if args.quiet:
@@ -33,7 +34,7 @@ def stage_progress(args, label: str, after_s: float = 0.0, clock=time.monotonic)
     start = clock()
     beat = Heartbeat(say_error, HEARTBEAT_S, clock)
 
-    def report(stage: str, done: int, total: int) -> None:
+    def report(done: int, total: int, stage: str) -> None:
         if clock() - start < after_s:
             return
         text = f"cadcnc: {label}: {stage} ..." if stage not in seen else \

@@ -10,7 +10,7 @@ from pathlib import Path
 from cadcnc.batch.operate import Settings
 from cadcnc.core.errors import InputError
 from cadcnc.io.gcode import blend_for
-from cadcnc.core.job import Finish, Job, PairPath, Pencil, Tool, check_number
+from cadcnc.core.job import Job, PairPath, Pencil, Tool, check_number, finishing
 from cadcnc.core.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT, Tolerances
 from cadcnc.core.units import parse_duration, parse_feed, parse_length, parse_point
 from cadcnc.parallel.pool import check_jobs
@@ -93,9 +93,9 @@ def finish_job(args, source: str) -> Job:
     except ValueError:
         raise InputError(f"--angle, --threshold: expected degrees, got {args.angle!r}, "
                          f"{args.threshold!r}") from None
-    return job_of(args, Finish(args.faces, angle=angle, pattern=args.pattern,
-                               strategy=args.strategy, threshold=threshold, side=args.side,
-                               overlap=parse_length(args.overlap, "overlap"), **spacing),
+    return job_of(args, finishing(args.strategy, args.faces, angle=angle,
+                                  pattern=args.pattern, threshold=threshold, side=args.side,
+                                  overlap=parse_length(args.overlap, "overlap"), **spacing),
                   source)
 
 

@@ -1,6 +1,6 @@
 """``cadcnc pencil PART --setups auto|+Z,-X,...``: the fewest setups, one program each.
 
-The library chooses the setups (:func:`cadcnc.ops.pencil.setups.pencil_setups`); each
+The library chooses the setups (:func:`cadcnc.ops.pencil.fewest_setups.pencil_setups`); each
 chosen setup's program is cut back, gated and judged as ``pencil``'s; every output name
 gets the setup's axis before its suffix (``P.json`` -> ``P+Z.json``, ``P-X.json``), and
 all the setups' outputs are written as one set, all or nothing. The exit code is the
@@ -28,8 +28,8 @@ def setups_command(args) -> int:
     from cadcnc.io.outputs import SUFFIXES, render
     from cadcnc.core.job import PRINCIPAL_AXES
     from cadcnc.ops.common import safe_height
-    from cadcnc.ops.pencil.pencil import CHAIN_GAP
-    from cadcnc.ops.pencil.setups import AUTO, axis_tag, parse_setups, pencil_setups
+    from cadcnc.ops.pencil.pencil_program import CHAIN_GAP
+    from cadcnc.ops.pencil.fewest_setups import AUTO, axis_tag, parse_setups, pencil_setups
     from cadcnc.core.units import parse_length
     from cadcnc.parallel.pool import check_jobs, kept_pools
     from cadcnc.verification.judgement import judge, settle, worst

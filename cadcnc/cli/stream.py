@@ -221,8 +221,8 @@ def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_peri
 
     estimate(plan_feed(pieces_of(program, machine, feed), machine, planned).periods)
 
-    def progress(done: int, total: int) -> None:
-        tick.stage = f"streaming: {done}/{total} periods"
+    def progress(done: int, total: int, what: str) -> None:
+        tick.stage = f"streaming: {done}/{total} {what}"
 
     return stream_program(program, machine, steppers, feed=feed, planned=planned,
                           max_periods=max_periods, progress=progress)

@@ -20,6 +20,7 @@ from typing import Callable
 import numpy as np
 
 from ..core.errors import GeometryError
+from ..core.progress import Progress
 from ..interp.cycle import CLOSED, END
 from ..interp.follow import follow
 from ..program.program import Program
@@ -161,8 +162,6 @@ def _landed(stepper, piece: Piece, out: np.ndarray, what: str) -> np.ndarray:
     return out
 
 
-Progress = Callable[[int, int], None]
-"""progress(periods done, periods in all), called at least every CHUNK periods."""
 CHUNK = 100_000   # periods the kernel follows between two progress calls
 SLACK = 1e-6      # relative: the finite differences' allowance over a limit
 REPLANS = 3       # plans again with the limit that was broken lowered by as much ...
@@ -218,7 +217,7 @@ def _cut_rows(stepper, piece: Piece, s: np.ndarray, what: str, done: int, total:
         out[a:b] = follow(stepper, plan[a:b], piece.points[-1], float(piece.kappa[-1]),
                           LANDING)
         if progress is not None:
-            progress(min(done + b, total), total)
+            progress(min(done + b, total), total, "periods")
     return _landed(stepper, piece, out, what)
 
 
@@ -230,7 +229,7 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
     ``feed`` (mm/min) replaces the program's feed; ``planned=False`` streams at the
     programmed feed ignoring the limits (a comparison, not for a machine). A plan over
     ``max_periods`` periods is refused before any position is computed (InputError);
-    ``progress(done, total)`` hears of the work at least every CHUNK periods. A planned
+    ``progress(done, total, "periods")`` hears of the work at least every CHUNK periods. A planned
     stream whose finite differences break a limit is planned again with that limit
     lowered by as much (REPLANS times at most), then refused (PlanError)."""
     pieces = pieces_of(program, machine, feed)
@@ -278,7 +277,7 @@ def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
     positions[0] = pieces[0].points[0]
     positions[-1] = pieces[-1].points[-1]
     if progress is not None:
-        progress(total, total)
+        progress(total, total, "periods")
     return Stream(positions, plan, programmed_time(pieces, machine), rows, kernel, hermite)
 
 

@@ -11,6 +11,10 @@ from ..program.toolpath import Toolpath, toolpath_from_record
 from ..core.work_limits import MAX_CYCLES, refuse_over
 from .path.pair_path import PathPlan, stepper_for
 
+FINISH_JOIN = 1e-6
+"""mm: a finishing cut starting this near the last one's end continues it (one pass or
+level, chained); also the gap of a finishing program relinked once cut back."""
+
 
 def require_ball(job: Job) -> None:
     """InputError unless the ball has a size: R' = R + C > 0 mm. A ball of R' = 0 runs its
@@ -39,13 +43,14 @@ def safe_height(part, job: Job) -> float:
     return job.clearance if job.clearance is not None else part.top + SAFE_MARGIN
 
 
-def run_stretch(plan: PathPlan, guard, max_cycles: int, progress,
+def run_stretch(plan: PathPlan, guard, max_cycles: int, steps,
                 allow_empty: bool = False) -> Toolpath:
     """Run the plan's stepper with ``guard`` inside it (given to the constructor, so that
     the compiled stepper asks it before committing a step); a path of its start alone is
-    an error unless ``allow_empty`` (the caller then skips it with the stop's reason)."""
+    an error unless ``allow_empty`` (the caller then skips it with the stop's reason);
+    ``steps``: the stepper's own ``(cycles, mm)`` callback, or None."""
     stepper = stepper_for(plan, max_cycles, True, guard=guard)
-    stepper.run(progress)
+    stepper.run(steps)
     if stepper.cycles == 0 and not allow_empty:
         raise GeometryError(f"no path: the interpolator stopped at the start point "
                             f"({stepper.stop_reason}): {stepper.stop_detail}")

@@ -19,7 +19,7 @@ import numpy as np
 from ..interp.compiled import new_stepper
 from ..interp.stepper import Tangency
 from .finish.passes import GuidePlane
-from .finish.setup import GUIDE_MARGIN, guide_face
+from .finish.pass_setup import GUIDE_MARGIN, guide_face
 
 END_REACHED = 1e-12  # mm
 ROLLED = "rolled over"   # the stop detail of a convex roll-over arc (ops/finish/transitions.py)

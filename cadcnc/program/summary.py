@@ -4,7 +4,6 @@ count), the links, what was skipped and why, the notes, the totals and complete 
 
 from __future__ import annotations
 
-from ..core.job import Finish, PairPath, Pencil
 from ..core.units import format_duration
 
 CUT_LINES = 12
@@ -27,24 +26,7 @@ def skipped_counts(program) -> str:
 
 
 def _operation(job) -> str:
-    op = job.operation
-    if isinstance(op, PairPath):
-        return f"path along faces {op.faces[0]} and {op.faces[1]}"
-    if isinstance(op, Pencil):
-        which = "every corner" if op.faces is None else \
-            "corners of faces " + " ".join(map(str, op.faces))
-        return f"pencil, {which}, {op.side}"
-    if isinstance(op, Finish):
-        spacing = ", ".join(f"{k} {getattr(op, k):g} mm" for k in (
-            "stepover", "stepdown", "scallop") if getattr(op, k) is not None)
-        if op.strategy != "raster":
-            how = (f"{op.side}" if op.strategy == "waterline" else
-                   f"threshold {op.threshold:g} deg, overlap {op.overlap:g} mm, {op.side}")
-            return (f"finish faces {' '.join(map(str, op.faces))}, {op.strategy}, "
-                    f"{spacing}, {how}")
-        return (f"finish faces {' '.join(map(str, op.faces))}, {spacing}, angle "
-                f"{op.angle:g} deg, {op.pattern}")
-    return type(op).__name__
+    return job.operation.describe()   # every operation record's own words
 
 
 def _cut_lines(k: int, seg) -> list[str]:

@@ -28,12 +28,12 @@ from __future__ import annotations
 
 from .gate import GateResult, gouge_gate
 from .program_gate import ProgramGate, gate_program
-from .records import (
+from .check_records import (
     Criterion, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, SweepCheck, SweepHit,
     TheoryRow, WholePartCheck, WholePartHit,
 )
 from .report import VerificationReport
-from .run import verify
+from .all_checks import verify
 
 __all__ = [
     "verify", "gouge_gate", "GateResult", "gate_program", "ProgramGate", "VerificationReport", "SurfaceCheck",

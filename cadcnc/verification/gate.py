@@ -19,7 +19,7 @@ from ..core.errors import require
 from dataclasses import dataclass, field
 
 from ..core.tolerances import Tolerances
-from .records import SweepCheck, WholePartHit, strict_max
+from .check_records import SweepCheck, WholePartHit, strict_max
 from .gate_cache import cache_for, toolpath_key
 from .surface_checks import SAMPLE_UNSEEDED, check_pair, prepare, resolve_part
 from .whole_part import check_whole_part
@@ -60,7 +60,7 @@ def gouge_gate(toolpath, part=None, tol: Tolerances | None = None, *, moves=None
     (after point dropping, rounding, the tool-tip offset taken back to centres, and the
     links); default the toolpath's points. ``blend_mm``: how far the machine may leave the
     programmed polyline (G64 P), counted against the limit: every move must keep the ball
-    within ``tol.gouge - blend_mm`` of the part. ``progress(stage, done, total)`` is called
+    within ``tol.gouge - blend_mm`` of the part. ``progress(done, total, stage)`` is called
     as the checks advance ("surfaces", "whole part", "moves"). ``reference``: the gate
     as it was before its work was shared (:mod:`.gate_cache`) and bounded (a sampled
     cycle's exact distance always measured): the same answers, kept to test that.

@@ -37,8 +37,8 @@ def gate_cuts(part, items: list, tol: Tolerances, *, jobs: int | None = 1,
               reference: bool = False, progress=None) -> list[GateResult]:
     """The gate of each ``(toolpath, moves or None, blend_mm)`` of ``items`` on ``part``.
 
-    ``jobs``: processes (None: every core; 1: here, in order). ``progress(stage, done,
-    total)`` with stage "cuts" as each gate ends."""
+    ``jobs``: processes (None: every core; 1: here, in order). ``progress(done, total,
+    "cuts")`` as each gate ends."""
     if part is None and items:  # the part the first cut's job names, read once
         part = resolve_part(items[0][0], None)
     shares = None if reference else cache_for(part, tol).shares
@@ -53,7 +53,7 @@ def gate_cuts(part, items: list, tol: Tolerances, *, jobs: int | None = 1,
         if shares is not None and res[1] is not None:
             shares[res[1][0]] = _merged(shares.get(res[1][0]), res[1])
         if progress is not None:
-            progress("cuts", count[0], len(tasks))
+            progress(count[0], len(tasks), "cuts")
 
     sizes = [len(tp.points) + (0 if moves is None else len(moves)) for tp, moves, _ in items]
     out = on_workers(_gate_task, tasks, part, jobs, arrived, "the gate of cut", sizes=sizes)

@@ -12,7 +12,7 @@ from ..geometry.part import CONCAVE
 from ..core.tolerances import Tolerances
 from ..core.trim_labels import INSIDE
 from .probe import FaceProbe
-from .records import BOUND_NAMES, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, TheoryRow
+from .check_records import BOUND_NAMES, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, TheoryRow
 
 SHORTENED_LAST_STEP = ("end", "closed", "boundary")  # stop reasons that may land short
 

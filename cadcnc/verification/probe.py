@@ -32,7 +32,7 @@ from ..geometry.boxes import optimal_box
 from ..core.tolerances import DEFAULT, Tolerances
 from ..core.trim_labels import BOUNDARY, INSIDE, OUTSIDE
 from .box_face import whole_box
-from .face_edges import FaceEdges
+from .face_boundary import FaceEdges
 
 _STATES = {TopAbs_IN: INSIDE, TopAbs_ON: BOUNDARY}
 NEWTON_PARAMETER_PRECISION = 1e-12

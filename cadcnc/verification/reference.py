@@ -15,7 +15,7 @@ import numpy as np
 
 from ..core.tolerances import DEFAULT, Tolerances
 from . import probe as occt
-from .records import ReferenceCheck
+from .check_records import ReferenceCheck
 
 
 

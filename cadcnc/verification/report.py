@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from ..core.jsonable import plain
 from ..core.tolerances import DEFAULT, Tolerances
-from .records import (
+from .check_records import (
     Criterion, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, SweepCheck, TheoryRow,
     WholePartCheck, WholePartHit, strict_max,
 )

@@ -15,7 +15,7 @@ from ..geometry.setup import setup_part
 from ..core.tolerances import Tolerances
 from ..core.trim_labels import OUTSIDE
 from .probe import FaceProbe
-from .records import SurfaceCheck, cycle_ranges
+from .check_records import SurfaceCheck, cycle_ranges
 
 PERCENTILES = (50, 95, 99)
 SAMPLE_UNSEEDED = 64  # cycles per face re-projected without seeds (plus the worst ones)
@@ -60,11 +60,11 @@ def check_pair(toolpath, probes: dict[int, FaceProbe], tol: Tolerances, n_unseed
         if n is None:  # a guide surface: the centres lie on it by construction
             continue
         if progress:
-            progress("surfaces", side, 2)
+            progress(side, 2, "surfaces")
         tick = None
         if progress:
             def tick(k, n_points, side=side):
-                progress("surfaces", side * n_points + k, 2 * n_points)
+                progress(side * n_points + k, 2 * n_points, "surfaces")
         out.append(check_surface(probes[n], n, float(toolpath.offsets[side]),
                                  toolpath.points, toolpath.uv[:, side], n_unseeded, tol,
                                  tick, bounded))

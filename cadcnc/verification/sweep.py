@@ -92,7 +92,7 @@ class Polyline:
         far = self._far(near)
         for count, k in enumerate(near, 1):
             if self.progress:
-                self.progress(self.stage, count, len(near))
+                self.progress(count, len(near), self.stage)
             if k in far:  # what _face concludes from the loose box alone
                 self.d_lb = np.minimum(self.d_lb, point_box_distance(pts, *self.faces.loose[k]))
             else:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 
-from .records import Criterion
+from .check_records import Criterion
 
 
 def criteria(rep, gouge_mm: float | None = None) -> list[Criterion]:

@@ -18,7 +18,7 @@ from scipy.spatial import cKDTree
 
 from ..core.tolerances import Tolerances
 from .probe import FaceProbe
-from .records import SurfaceCheck, SweepCheck, SweepHit, WholePartCheck, WholePartHit, cycle_ranges
+from .check_records import SurfaceCheck, SweepCheck, SweepHit, WholePartCheck, WholePartHit, cycle_ranges
 from .material import Material, PartFaces
 from .sweep import Polyline
 

@@ -3,7 +3,7 @@
 A block whose two long top edges are rounded (r 4 mm): a 2 mm ball finishes the top and
 both rounds in zigzag passes along them, 1 mm apart. ``cadcnc.finish`` takes the
 Workplane and a Workplane selection of its faces; ``cadcnc.show_program`` shows the
-program with ``show_object`` (``cadcnc.to_cq`` gives its wires). Run:
+program with ``show_object`` (``cadcnc.io.program_cq.to_cq`` gives its wires). Run:
 ``python docs/examples/finish_example.py``.
 """
 

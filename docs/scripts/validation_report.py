@@ -26,6 +26,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 import cadcnc  # noqa: E402
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.verification import verify  # noqa: E402
 
 STEPS = (0.1, 0.2, 0.5, 1.0)
@@ -54,7 +55,7 @@ def run():
         part = parts.setdefault(name, cadcnc.load_step(ROOT / "fixtures" / file))
         radius = SMALL.get(name, 3.0)
         for f in STEPS:
-            tp = cadcnc.intersection_path(part.face(i), part.face(j), radius=radius,
+            tp = intersection_path(part.face(i), part.face(j), radius=radius,
                                           feed=f / PERIOD * 60, period=PERIOD)
             if len(tp) < 2:
                 rows.append((name, i, j, radius, f, None, tp))

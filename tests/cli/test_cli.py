@@ -14,7 +14,8 @@ import shutil
 import numpy as np
 import pytest
 
-import cadcnc
+from cadcnc.core.errors import StepFileError
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.cli.app import main
 from cadcnc.io import read_csv, read_json
 
@@ -136,7 +137,7 @@ def test_errors_are_one_line_with_exit_codes(tmp_path, args, code, message):
 
 
 def test_debug_raises_instead_of_one_line(tmp_path):
-    with in_folder(tmp_path), pytest.raises(cadcnc.StepFileError, match="nope.step"):
+    with in_folder(tmp_path), pytest.raises(StepFileError, match="nope.step"):
         main(["faces", "nope.step", "--debug"])
 
 
@@ -169,7 +170,7 @@ def test_run_writes_every_path(program_run, boss_api):
     np.testing.assert_array_equal(boss.points, boss_api.points)
     saddle = read_json(d / "job-SADDLE.json")
     part = load_fixture("crossing_cylinders")
-    want = cadcnc.intersection_path(part.face(1), part.face(2), radius=3.0, feed=1500.0,
+    want = intersection_path(part.face(1), part.face(2), radius=3.0, feed=1500.0,
                                     period=0.004, edge=1)
     np.testing.assert_array_equal(saddle.points, want.points)
 

@@ -63,7 +63,7 @@ def test_a_long_stage_reports_at_least_every_five_seconds():
                                          clock=lambda: now[0])
         for k in range(100):          # 100 steps of 0.7 s of one stage
             now[0] += 0.7
-            report("moves", k, 100)
+            report(k, 100, "moves")
     finally:
         feedback.say_error = feedback_say
     assert lines[0] == "cadcnc: gate: moves ..." and "/100" in lines[-1]

@@ -13,14 +13,14 @@ import pytest
 import cadcnc
 from cadcnc.controller import Machine, stream_program
 from cadcnc.controller.feed_plan import PlanError
-from cadcnc.ops.finish.finish import finish
+from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
-from cadcnc.ops.pencil.pencil import pencil
 from cadcnc.ops.stream_steppers import stepper_factory
 
 from cadcnc.testing.topp_bound import va_bound
 from helpers.fixtures import FIXTURES
+from helpers.programs import pencil_run
 
 pytestmark = pytest.mark.slow
 
@@ -40,7 +40,7 @@ def _corner():
 
 def _pencil():
     part = cadcnc.load_step(FIXTURES / "step_block.step")
-    return part, pencil(part, radius=3.0)
+    return part, pencil_run(part, radius=3.0)
 
 
 def _finish():
@@ -135,7 +135,7 @@ def test_a_link_move_of_a_micrometre_streams():
     """fillet_pocket's pencil has a link move of about 1e-6 mm between two corners: a run
     of its own, from rest to rest, in finite time and within every limit."""
     part = cadcnc.load_step(FIXTURES / "fillet_pocket.step")
-    prog = pencil(part, radius=3.0)
+    prog = pencil_run(part, radius=3.0)
     m = Machine.default()
     stream = stream_program(prog, m, stepper_factory(part), feed=FAST)
     assert np.isfinite(stream.cycle_time) and stream.periods > 1000

@@ -13,13 +13,13 @@ from scipy.spatial import cKDTree
 import cadcnc
 from cadcnc.controller import Machine, stream_program
 from cadcnc.interp.follow import follow
-from cadcnc.ops.finish.finish import finish
+from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
-from cadcnc.ops.pencil.pencil import pencil
 from cadcnc.ops.stream_steppers import stepper_factory
 
 from helpers.fixtures import FIXTURES
+from helpers.programs import pencil_run
 
 pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
 
@@ -47,7 +47,7 @@ def _corner(feed=1500.0):
 
 def _pencil(feed=None):
     part = _part("step_block.step")
-    return part, pencil(part, radius=3.0, **({} if feed is None else {"feed": feed}))
+    return part, pencil_run(part, radius=3.0, **({} if feed is None else {"feed": feed}))
 
 
 def _finish(feed=None):

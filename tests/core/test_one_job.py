@@ -12,7 +12,7 @@ import cadcnc
 from cadcnc.core.errors import InputError
 from cadcnc.io.outputs import PROGRAM_CSV_COLUMNS
 from cadcnc.io.program_json import program_json, read_program
-from cadcnc.core.job import Finish, Job, PairPath, Pencil, Tool
+from cadcnc.core.job import Raster, Job, PairPath, Pencil, Tool
 
 from helpers.cli import cadcnc_cli
 
@@ -31,7 +31,7 @@ JOBS = {
     "path": ("pocket", Job(Tool(3.0), 1500.0, 0.004, PairPath(faces=(10, 17)),
                            plunge_feed=300.0, spindle=9000.0)),
     "pencil": ("step_block", Job(Tool(3.0), 1500.0, 0.004, Pencil(side="conventional"))),
-    "finish": ("finish_slab", Job(Tool(3.0), 1500.0, 0.004, Finish((5,), stepover=4.0))),
+    "finish": ("finish_slab", Job(Tool(3.0), 1500.0, 0.004, Raster((5,), stepover=4.0))),
 }
 
 
@@ -48,10 +48,10 @@ def test_a_saved_program_reads_back_as_its_operation(kind, tmp_path):
     assert [len(c.points) for c in back.cuts] == [len(c.points) for c in program.cuts]
 
 
-def test_run_gives_the_keyword_conveniences_programs():
-    part = load_fixture("step_block")
-    by_job = cadcnc.run(part, Job(Tool(3.0), 1500.0, 0.004, Pencil()))
-    by_keywords = cadcnc.pencil(part, radius=3.0)
+def test_run_gives_the_finishing_shortcuts_program():
+    part = load_fixture("finish_slab")
+    by_job = cadcnc.run(part, Job(Tool(3.0), 1500.0, 0.004, Raster((5,), stepover=4.0)))
+    by_keywords = cadcnc.finish(part, [5], radius=3.0, stepover=4.0)
     assert len(by_job.segments) == len(by_keywords.segments)
     for a, b in zip(by_job.segments, by_keywords.segments):
         np.testing.assert_array_equal(a.points, b.points)

@@ -16,8 +16,9 @@ from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 
-from cadcnc import FaceSurface, SingularPointError
 from cadcnc.core.trim_labels import BOUNDARY, INSIDE, OUTSIDE
+from cadcnc.core.errors import SingularPointError
+from cadcnc.geometry.face_surface import FaceSurface
 
 V = cq.Vector
 

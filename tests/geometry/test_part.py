@@ -13,7 +13,7 @@ from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
 import cadcnc
-from cadcnc import FaceNumberError, StepFileError
+from cadcnc.core.errors import FaceNumberError, StepFileError
 
 
 @pytest.mark.parametrize("name", FIXTURE_NAMES)

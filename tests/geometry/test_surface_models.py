@@ -23,8 +23,9 @@ from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Compound
 
 import cadcnc
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.geometry.material_side import CLOSED_SHELL, FLIPPED, OPEN_LEVEL, OPEN_SHELL, VOID
-from cadcnc.geometry.report import faces_report
+from cadcnc.geometry.faces_report import faces_report
 from cadcnc.geometry.sewing import file_faces, inconsistent_edges, sew
 from cadcnc.geometry.step_file import read_step
 from cadcnc.core.tolerances import DEFAULT
@@ -95,7 +96,7 @@ def test_solid_closed_shell_and_loose_faces_give_the_same_path():
     for name in BOSS:
         part = part_of(name)
         i, j = SIDE[name]["pair"]
-        paths[name] = tp = cadcnc.intersection_path(part.face(i), part.face(j), radius=3,
+        paths[name] = tp = intersection_path(part.face(i), part.face(j), radius=3,
                                                     feed=1500, period=0.004)
         assert len(tp.points) > 100 and tp.complete
         assert gouge_gate(tp, part).ok, name
@@ -120,7 +121,7 @@ def test_open_sheet_faces_up_and_its_corner_path_passes_the_gate():
     sheet = SIDE["surf_sheet"]["sheet"]
     # closed form: the floor's projection on XY is x1 * y1 (the flux of n.z)
     assert shell.flux_mm2 == pytest.approx(sheet["x1"] * sheet["y1"], rel=1e-3)
-    tp = cadcnc.intersection_path(floor, wall, radius=3, feed=1500, period=0.004)
+    tp = intersection_path(floor, wall, radius=3, feed=1500, period=0.004)
     assert tp.complete and len(tp.points) > 100
     assert np.allclose(tp.points[:, 0], 3.0, atol=1e-6)  # R from the wall x = 0
     gate = gouge_gate(tp, part)  # measured: 1.8e-6 mm into the B-spline floor
@@ -272,7 +273,7 @@ def _distance_to(shape, points) -> np.ndarray:
 ], ids=["cut", "under the floor", "in the wedge"])
 def test_the_gate_refuses_an_open_sheet_path_in_its_material(shift, inside):
     part = part_of("surf_sheet")
-    tp = cadcnc.intersection_path(part.face(1), part.face(2), radius=3, feed=1500,
+    tp = intersection_path(part.face(1), part.face(2), radius=3, feed=1500,
                                   period=0.004)
     keep = np.nonzero(np.abs(tp.points[:, 1] - 15) <= 5)[0]
     bad = _shifted(tp, keep, shift)

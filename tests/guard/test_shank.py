@@ -20,6 +20,7 @@ from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.gp import gp_Pnt
 
 import cadcnc
+from helpers.programs import pencil_run
 
 R = 3.0
 ROOF = (10.0, 22.0)   # the roof covers y in [0, 10] from z 22 up; the corner is at z 10
@@ -31,7 +32,7 @@ def roofed():
     wall = cq.Workplane().box(10, 20, 40, centered=False)
     roof = cq.Workplane().box(25, ROOF[0], 5, centered=False).translate((0, 0, ROOF[1]))
     part = cadcnc.Part.from_cadquery(base.union(wall).union(roof).val())
-    return part, cadcnc.pencil(part, radius=R)
+    return part, pencil_run(part, radius=R)
 
 
 def shank_distance(part, p: np.ndarray, length: float) -> float:

@@ -32,9 +32,9 @@ def fixture_path(name: str, i: int, j: int, *, radius: float = 3.0, feed: float 
     """The toolpath of a fixture pair, computed once per test session (do not modify it)."""
     key = (name, i, j, radius, feed, period, tuple(sorted(kwargs.items())))
     if key not in _paths:
-        import cadcnc
+        from cadcnc.ops.path.pair_path import intersection_path
 
         part = load_fixture(name)
-        _paths[key] = cadcnc.intersection_path(part.face(i), part.face(j), radius=radius,
-                                               feed=feed, period=period, **kwargs)
+        _paths[key] = intersection_path(part.face(i), part.face(j), radius=radius,
+                                        feed=feed, period=period, **kwargs)
     return _paths[key]

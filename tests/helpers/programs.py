@@ -26,3 +26,15 @@ def assert_same_path(a, b) -> None:
     for ba, bb in zip(a.bounds, b.bounds):
         for f in fields(SurfaceBounds):
             np.testing.assert_array_equal(getattr(ba, f.name), getattr(bb, f.name))
+
+
+def pencil_run(part, *, radius, faces=None, side="climb", feed=1500.0, axis="+Z", **options):
+    """The pencil program of ``part`` (a Part, Workplane or Shape) with a ball of
+    ``radius`` mm: ``cadcnc.run`` of a Pencil job (feed mm/min, period 4 ms)."""
+    import cadcnc
+
+    if not isinstance(part, cadcnc.Part):
+        part = cadcnc.Part.from_cadquery(part)
+    job = cadcnc.Job(cadcnc.Tool(radius), feed, 0.004, cadcnc.Pencil(faces, side),
+                     source=part.source, axis=axis)
+    return cadcnc.run(part, job, **options)

@@ -13,6 +13,7 @@ from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt
 
 import cadcnc
+from cadcnc.ops.path.pair_path import intersection_path, intersection_paths
 from cadcnc.interp.cycle import CLOSED, END
 from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for
 from cadcnc.interp.compiled import new_stepper
@@ -44,7 +45,7 @@ def crossing_deviation(points, r_prime, A=20.0, B=10.0):
 def path_for(name, i, j, **kw):
     part = load_fixture(name)
     args = dict(radius=R, feed=FEED, period=PERIOD) | kw
-    return cadcnc.intersection_path(part.face(i), part.face(j), **args)
+    return intersection_path(part.face(i), part.face(j), **args)
 
 
 # -- crossing cylinders: closed form --------------------------------------------------------
@@ -83,7 +84,7 @@ PAIRS = [p for p in CONCAVE_PAIRS if p[0] in {
 @pytest.mark.parametrize("name,i,j", PAIRS, ids=[f"{n}-{i}-{j}" for n, i, j in PAIRS])
 def test_every_pair_within_1um_of_both_offset_surfaces(name, i, j):
     part = load_fixture(name)
-    for tp in cadcnc.intersection_paths(part.face(i), part.face(j), radius=R, feed=FEED,
+    for tp in intersection_paths(part.face(i), part.face(j), radius=R, feed=FEED,
                                         period=PERIOD):
         assert tp.stop_reason in (END, CLOSED), tp.stop_detail
         f = FEED * PERIOD / 60
@@ -140,7 +141,7 @@ def test_initial_error_decays_to_steady_state(name, i, j):
                                       ("sphere_cylinder", 1, 2)])
 def test_radius_zero_traces_the_shared_edge(name, i, j):
     part = load_fixture(name)
-    for k, tp in enumerate(cadcnc.intersection_paths(part.face(i), part.face(j), radius=0.0,
+    for k, tp in enumerate(intersection_paths(part.face(i), part.face(j), radius=0.0,
                                                      feed=FEED, period=PERIOD)):
         edge = [e for e in part.shared_edges(i, j) if e.edge_class == "concave"][k]
         curve = BRep_Tool.Curve_s(edge.edge, 0.0, 0.0)

@@ -8,7 +8,7 @@ import re
 import numpy as np
 import pytest
 
-import cadcnc
+from cadcnc.ops.path.pair_path import intersection_paths
 from cadcnc.io.gcode import DEFAULT_TOLERANCE, digits_for, programmed_points, simplify
 from cadcnc.io.program_gcode import to_ngc
 
@@ -23,7 +23,7 @@ def paths():
     saddle = load_fixture("crossing_cylinders")
     return {
         "boss": [fixture_path("bspline_boss", 4, 5)],
-        "saddles": cadcnc.intersection_paths(saddle.face(1), saddle.face(2), radius=3.0,
+        "saddles": intersection_paths(saddle.face(1), saddle.face(2), radius=3.0,
                                              allowance=0.2, feed=1500.0, period=0.004),
     }
 

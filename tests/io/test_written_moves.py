@@ -11,7 +11,7 @@ import pytest
 import cadcnc
 from cadcnc.core.errors import InputError
 from cadcnc.io.program_gcode import program_ngc, program_written_moves, segment_moves
-from cadcnc.core.job import Finish, Job, Pencil, Tool
+from cadcnc.core.job import Job, Pencil, Raster, Tool
 from helpers.fixtures import FIXTURES
 
 pytestmark = pytest.mark.slow
@@ -23,7 +23,7 @@ def programs():
     boss = cadcnc.load_step(str(FIXTURES / "finish_boss.step"))
     return [cadcnc.run(slot, Job(Tool(3.0, 0.0), 1500.0, 0.004, Pencil(None, "climb"))),
             cadcnc.run(boss, Job(Tool(3.0, 0.0), 1500.0, 0.004,
-                                 Finish((6,), 4.0, None, 0.0, "zigzag")))]
+                                 Raster((6,), 4.0, None, 0.0, "zigzag")))]
 
 
 @pytest.mark.parametrize("options", [{}, {"tolerance": 0.002}, {"tool_tip": True},

@@ -18,12 +18,12 @@ import pytest
 
 import cadcnc
 from cadcnc.core.errors import InputError
-from cadcnc.core.job import Finish, Job, Tool
+from cadcnc.core.job import Raster, Job, Tool
 from cadcnc.ops.finish.check import planned_intervals
-from cadcnc.ops.finish.finish import finish_program
+from cadcnc.ops.finish.raster import raster_program
 from cadcnc.ops.finish.passes import GuidePlane, _Pass
 from cadcnc.ops.finish.plan import centre_chord
-from cadcnc.ops.finish.setup import pass_setup
+from cadcnc.ops.finish.pass_setup import pass_setup
 from cadcnc.program.program import FAILED, STOPPED_SHORT
 from cadcnc.core.work_limits import HEARTBEAT_S, MAX_PLANES, WorkLimitError
 
@@ -43,7 +43,7 @@ def part_of(name: str):
 
 
 def finish_job(faces, stepover=None, scallop=None, radius=R, angle=0.0):
-    return Job(Tool(radius), 1500.0, 0.004, Finish(tuple(faces), stepover, scallop, angle))
+    return Job(Tool(radius), 1500.0, 0.004, Raster(tuple(faces), stepover, scallop, angle))
 
 
 def boss_pass(offset: float, reverse: bool):
@@ -149,7 +149,7 @@ def test_a_horizontal_cylinder_on_a_plane_along_its_axis_is_complete():
 def test_too_many_planes_are_refused_with_the_estimate_and_the_option(kw, option):
     part = part_of("slab")
     with pytest.raises(WorkLimitError, match="guide planes") as err:
-        finish_program(part, finish_job(FACTS["slab"]["faces"], **kw))
+        raster_program(part, finish_job(FACTS["slab"]["faces"], **kw))
     assert option in str(err.value) and f"{MAX_PLANES:g}" in str(err.value)
     assert err.value.exit_code == 2
 
@@ -159,7 +159,7 @@ def test_a_huge_scallop_spaces_the_planes_by_the_ball_width():
     (not NaN); the program is complete."""
     assert float(centre_chord(1e6, 0.0, R)) == pytest.approx(2 * R, rel=1e-12)
     work: dict = {}
-    program = finish_program(part_of("slab"), finish_job(FACTS["slab"]["faces"],
+    program = raster_program(part_of("slab"), finish_job(FACTS["slab"]["faces"],
                                                          scallop=1e6), work=work)
     assert program.complete and work["planes"] >= 1
     assert work["planes"] <= 1.5 * work["planes_estimate"]
@@ -169,7 +169,7 @@ def test_a_huge_scallop_spaces_the_planes_by_the_ball_width():
 def test_the_counted_planes_stay_within_the_estimate(kw):
     """Planes are estimated before any is placed; the count stays within 1.5 times the
     estimate (and the estimate within 2.5 times the count)."""
-    from cadcnc.ops.finish.finish import plan_for_job
+    from cadcnc.ops.finish.raster import plan_for_job
 
     for name in ("slab", "ridge"):
         work: dict = {}
@@ -182,13 +182,13 @@ def test_the_counted_planes_stay_within_the_estimate(kw):
 
 def test_the_plane_limit_is_a_keyword():
     with pytest.raises(WorkLimitError, match="over the limit of 3"):
-        finish_program(part_of("slab"), finish_job(FACTS["slab"]["faces"], stepover=1.0),
+        raster_program(part_of("slab"), finish_job(FACTS["slab"]["faces"], stepover=1.0),
                        max_planes=3)
 
 
 def test_a_scallop_too_small_for_floats_is_a_clear_error():
     with pytest.raises(InputError):
-        finish_program(part_of("slab"), finish_job(FACTS["slab"]["faces"], scallop=1e-300))
+        raster_program(part_of("slab"), finish_job(FACTS["slab"]["faces"], scallop=1e-300))
 
 
 # -- 4. never silent for more than 5 s ---------------------------------------------------
@@ -205,7 +205,7 @@ def test_progress_comes_at_least_every_5_s_inside_a_plane():
         return now[0]
 
     seen = []
-    finish_program(part_of("slab"), finish_job(FACTS["slab"]["faces"], stepover=10.0),
+    raster_program(part_of("slab"), finish_job(FACTS["slab"]["faces"], stepover=10.0),
                    clock=clock, progress=lambda done, total, what: seen.append(
                        (now[0], done, total, what)))
     inside = [s for s in seen if "cycles" in s[3] or "cutting" in s[3]]

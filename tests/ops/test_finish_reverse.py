@@ -16,11 +16,12 @@ import pytest
 import cadcnc
 import cadcnc.ops.finish.crossings as crossings_module
 import cadcnc.ops.finish.passes as pass_module
-from cadcnc.core.job import Finish, Job, PairPath, Tool
-from cadcnc.ops.finish.finish import finish, plan_for_job
+from cadcnc.core.job import Raster, Job, PairPath, Tool
+from cadcnc.ops.finish.raster import plan_for_job
+from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.finish.check import pass_problems
 from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
-from cadcnc.ops.finish.setup import pass_setup
+from cadcnc.ops.finish.pass_setup import pass_setup
 from cadcnc.program.program import FAILED, CutSegment
 
 from helpers.fixtures import FIXTURES
@@ -38,7 +39,7 @@ def part_of(name: str):
 
 def job_of(radius: float, faces=None, angle: float = 0.0, stepover: float = 2.0) -> Job:
     """A finishing job (``faces`` given: the plan's), or a bare pass's."""
-    op = PairPath() if faces is None else Finish(tuple(faces), stepover, None, angle,
+    op = PairPath() if faces is None else Raster(tuple(faces), stepover, None, angle,
                                                  "zigzag")
     return Job(Tool(radius), 1500.0, 0.004, op)
 

@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 import cadcnc
+from cadcnc.io.program_cq import to_cq
 from cadcnc.ops.path.pair_program import CLIMB, climb_measure
-from cadcnc.ops.pencil.pencil import pencil
 from cadcnc.verification import gouge_gate
 from helpers.fixtures import FIXTURES, load_fixture
+from helpers.programs import pencil_run
 
 _programs: dict = {}
 
@@ -19,7 +20,7 @@ def program_of(name: str, **kw):
     if key not in _programs:
         part = load_fixture(name) if name == "pocket" else cadcnc.load_step(
             FIXTURES / f"{name}.step")
-        _programs[key] = (part, pencil(part, radius=3.0, **kw))
+        _programs[key] = (part, pencil_run(part, radius=3.0, **kw))
     return _programs[key]
 
 
@@ -69,7 +70,7 @@ def test_every_move_clears_the_part(name):
 
 def test_side_is_checked():
     with pytest.raises(cadcnc.InputError, match="side"):
-        pencil(load_fixture("pocket"), radius=3.0, side="up")
+        pencil_run(load_fixture("pocket"), radius=3.0, side="up")
 
 
 def test_cadquery_example_runs_as_script_and_under_cq_editor(capsys):
@@ -86,13 +87,13 @@ def test_cadquery_example_runs_as_script_and_under_cq_editor(capsys):
     assert set(shown) == {"part", "cuts", "links"} and prog.complete
     # the round pocket r 8 (ball centres on r 6, once around) and the step, 30 mm across
     assert sorted(c.length for c in prog.cuts) == pytest.approx([30.0, 12 * np.pi], abs=0.01)
-    wires = cadcnc.to_cq(prog, links=False)
+    wires = to_cq(prog, links=False)
     assert len(wires) == len(prog.cuts)
     for w, cut in zip(wires, prog.cuts):
         ends = np.array([w.startPoint().toTuple(), w.endPoint().toTuple()])
         np.testing.assert_allclose(ends, cut.points[[0, -1]], atol=1e-3)
         assert w.Length() == pytest.approx(cut.length, abs=1e-3)
-    assert len(shown["links"].Wires()) == len(cadcnc.to_cq(prog, cuts=False))
+    assert len(shown["links"].Wires()) == len(to_cq(prog, cuts=False))
     runpy.run_path(example, run_name="__main__")  # as a plain script: prints the summary
     assert "pencil R 2:" in capsys.readouterr().out
 
@@ -102,9 +103,9 @@ def test_pencil_takes_a_cadquery_shape():
 
     step = cq.Workplane("XY").box(20, 10, 10).faces(">Z").workplane().center(5, 0).rect(
         10, 10).cutBlind(-4)  # a step: one concave edge, 10 mm long
-    part_prog = cadcnc.pencil(cadcnc.Part.from_cadquery(step.val()), radius=2.0)
-    shape_prog = cadcnc.pencil(step.val(), radius=2.0)
-    work_prog = cadcnc.pencil(step, radius=2.0)
+    part_prog = pencil_run(cadcnc.Part.from_cadquery(step.val()), radius=2.0)
+    shape_prog = pencil_run(step.val(), radius=2.0)
+    work_prog = pencil_run(step, radius=2.0)
     assert len(part_prog.cuts) == 1 and part_prog.cut_length == pytest.approx(10, abs=0.1)
     for other in (shape_prog, work_prog):
         np.testing.assert_array_equal(other.cuts[0].points, part_prog.cuts[0].points)
@@ -138,7 +139,7 @@ def test_a_hole_of_the_balls_radius_is_cut_by_a_plunge():
     face tighter than the ball; its corner is one position (10, 10, 17), a point cut,
     and the program (links included) clears the part."""
     part = cadcnc.load_step(FIXTURES / "narrow_slot.step")
-    prog = pencil(part, radius=2.0)
+    prog = pencil_run(part, radius=2.0)
     (point,) = [c for c in prog.cuts if len(c.points) == 1]
     np.testing.assert_allclose(point.points[0], (10.0, 10.0, 17.0), atol=1e-6)
     assert point.path.faces == (11, 12) and prog.complete and not prog.skipped

@@ -19,7 +19,7 @@ from cadcnc.core.job import Job, PairPath, Pencil, Tool
 from cadcnc.ops.path.pair_path import plan_path
 from cadcnc.ops.path.pair_program import program_for_job, stretch_cuts
 from cadcnc.ops.path.stretches import EdgeStretches, Limit, Stretch, too_tight
-from cadcnc.ops.pencil.pencil import pencil_program
+from cadcnc.ops.pencil.pencil_program import pencil_program
 from cadcnc.ops.common import safe_height
 from cadcnc.core.tolerances import DEFAULT
 from cadcnc.verification.judgement import judge, settle

@@ -7,10 +7,10 @@ import cadquery as cq
 import numpy as np
 import pytest
 
-import cadcnc
 from cadcnc.geometry.part import Part
-from cadcnc.ops.pencil.pencil import NOT_REACHABLE
+from cadcnc.ops.pencil.pencil_program import NOT_REACHABLE
 from cadcnc.verification import gouge_gate
+from helpers.programs import pencil_run
 
 RADIUS = 1.0   # shank 10 mm, shorter than the 30 mm void
 
@@ -53,7 +53,7 @@ def test_pencil_skips_cuts_no_plunge_reaches(shape):
     """Pencil cuts the open pocket and skips the void's corners as not reachable from +Z
     (before, the plunge into the void made the gate refuse the whole program)."""
     part = Part.from_cadquery(shape)
-    prog = cadcnc.pencil(part, radius=RADIUS)
+    prog = pencil_run(part, radius=RADIUS)
     unreachable = [s for s in prog.skipped if s.reason == NOT_REACHABLE]
     assert unreachable and all("on the way to Z" in s.detail for s in unreachable)
     assert prog.cuts and all(c.points[:, 0].min() > 30.0 for c in prog.cuts)

@@ -14,6 +14,7 @@ from cadcnc.io.program_json import read_program
 from cadcnc.verification import gouge_gate
 from helpers.cli import cadcnc_cli
 from helpers.fixtures import FIXTURES
+from helpers.programs import pencil_run
 
 RADIUS = 2.0
 
@@ -53,7 +54,7 @@ def test_open_sheet_pencil_is_a_verified_program(sheet):
 
 @pytest.fixture(scope="module")
 def solid():
-    return cadcnc.pencil(cadcnc.load_step(FIXTURES / "surf_boss_solid.step"), radius=RADIUS)
+    return pencil_run(cadcnc.load_step(FIXTURES / "surf_boss_solid.step"), radius=RADIUS)
 
 
 @pytest.mark.parametrize("name", ["surf_boss_shell", "surf_boss_faces"])
@@ -61,7 +62,7 @@ def test_shell_and_loose_faces_give_the_solids_program(name, solid):
     """The boss as a closed shell, and as loose faces sewn on reading, give the cuts of
     the same part as a solid (face numbers survive sewing)."""
     part = cadcnc.load_step(FIXTURES / f"{name}.step")
-    prog = cadcnc.pencil(part, radius=RADIUS)
+    prog = pencil_run(part, radius=RADIUS)
     assert [c.path.faces for c in prog.cuts] == [c.path.faces for c in solid.cuts] != []
     for a, b in zip(prog.cuts, solid.cuts):
         assert a.points.shape == b.points.shape

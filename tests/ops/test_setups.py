@@ -22,10 +22,11 @@ import subprocess
 import numpy as np
 import pytest
 
+from cadcnc.core.job import Job, Pencil, Tool
 from helpers.cli import cadcnc_cli
 
 R = 3.0
-SPACING = 0.5   # mm: the setups' positions along a corner (cadcnc.ops.pencil.setups)
+SPACING = 0.5   # mm: the setups' positions along a corner (cadcnc.ops.pencil.fewest_setups)
 RS274 = shutil.which("rs274")
 
 
@@ -72,10 +73,11 @@ def cut_ys(program, setup) -> list[tuple[float, float]]:
 @pytest.mark.parametrize("overlap", [0.0, 2.0])
 def test_two_setups_share_the_corner(shared_corner, overlap):
     import cadcnc
+    from cadcnc.ops.pencil.fewest_setups import pencil_setups
 
     part, floor, wall, _ = shared_corner
-    result = cadcnc.pencil(part, radius=R, faces=[floor, wall], setups="auto",
-                           setup_overlap=overlap)
+    job = Job(Tool(R), 1500.0, 0.004, Pencil([floor, wall]), source=part.source)
+    result = pencil_setups(part, job, "auto", overlap)
     assert [r.setup.name for r in result.runs] == ["+Z", "+X"]
     assert result.subsets_checked == 6 + 15     # no single axis covers: every pair tried
     first, second = result.runs

@@ -21,8 +21,8 @@ import pytest
 from scipy.spatial import cKDTree
 
 import cadcnc
-from cadcnc.core.job import Finish, Job, Tool
-from cadcnc.ops.finish.finish import plan_for_job
+from cadcnc.core.job import Raster, Job, Tool
+from cadcnc.ops.finish.raster import plan_for_job
 from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
 from cadcnc.program.program import FAILED
 from helpers.fixtures import FIXTURES
@@ -41,7 +41,7 @@ def boss_passes():
     """The raster job of steep-shallow on the boss (its faces, R 2, scallop 0.05), its two
     planes either side of WORST's y, and their passes (zigzag: odd planes reversed)."""
     part = cadcnc.load_step(FIXTURES / FACTS["file"])
-    job = Job(Tool(R, 0.0, None), 1500.0, 0.004, Finish(tuple(FACTS["faces"]), None, H,
+    job = Job(Tool(R, 0.0, None), 1500.0, 0.004, Raster(tuple(FACTS["faces"]), None, H,
                                                        0.0, "zigzag"), source=part.source)
     plan, _ = plan_for_job(part, job)
     offsets = np.asarray(plan.offsets)
@@ -162,7 +162,7 @@ def test_a_plane_just_inside_the_top_rolls_back_down_over_its_edge():
     edge, the top, the arc back, wall, fillet; every point R' from the boss."""
     y = 7.8772
     part = cadcnc.load_step(FIXTURES / FACTS["file"])
-    job = Job(Tool(R, 0.0, None), 1500.0, 0.004, Finish(tuple(FACTS["faces"]), None, 0.2,
+    job = Job(Tool(R, 0.0, None), 1500.0, 0.004, Raster(tuple(FACTS["faces"]), None, 0.2,
                                                        0.0, "zigzag"), source=part.source)
     res = pass_cuts(part, job.operation.faces, GuidePlane(0.0, y), job)
     assert not [s for s in res.skipped if s.reason == FAILED], res.skipped

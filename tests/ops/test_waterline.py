@@ -13,11 +13,11 @@ import pytest
 import cadcnc
 from cadcnc.core.errors import InputError
 from cadcnc.geometry.offset_section import loop_count, offset_face
-from cadcnc.core.job import Finish, Job, Tool
+from cadcnc.core.job import Job, SteepShallow, Tool, Waterline, finishing
 from cadcnc.ops.finish.levels import CRITICAL_MM, critical_heights, plan_levels
 from cadcnc.ops.finish.loops import level_cuts
 from cadcnc.ops.finish.plan import sample_faces
-from cadcnc.ops.finish.setup import pass_setup
+from cadcnc.ops.finish.pass_setup import pass_setup
 from cadcnc.verification.probe import shape_distances
 from cadcnc.core.work_limits import WorkLimitError
 from helpers.fixtures import FIXTURES
@@ -36,7 +36,7 @@ def fixture(name: str):
         part = cadcnc.load_step(FIXTURES / FACTS[name]["file"])
         faces = FACTS[name]["faces"]
         job = Job(Tool(RADIUS[name]), 1500.0, 0.004,
-                  Finish(faces, strategy="waterline", stepdown=1.0))
+                  Waterline(faces, stepdown=1.0))
         offs = {f: offset_face(part.face(f).topods, job.tool.offset) for f in faces}
         _cache[name] = (part, job, pass_setup(part, faces, job), offs)
     return _cache[name]
@@ -129,11 +129,11 @@ def test_dome_top_is_a_tangency_found_exactly():
     (dict(strategy="steep-shallow", stepdown=1.0), "both stepover"),
     (dict(strategy="zigzag", stepover=1.0), "strategy"),
     (dict(strategy="waterline", stepdown=1.0, side="left"), "side"),
-    (dict(strategy="waterline", stepdown=1.0, overlap=-1), "overlap"),
+    (dict(strategy="steep-shallow", scallop=0.01, overlap=-1), "overlap"),
 ])
 def test_bad_strategy_fields_are_refused(kw, words):
     with pytest.raises(InputError, match=words):
-        Finish([5], **kw)
+        finishing(kw.pop("strategy"), [5], **kw)
 
 
 def test_levels_are_estimated_and_bounded_before_any_is_cut():
@@ -147,8 +147,8 @@ def test_levels_are_estimated_and_bounded_before_any_is_cut():
 
 
 def test_the_job_records_the_strategy():
-    op = Finish([5], stepover=1.0, stepdown=0.5, strategy="steep-shallow", threshold=30,
-                side="conventional", overlap=0.5)
+    op = SteepShallow([5], stepover=1.0, stepdown=0.5, threshold=30,
+                      side="conventional", overlap=0.5)
     job = Job(Tool(3.0), 1500.0, 0.004, op)
     again = Job.from_inputs(json.loads(json.dumps(job.to_inputs())))
     assert again.operation == op

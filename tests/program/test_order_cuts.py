@@ -16,7 +16,7 @@ import pytest
 
 import cadcnc
 from cadcnc.core.job import Job, Pencil, Tool
-from cadcnc.ops.pencil import pencil
+from cadcnc.ops.pencil import pencil_program
 from cadcnc.program.linking import TWO_OPT_MAX, order_cuts
 
 from helpers.fixtures import FIXTURES
@@ -150,7 +150,7 @@ def test_the_same_order_on_a_real_pencil_program(monkeypatch):
         got = order_cuts(items, join)
         seen.append((len(items), same(got, order_by_loops(items, join))))
         return got
-    monkeypatch.setattr(pencil, "order_cuts", both)
+    monkeypatch.setattr(pencil_program, "order_cuts", both)
     part = cadcnc.load_step(FIXTURES / "step_slot.step")
     program = cadcnc.run(part, Job(Tool(3.0, 0.0), 1500.0, 0.004, Pencil(None, "climb")),
                          jobs=1)

@@ -24,6 +24,7 @@ from OCP.GeomLProp import GeomLProp_SLProps
 from OCP.gp import gp_Pnt
 
 import cadcnc
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.interp.cycle import CLOSED, CURVATURE, DIVERGED, END, paper_inverse_ratio, track
 from cadcnc.interp.compiled import new_stepper
 from cadcnc.core.job import MIN_STEP, Job, PairPath, Tool
@@ -82,7 +83,7 @@ def fixture_faces(name, i, j):
 def test_torus_cone_with_a_ball_wider_than_the_tube_goes_once_around(radius):
     """Was: R 7 covered 5.9 mm of the 97.8 mm edge, stop `diverged`, predicted "inf mm"."""
     faces = fixture_faces("torus_cone", 1, 2)
-    tp = cadcnc.intersection_path(*faces, radius=radius, **KW)
+    tp = intersection_path(*faces, radius=radius, **KW)
     assert tp.stop_reason == CLOSED and tp.complete and tp.partial_reason == ""
     np.testing.assert_allclose(tp.points[-1], tp.points[0], atol=1e-9)
     # the centres run on a circle about the axis (Z): its length is the polyline's
@@ -113,7 +114,7 @@ def test_r0901_fillet_no_longer_drifts_off_face_220():
     fixtures/r0901_fillet.step is cut from OCCT test data r0901_ec.stp (faces 3 and 220
     are its faces 16 and 18; fixtures/build_r0901_fillet.py)."""
     faces = fixture_faces("r0901_fillet", 16, 18)
-    tp = cadcnc.intersection_path(*faces, radius=2.0, **KW)
+    tp = intersection_path(*faces, radius=2.0, **KW)
     assert tp.stop_reason == CLOSED and tp.complete
     assert len(tp) == 1328 and tp.length == pytest.approx(132.663, abs=1e-3)
     assert worst_deviation(faces, tp) < ACC
@@ -128,7 +129,7 @@ def test_a_blend_that_folds_under_the_ball_stops_at_the_curvature_limit_not_dive
     17 and 18; fixtures/build_abc_fold.py). Oracle: OCCT's principal curvatures
     (GeomLProp_SLProps) at the last contact on the blend."""
     faces = fixture_faces("abc_fold", 17, 18)
-    tp = cadcnc.intersection_path(*faces, radius=2.0, **KW)
+    tp = intersection_path(*faces, radius=2.0, **KW)
     assert tp.stop_reason == CURVATURE and not tp.complete
     assert "reaches the ball's" in tp.stop_detail and "runs away" in tp.stop_detail
     assert tp.partial_reason.startswith("stopped at 2.375 of 3.8 mm")
@@ -143,7 +144,7 @@ def test_a_blend_that_folds_under_the_ball_stops_at_the_curvature_limit_not_dive
 def test_a_period_in_seconds_gives_short_accurate_steps_not_a_diverged_path():
     """period=4 (100 mm steps) returned a 2-point `diverged` path 46 um off."""
     faces = fixture_faces("bspline_boss", 4, 5)
-    tp = cadcnc.intersection_path(*faces, radius=3.0, feed=1500.0, period=4.0)
+    tp = intersection_path(*faces, radius=3.0, feed=1500.0, period=4.0)
     assert tp.stop_reason == CLOSED and tp.complete
     assert tp.accuracy_cycles == len(tp) - 1 and tp.accuracy_ratio < 0.01
     assert "feed reduced on" in tp.accuracy_note and "for accuracy" in tp.accuracy_note
@@ -155,7 +156,7 @@ def test_ellipse_pocket_over_cut_is_within_the_accuracy():
     """Was 3.1e-3 mm where R' k ~ 0.8-0.9: the contact runs 5-10 times faster than the
     centre through a changing curvature. The steps there are shortened, and only there."""
     faces = fixture_faces("ellipse_pocket", 7, 8)
-    tp = cadcnc.intersection_path(*faces, radius=3.0, **KW)
+    tp = intersection_path(*faces, radius=3.0, **KW)
     assert tp.complete and 0 < tp.accuracy_cycles < len(tp) // 10
     assert worst_deviation(faces, tp, chords=False) < ACC / 2
     assert worst_deviation(faces, tp) < ACC
@@ -174,13 +175,13 @@ def test_accepted_paths_stay_within_the_accuracy_at_any_feed(name, i, j, radius,
     """OCCT oracle: a complete path's centres and chord midpoints are within tol.accuracy
     of both offset surfaces, whatever step was commanded."""
     faces = fixture_faces(name, i, j)
-    tp = cadcnc.intersection_path(*faces, radius=radius, feed=f * 60 / 0.004, period=0.004)
+    tp = intersection_path(*faces, radius=radius, feed=f * 60 / 0.004, period=0.004)
     assert tp.complete, tp.partial_reason
     assert worst_deviation(faces, tp) < ACC
 
 
 def test_fixtures_already_within_the_accuracy_keep_their_steps():
-    tp = cadcnc.intersection_path(*fixture_faces("torus_cone", 1, 2), radius=3.0, **KW)
+    tp = intersection_path(*fixture_faces("torus_cone", 1, 2), radius=3.0, **KW)
     assert tp.accuracy_cycles == 0 and tp.accuracy_ratio == 1.0 and tp.accuracy_note == ""
     assert np.all(tp.commanded[1:-1] == 0.1)
 
@@ -194,7 +195,7 @@ def test_a_step_below_the_minimum_is_refused_naming_feed_and_period(period):
         Job(Tool(3.0), 1500.0, period, PairPath())
     faces = fixture_faces("sphere_cylinder", 1, 2)
     with pytest.raises(cadcnc.InputError, match="feed.*period"):
-        cadcnc.intersection_path(*faces, radius=3.0, feed=1500.0, period=period)
+        intersection_path(*faces, radius=3.0, feed=1500.0, period=period)
     with pytest.raises(cadcnc.InputError, match="feed.*period"):
         cadcnc.make_stepper(*faces, radius=3.0, feed=1500.0, period=period)
     assert Job(Tool(3.0), 60.0, MIN_STEP, PairPath()).step == pytest.approx(MIN_STEP)
@@ -217,9 +218,9 @@ def test_a_path_longer_than_the_cycle_limit_is_refused_before_running():
     ends = dict(start=tuple(a + 2 * d), end=tuple(a + 22 * d))   # 20 mm apart
     with pytest.raises(cadcnc.InputError, match=r"about 20 mm long: at feed 1 mm/min and "
                                                 r"period 0.001 s .* 1.2e\+06 cycles"):
-        cadcnc.intersection_path(*faces, radius=3.0, feed=1.0, period=0.001, **ends)
+        intersection_path(*faces, radius=3.0, feed=1.0, period=0.001, **ends)
     # a limit met while running leaves a partial path that says so
-    tp = cadcnc.intersection_path(*faces, radius=3.0, max_cycles=100, start=ends["start"],
+    tp = intersection_path(*faces, radius=3.0, max_cycles=100, start=ends["start"],
                                   **KW)
     assert tp.stop_reason == "max_cycles" and not tp.complete
     assert tp.partial_reason.startswith("stopped after 10.000 mm: max_cycles: cycle limit")
@@ -227,12 +228,12 @@ def test_a_path_longer_than_the_cycle_limit_is_refused_before_running():
 
 # -- partial paths say why -----------------------------------------------------------------
 def test_a_partial_path_says_how_far_it_got_and_why():
-    tp = cadcnc.intersection_path(*fixture_faces("ramp_wall", 3, 7), radius=3.0, **KW)
+    tp = intersection_path(*fixture_faces("ramp_wall", 3, 7), radius=3.0, **KW)
     assert not tp.complete
     assert tp.partial_reason.startswith("stopped at 28.000 of 40.0 mm (the edge's length): "
                                         "boundary: contact on surface 2")
     assert tp.expected_length == pytest.approx(40.0)
-    done = cadcnc.intersection_path(*fixture_faces("pocket", 10, 17), radius=3.0, **KW)
+    done = intersection_path(*fixture_faces("pocket", 10, 17), radius=3.0, **KW)
     assert done.stop_reason == END and done.complete and done.partial_reason == ""
 
 
@@ -240,6 +241,6 @@ def test_diverged_is_still_a_partial_stop():
     """The safety net stays: a carried-error limit below what the cycle carries stops it."""
     faces = fixture_faces("crossing_cylinders", 1, 2)
     tol = replace(DEFAULT, diverged=1e-6)
-    tp = cadcnc.intersection_path(*faces, radius=3.0, tol=tol, **KW)
+    tp = intersection_path(*faces, radius=3.0, tol=tol, **KW)
     assert tp.stop_reason == DIVERGED and not tp.complete
     assert "diverged: surface" in tp.partial_reason

@@ -14,6 +14,8 @@ import numpy as np
 import pytest
 
 import cadcnc
+from cadcnc.core.errors import FaceNumberError, StepFileError
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.core.job import Job, PairPath, Tool
 
 from helpers.cli import cadcnc_cli
@@ -90,7 +92,7 @@ def test_unreadable_step_is_a_clear_error_even_as_root(tmp_path, monkeypatch):
         return real_open(path, *a, **k)
 
     monkeypatch.setattr("builtins.open", deny)
-    with pytest.raises(cadcnc.StepFileError, match="cannot read"):
+    with pytest.raises(StepFileError, match="cannot read"):
         cadcnc.load_step(f)
 
 
@@ -120,21 +122,21 @@ def test_api_refuses_mistakes_with_clear_errors():
     floor, boss = part.face(4), part.face(5)
     kw = dict(radius=3, feed=1500, period=0.004)
     with pytest.raises(cadcnc.InputError, match="radius"):
-        cadcnc.intersection_path(floor, boss, **{**kw, "radius": True})
+        intersection_path(floor, boss, **{**kw, "radius": True})
     with pytest.raises(cadcnc.InputError, match="start must be a point"):
-        cadcnc.intersection_path(floor, boss, start="1,2,3", **kw)
+        intersection_path(floor, boss, start="1,2,3", **kw)
     with pytest.raises(cadcnc.InputError, match="edge"):
-        cadcnc.intersection_path(floor, boss, edge=-1, **kw)
+        intersection_path(floor, boss, edge=-1, **kw)
     with pytest.raises(cadcnc.InputError, match="edge"):
-        cadcnc.intersection_path(floor, boss, edge="1", **kw)
-    with pytest.raises(cadcnc.FaceNumberError, match="True"):
+        intersection_path(floor, boss, edge="1", **kw)
+    with pytest.raises(FaceNumberError, match="True"):
         part.face(True)
     with pytest.raises(cadcnc.InputError, match="finite"):
         floor.normal(float("nan"), float("nan"))
     import numpy as np
 
-    a = cadcnc.intersection_path(floor, boss, **{**kw, "feed": np.int64(1500)})
-    b = cadcnc.intersection_path(floor, boss, **{**kw, "feed": np.float32(1500)})
+    a = intersection_path(floor, boss, **{**kw, "feed": np.int64(1500)})
+    b = intersection_path(floor, boss, **{**kw, "feed": np.float32(1500)})
     assert (a.points == b.points).all()
 
 
@@ -144,7 +146,7 @@ def test_cadquery_objects_that_are_not_solids_get_a_clear_error():
     box = cq.Workplane().box(10, 10, 10)
     assembly = cq.Assembly().add(box)
     assert len(cadcnc.Part.from_cadquery(assembly)) == 6
-    with pytest.raises(cadcnc.StepFileError, match="Sketch"):
+    with pytest.raises(StepFileError, match="Sketch"):
         cadcnc.Part.from_cadquery(cq.Sketch().rect(1, 1))
 
 
@@ -175,7 +177,7 @@ def test_a_start_point_near_an_edge_is_accepted(z):
     """Was: 'no projection of point (np.float64(...)) found' for a start 0.2 mm outside
     the boss (99 of 130 API fuzz refusals). The path goes once around, as from the edge."""
     part = load_fixture("bspline_boss")
-    path = cadcnc.intersection_path(part.face(4), part.face(5), radius=3, feed=1500,
+    path = intersection_path(part.face(4), part.face(5), radius=3, feed=1500,
                                     period=0.004, start=(13.2, -3.0, z))
     assert path.complete, path.stop_reason
     assert path.stop_reason == "closed"

@@ -16,13 +16,15 @@ from pathlib import Path
 import pytest
 
 import cadcnc
+from cadcnc.io.program_cq import to_cq
+from cadcnc.verification import gouge_gate, verify
 from cadcnc.core.errors import InputError
-from cadcnc.core.job import Finish, Job, PairPath, Pencil, Tool
+from cadcnc.core.job import Raster, Job, PairPath, Pencil, Tool
 from cadcnc.core.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT
 
 from helpers.cli import cadcnc_cli
-
 from helpers.fixtures import FIXTURES
+from helpers.programs import pencil_run
 
 POCKET = FIXTURES / "pocket.step"   # faces 10 17: a straight edge, a program in ~0.2 s
 PATH = ["path", POCKET, "--faces", "10", "17", "--radius", "3"]
@@ -116,9 +118,9 @@ def block():
 
 
 API_CASES = {
-    "pencil radius": (lambda p: cadcnc.pencil(p, radius="3"), "radius"),
-    "pencil faces": (lambda p: cadcnc.pencil(p, radius=3.0, faces=5), "faces"),
-    "pencil side": (lambda p: cadcnc.pencil(p, radius=3.0, side=1), "side"),
+    "pencil radius": (lambda p: pencil_run(p, radius="3"), "radius"),
+    "pencil faces": (lambda p: pencil_run(p, radius=3.0, faces=5), "faces"),
+    "pencil side": (lambda p: pencil_run(p, radius=3.0, side=1), "side"),
     "finish faces": (lambda p: cadcnc.finish(p, "x", radius=3.0, stepover=1.0), "faces"),
     "finish stepover": (lambda p: cadcnc.finish(p, [5], radius=3.0, stepover="1"),
                         "stepover"),
@@ -127,12 +129,12 @@ API_CASES = {
     "Job operation": (lambda p: Job(Tool(3.0), 1500.0, 0.004, "pencil"), "operation"),
     "PairPath faces": (lambda p: PairPath(faces=5), "two faces"),
     "Pencil faces": (lambda p: Pencil(faces=[0]), "face numbers"),
-    "Finish faces": (lambda p: Finish(None, stepover=1.0), "faces"),
+    "Finish faces": (lambda p: Raster(None, stepover=1.0), "faces"),
     "load_step": (lambda p: cadcnc.load_step(123), "path"),
-    "verify": (lambda p: cadcnc.verify(None, p), "toolpath"),
-    "gouge_gate": (lambda p: cadcnc.gouge_gate("x", p), "toolpath"),
+    "verify": (lambda p: verify(None, p), "toolpath"),
+    "gouge_gate": (lambda p: gouge_gate("x", p), "toolpath"),
     "gate_program": (lambda p: cadcnc.gate_program("x", p), "program"),
-    "to_cq": (lambda p: cadcnc.to_cq("x"), "program"),
+    "to_cq": (lambda p: to_cq("x"), "program"),
     "read_program": (lambda p: cadcnc.read_program(5), "file"),
 }
 

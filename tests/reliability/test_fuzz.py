@@ -25,6 +25,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import cadcnc
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.core.errors import CadcncError
 from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_gcode import to_ngc
@@ -81,7 +82,7 @@ def test_an_accepted_path_never_gouges_along_its_moves(pair, r, step, period, st
     if start is not None:
         kw["start"] = tuple(edge_start(part, i, j, start[0], start[1]))
     try:
-        tp = cadcnc.intersection_path(part.face(i), part.face(j), **kw)
+        tp = intersection_path(part.face(i), part.face(j), **kw)
     except CadcncError as e:
         SEEN.append((name, radius, step, f"refused: {e}"[:60]))
         return   # refused up front with a reason: nothing is written

@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 
 import cadcnc
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.core.errors import InputError
 from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_gcode import to_ngc
@@ -70,7 +71,7 @@ def midpoint_depths(part, face, moves, ball):
 @pytest.mark.parametrize("name, case", CASES, ids=[c["name"] for _, c in CASES])
 def test_a_face_behind_a_thin_wall_is_no_gouge(name, case):
     part = part_of(name)
-    tp = cadcnc.intersection_path(*(part.face(n) for n in case["faces"]),
+    tp = intersection_path(*(part.face(n) for n in case["faces"]),
                                   radius=case["radius"], feed=1500, period=0.004)
     # why the signed rule failed: the far face's nearest point is inside it and the centre
     # on its material side, though the wall (or the part's far end) lies between
@@ -91,7 +92,7 @@ def test_a_path_buried_in_the_material_is_refused():
     part = cadcnc.load_step(FIXTURES / "third_face.step")
     case = json.loads((FIXTURES / "verification_fixtures.json").read_text())[
         "third_face"]["cases"][1]  # the slot: centres x = 17, z = 17
-    tp = cadcnc.intersection_path(*(part.face(n) for n in case["faces"]),
+    tp = intersection_path(*(part.face(n) for n in case["faces"]),
                                   radius=case["radius"], feed=1500, period=0.004)
     keep = np.nonzero(np.abs(tp.points[:, 1]) <= 10)[0]
     sub = {f.name: getattr(tp, f.name)[keep] for f in dataclasses.fields(tp)
@@ -123,7 +124,7 @@ def test_without_a_solid_the_nearest_faces_side_decides(monkeypatch):
     for what, (p, state) in probes.items():
         assert solid.state(p) == by_faces.state(p) == state, what
     case = SIDE["thin_ring"]["cases"][0]
-    tp = cadcnc.intersection_path(*(part.face(n) for n in case["faces"]), radius=3,
+    tp = intersection_path(*(part.face(n) for n in case["faces"]), radius=3,
                                   feed=1500, period=0.004)
     monkeypatch.setattr(whole_part, "Material",
                         lambda f, tol: Material(f, tol, solids=[]))
@@ -232,8 +233,8 @@ def test_the_gate_reports_progress():
     part, tp = boss()
     calls = []
     gouge_gate(tp, part, moves=tp.points[:50], progress=lambda *a: calls.append(a))
-    assert {c[0] for c in calls} == {"surfaces", "whole part", "moves"}
-    assert all(0 <= done <= total for _, done, total in calls)
+    assert {c[2] for c in calls} == {"surfaces", "whole part", "moves"}
+    assert all(0 <= done <= total for done, total, _ in calls)
 
 
 # -- defect 8: verify's verdict ---------------------------------------------------------------
@@ -315,7 +316,7 @@ def test_the_cli_gates_the_program_it_writes(tmp_path):
     assert "along 149 moves between points" in run.stderr
     assert "A smaller --tolerance (fewer points dropped) may pass" in run.stderr
     part = load_fixture("sphere_cylinder")
-    text = to_ngc([cadcnc.intersection_path(part.face(1), part.face(2), radius=6.6,
+    text = to_ngc([intersection_path(part.face(1), part.face(2), radius=6.6,
                                             feed=21000, period=0.004)], tolerance=0.002)
     oracle = midpoint_depths(part, 2, programmed_moves(text), 6.6)
     assert oracle.max() > LIMIT   # the refusal is real

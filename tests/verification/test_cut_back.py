@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 import cadcnc
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.program.linking import linked
 from cadcnc.program.program import CutSegment, Program
 from cadcnc.verification import gouge_gate
@@ -17,7 +18,7 @@ def test_a_cut_running_into_a_wall_is_cut_back_where_the_ball_reaches_it():
     wall at x = 32 (closed form, fixtures/stretch_fixtures.json). A path run on to x = 34
     without the guard cuts that wall; cut back, it ends within a step of x = 32."""
     part = cadcnc.load_step(FIXTURES / "stretch_pocket.step")
-    tp = cadcnc.intersection_path(part.face(11), part.face(8), radius=3.0, feed=1500.0,
+    tp = intersection_path(part.face(11), part.face(8), radius=3.0, feed=1500.0,
                                   period=0.004, start=(10.0, 8.0, 11.0), end=(34.0, 8.0, 11.0))
     assert not gouge_gate(tp, part).ok
     prog = Program(tp.job, linked([CutSegment(tp), CutSegment(tp)], 60.0), [])
@@ -33,7 +34,7 @@ def test_a_cut_running_into_a_wall_is_cut_back_where_the_ball_reaches_it():
 
 def test_a_clear_program_is_left_as_it_is():
     part = cadcnc.load_step(FIXTURES / "stretch_pocket.step")
-    tp = cadcnc.intersection_path(part.face(11), part.face(8), radius=3.0, feed=1500.0,
+    tp = intersection_path(part.face(11), part.face(8), radius=3.0, feed=1500.0,
                                   period=0.004, start=(10.0, 8.0, 11.0), end=(30.0, 8.0, 11.0))
     prog = Program(tp.job, linked([CutSegment(tp)], 60.0), [])
     assert cut_back(prog, part, 60.0) is prog

@@ -21,7 +21,7 @@ import pytest
 import cadcnc
 from OCP.GeomAbs import (GeomAbs_BSplineSurface, GeomAbs_Cylinder, GeomAbs_Sphere,
                          GeomAbs_SurfaceOfExtrusion, GeomAbs_Torus)
-from cadcnc.core.job import Finish, Job, Tool
+from cadcnc.core.job import Raster, Job, Tool
 from cadcnc.program.program import CutSegment, Program
 from cadcnc.verification import gate_program
 from cadcnc.verification.gate_cache import shared_gates
@@ -117,7 +117,7 @@ def test_a_slab_finish_gets_the_reference_verdicts():
     """Three passes over finish_slab's B-spline top (ends by its extruded sides), one
     pushed 0.05 mm into the top over 15 cycles: both gates fail that cut alone, alike."""
     part = _load("finish_slab")
-    job = Job(Tool(3.0, 0.0), 1500.0, 0.004, Finish((5,), 8.0, None, 0.0, "zigzag"),
+    job = Job(Tool(3.0, 0.0), 1500.0, 0.004, Raster((5,), 8.0, None, 0.0, "zigzag"),
               source=str(FIXTURES / "finish_slab.step"))
     program = cadcnc.run(part, job)
     cuts = [s for s in program.segments if s.kind == "cut"][:3]

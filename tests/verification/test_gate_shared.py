@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import cadcnc
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.program.linking import linked
 from cadcnc.program.program import CutSegment, Program
 from cadcnc.verification import gate_program, gouge_gate
@@ -34,7 +35,7 @@ def wall_path(end_x: float):
     if "pocket" not in _PARTS:
         _PARTS["pocket"] = cadcnc.load_step(FIXTURES / "stretch_pocket.step")
     part = _PARTS["pocket"]
-    return part, cadcnc.intersection_path(part.face(11), part.face(8), radius=3.0,
+    return part, intersection_path(part.face(11), part.face(8), radius=3.0,
                                           feed=1500.0, period=0.004,
                                           start=(10.0, 8.0, 11.0), end=(end_x, 8.0, 11.0))
 

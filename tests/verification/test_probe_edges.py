@@ -1,6 +1,6 @@
 """Verification's face boundaries and whole-box faces answer as OCCT does point by point.
 
-- :class:`~cadcnc.verification.face_edges.FaceEdges` projects with one projector per edge
+- :class:`~cadcnc.verification.face_boundary.FaceEdges` projects with one projector per edge
   made once: its gaps equal those from a projector made for every point
   (``GeomAPI_ProjectPointOnCurve(P, C, t0, t1)``, :func:`project_on_curve`) and the
   edges' ends, at points around every face: to 1e-12 mm, the rounding of the ends'

@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 
 import cadcnc
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.core.tolerances import Tolerances
 from cadcnc.core.trim_labels import TRIM_STATES
 from cadcnc.verification import (
@@ -222,7 +223,7 @@ def third_face_part():
 @pytest.mark.parametrize("case", VSIDE["cases"], ids=lambda c: c["name"])
 def test_whole_part_check_catches_a_third_face(third_face_part, case):
     part = third_face_part
-    tp = cadcnc.intersection_path(*(part.face(n) for n in case["faces"]),
+    tp = intersection_path(*(part.face(n) for n in case["faces"]),
                                   radius=case["radius"], feed=1500, period=0.004)
     rep = verify(tp, part)
     hits = {h.face: h for h in rep.whole_part_hits}
@@ -244,7 +245,7 @@ def test_part_defaults_to_the_toolpath_source_and_progress_is_called(cylinders):
     calls = []
     rep = verify(tp, progress=lambda *a: calls.append(a))
     assert rep.max_overcut_mm == clean.max_overcut_mm
-    assert {c[0] for c in calls} >= {"surfaces", "reference", "whole part"}
+    assert {c[2] for c in calls} >= {"surfaces", "reference", "whole part"}
     text = rep.format_table()
     assert "face 1" in text and "OK" in text
 

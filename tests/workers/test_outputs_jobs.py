@@ -9,6 +9,7 @@ import json
 import pytest
 
 import cadcnc
+from cadcnc.core.errors import OutputError
 from cadcnc.geometry.setup import setup_part
 from cadcnc.io.gcode import blend_for
 from cadcnc.io.outputs import render, render_all
@@ -52,5 +53,5 @@ def test_every_output_made_on_two_processes_is_the_same_bytes(programs, monkeypa
     two = render_all(program, outs, part, "slot", 2, **gcode)
     assert list(two) == outs and two == one
     assert one["p.ngc"] == render(program, "p.ngc", part, "slot", **gcode)
-    with pytest.raises(cadcnc.OutputError, match="unknown output format"):
+    with pytest.raises(OutputError, match="unknown output format"):
         render_all(program, ["p.json", "p.txt"], part, "slot", 2)

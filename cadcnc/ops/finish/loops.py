@@ -40,7 +40,7 @@ from ...program.program import FAILED, STOPPED_SHORT, CutSegment, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
 from .polish import polish
 from .resume import PASS_CYCLES, clear_again, free_run, last_state, xyz
-from .setup import PassSetup, guide_face
+from .pass_setup import PassSetup, guide_face
 
 Z = np.array([0.0, 0.0, 1.0])
 X = np.array([1.0, 0.0, 0.0])

@@ -42,7 +42,7 @@ from ...program.program import FAILED, STOPPED_SHORT, CutSegment, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
 from .check import along_pass, pass_problems
 from .crossings import Crossing, pass_tangent
-from .setup import PassSetup, guide_face, pass_setup
+from .pass_setup import PassSetup, guide_face, pass_setup
 from .polish import polish
 from .resume import PASS_CYCLES, clear_again, free_run, land_exact, last_state, xyz
 from .transitions import CONCAVE, CONVEX, TANGENT, transition

@@ -5,8 +5,9 @@ acos(N_z). With ``--threshold A`` (deg):
 
 - the **waterline** cuts (:mod:`.waterline`, levels planned over the samples steeper than
   A) are kept where their contact's slope exceeds A;
-- the **raster** cuts (the existing passes, :func:`~.finish.finish_program` with strategy
-  raster, planes planned over the samples at most A steep) are kept where it does not;
+- the **raster** cuts (the existing passes, :func:`~.raster.raster_program` of the
+  record's :meth:`~cadcnc.core.operations.SteepShallow.raster`, planes planned over the
+  samples at most A steep) are kept where it does not;
 - ``--overlap MM``: each keeps also what lies within MM (over the surface, measured to
   the nearest sample of the other region, so to within the samples' spacing) of its
   region, so that the two overlap at the boundary.
@@ -27,13 +28,14 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...geometry.part import Part
-from ...core.job import Finish, Job
+from ...core.job import Job
+from ...core.progress import Progress
 from ...program.program import CutSegment, Program
 from ...core.work_limits import MAX_PLANES
 from .plan import FaceSamples, plan_planes
+from .raster import raster_program
 from .uncut import UncutReport, uncut_report
-from .waterline import entered_program, waterline_cuts, waterline_program, \
-    waterline_samples
+from .waterline import entered_program, waterline_cuts, waterline_samples
 
 
 def subset(samples: FaceSamples, mask: np.ndarray) -> FaceSamples:
@@ -99,15 +101,14 @@ def merged(a: UncutReport, b: UncutReport) -> UncutReport:
     return out
 
 
-def strategy_program(part: Part, job: Job, raster, *, progress=None,
-                     max_planes: int = MAX_PLANES, clock=time.monotonic,
-                     work: dict | None = None) -> Program:
-    """The program of a waterline or steep-shallow ``job``; ``raster(part, job, ...)``
-    the raster strategy's program (:func:`~.finish.finish_program`)."""
-    if job.operation.strategy == "waterline":
-        return waterline_program(part, job, progress=progress, max_planes=max_planes,
-                                 clock=clock, work=work)
+def steep_shallow_program(part: Part, job: Job, *, progress: Progress | None = None,
+                          max_planes: int = MAX_PLANES, clock=time.monotonic,
+                          work: dict | None = None) -> Program:
+    """The program of a :class:`~cadcnc.core.job.SteepShallow` ``job`` on ``part`` (the
+    module doc)."""
     op = job.operation
+    for n in op.faces:
+        part.face(n)  # FaceNumberError names the range
     work = {} if work is None else work
     samples = waterline_samples(part, job, work)
     steep = steep_mask(samples.normals, op.threshold)
@@ -122,9 +123,9 @@ def strategy_program(part: Part, job: Job, raster, *, progress=None,
         notes += wl.plan.moved
         reports.append((high, wl.plan))
     if len(low):
-        rjob = replace(job, operation=Finish(op.faces, op.stepover, op.scallop, op.angle,
-                                             op.pattern))
-        ras = raster(part, rjob, progress=progress, max_planes=max_planes, clock=clock)
+        rjob = replace(job, operation=op.raster())
+        ras = raster_program(part, rjob, progress=progress, max_planes=max_planes,
+                             clock=clock)
         cuts += region_cuts(ras.cuts, False, op.threshold, op.overlap, contacts[steep])
         skipped += [s for s in ras.skipped if s.reason in ("failed", "stopped short",
                                                            "collision")]

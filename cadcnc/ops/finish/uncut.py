@@ -100,7 +100,8 @@ def scallop_limit(job) -> float:
     op = job.operation
     if op.scallop is not None:
         return op.scallop
-    spacing = max(s for s in (op.stepover, getattr(op, "stepdown", None)) if s is not None)
+    spacing = max(s for s in (getattr(op, "stepover", None), getattr(op, "stepdown", None))
+                  if s is not None)
     return stepover_scallop(spacing, job.tool.radius)
 
 

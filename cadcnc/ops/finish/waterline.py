@@ -24,18 +24,18 @@ from ...geometry.offset_section import offset_face
 from ...geometry.part import Part
 from ...guard.stay_down import StayDown
 from ...core.job import Job
+from ...core.progress import Progress
 from ...program.program import CutSegment, Program, Skipped
 from ...core.work_limits import MAX_PLANES, Heartbeat
+from ..common import FINISH_JOIN as JOIN
 from ..common import safe_height
 from ..entries import entered_program_segments
 from .levels import CRITICAL_MM, LevelPlan, check_stepdown, critical_heights, plan_levels
 from .loops import level_cuts
 from .plan import MAX_SAMPLES, FaceSamples, centre_chord, sample_faces
-from .setup import pass_setup
+from .pass_setup import pass_setup
 from .uncut import uncut_report
 
-JOIN = 1e-6
-"""mm: a cut starting this near the last one's end continues it."""
 SAMPLES_PER_SPACING = 4
 
 
@@ -65,7 +65,8 @@ def waterline_samples(part: Part, job: Job, work: dict) -> FaceSamples:
     return sample_faces(part, job.operation.faces, level_spacing(job) / SAMPLES_PER_SPACING)
 
 
-def waterline_cuts(part: Part, job: Job, samples: FaceSamples, *, progress=None,
+def waterline_cuts(part: Part, job: Job, samples: FaceSamples, *,
+                   progress: Progress | None = None,
                    max_levels: int = MAX_PLANES, clock=time.monotonic,
                    work: dict | None = None) -> WaterlineCuts:
     """Every level's cuts of a waterline ``job`` over ``samples`` of its faces (the module
@@ -123,10 +124,13 @@ def entered_program(part: Part, job: Job, cuts: list[CutSegment], skipped: list[
     return Program(job, segments, skipped + unreachable, notes)
 
 
-def waterline_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX_PLANES,
-                      clock=time.monotonic, work: dict | None = None) -> Program:
-    """The waterline finishing program of a :class:`~cadcnc.core.job.Finish` ``job``
-    (strategy waterline) on ``part`` (the module doc)."""
+def waterline_program(part: Part, job: Job, *, progress: Progress | None = None,
+                      max_planes: int = MAX_PLANES, clock=time.monotonic,
+                      work: dict | None = None) -> Program:
+    """The program of a :class:`~cadcnc.core.job.Waterline` ``job`` on ``part`` (the
+    module doc)."""
+    for n in job.operation.faces:
+        part.face(n)  # FaceNumberError names the range
     work = {} if work is None else work
     samples = waterline_samples(part, job, work)
     res = waterline_cuts(part, job, samples, progress=progress, max_levels=max_planes,

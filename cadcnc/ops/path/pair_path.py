@@ -19,6 +19,7 @@ from ...interp.compiled import new_stepper
 from ...interp.stepper import Stepper, Tangency
 from ...interp.tangency import solve_tangency
 from ...core.job import Job, PairPath, Tool
+from ...core.progress import Progress, cycles_progress
 from ...core.tolerances import DEFAULT, Tolerances
 from ...program.toolpath import Toolpath, toolpath_from_record
 
@@ -201,9 +202,11 @@ def stepper_for(plan: PathPlan, max_cycles: int = 1_000_000, record: bool = True
                    record=record, check_boundary=plan.check_boundary, guard=guard)
 
 
-def run_plan(plan: PathPlan, max_cycles: int = 1_000_000, progress=None) -> Toolpath:
-    """Run the stepper of a plan to its stop; the toolpath with its error bounds."""
-    stepper = stepper_for(plan, max_cycles, True).run(progress)
+def run_plan(plan: PathPlan, max_cycles: int = 1_000_000,
+             progress: Progress | None = None) -> Toolpath:
+    """Run the stepper of a plan to its stop; the toolpath with its error bounds.
+    ``progress(cycles, 0, "<mm> mm")`` every 10 000 cycles."""
+    stepper = stepper_for(plan, max_cycles, True).run(cycles_progress(progress))
     if stepper.cycles == 0:
         raise GeometryError(f"no path: the interpolator stopped at the start point "
                             f"({stepper.stop_reason}): {stepper.stop_detail}")
@@ -214,7 +217,7 @@ def run_plan(plan: PathPlan, max_cycles: int = 1_000_000, progress=None) -> Tool
 def intersection_path(face_a, face_b, *, radius: float, allowance: float = 0.0, feed: float,
                       period: float, start=None, end=None, offsets=None, edge: int = 0,
                       tol: Tolerances = DEFAULT, max_cycles: int = 1_000_000,
-                      progress=None) -> Toolpath:
+                      progress: Progress | None = None) -> Toolpath:
     """The ball-end cutter path along the intersection of two faces (the paper's method).
 
     ``face_a``/``face_b``: part faces (``part.face(n)``), CadQuery faces or TopoDS faces.
@@ -223,7 +226,7 @@ def intersection_path(face_a, face_b, *, radius: float, allowance: float = 0.0, 
     intersection; by default the ends of the faces' shared concave edge number ``edge``
     (0-based; a closed edge is followed once around). ``offsets``: per-surface offset
     distance, None meaning R + C; 0 makes that face a guide surface carrying the cutter
-    centre. ``progress(cycles, mm)`` is called every 10 000 cycles.
+    centre. ``progress(cycles, 0, "<mm> mm")`` is called every 10 000 cycles.
     """
     s1, s2, job = pair_job(face_a, face_b, radius=radius, allowance=allowance, feed=feed,
                            period=period, start=start, end=end, offsets=offsets, edge=edge,
@@ -231,7 +234,8 @@ def intersection_path(face_a, face_b, *, radius: float, allowance: float = 0.0, 
     return run_plan(plan_path(s1, s2, job), max_cycles, progress)
 
 
-def path_for_job(part, job: Job, max_cycles: int = 1_000_000, progress=None) -> Toolpath:
+def path_for_job(part, job: Job, max_cycles: int = 1_000_000,
+                 progress: Progress | None = None) -> Toolpath:
     """The toolpath of a ``job`` whose operation names two faces of ``part``."""
     i, j = job.operation.faces
     if i is None or j is None:

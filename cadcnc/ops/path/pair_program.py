@@ -26,6 +26,7 @@ from ...core.errors import InputError, NothingToCutError, StartPointError
 from ...interp.cycle import BOUNDARY, COLLISION
 from ...interp.stepper import Tangency
 from ...core.job import Job
+from ...core.progress import Progress, cycles_progress
 from ...program.program import STOPPED_SHORT, CutSegment, Program, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
 from ..common import require_ball, run_stretch, safe_height
@@ -58,23 +59,25 @@ def _reached_limit(tp: Toolpath, st: Stretch) -> bool:
     return tp.stop_reason in (BOUNDARY, COLLISION) and bool(near)
 
 
-def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000, progress=None,
-                    found=None) -> Program:
+def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000,
+                    progress: Progress | None = None, found=None) -> Program:
     """The :class:`Program` of a pair job on ``part`` (see the module doc).
 
-    ``progress(cycles, mm)`` as for a path; ``found``: the pair's stretches when already
-    computed (``pair_stretches``). Raises NothingToCutError (exit 3) naming the reason per
-    edge when no edge has a feasible position; InputError for a ball of R' = 0.
+    ``progress(cycles, 0, "<mm> mm")`` as for a path; ``found``: the pair's stretches
+    when already computed (``pair_stretches``). Raises NothingToCutError (exit 3) naming
+    the reason per edge when no edge has a feasible position; InputError for a ball of
+    R' = 0.
     """
     op = job.operation
     i, j = op.faces
     if i is None or j is None:
         raise InputError("the job names no faces: give the two face numbers")
     require_ball(job)
+    steps = cycles_progress(progress)   # the stepper's (cycles, mm)
     s1, s2 = part.face(i), part.face(j)
     guard = guard_for(part, (i, j), job)
     if op.start is not None:
-        return _from_start(part, job, s1, s2, guard, max_cycles, progress)
+        return _from_start(part, job, s1, s2, guard, max_cycles, steps)
     shared_edge_for(s1, s2)  # FacePairError unless they share a concave edge
     if found is None:
         found = pair_stretches(s1, s2, job, guard)
@@ -84,7 +87,7 @@ def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000, progress=Non
                              f"is no edge {op.edge + 1}")
         found = [found[op.edge]]
     refuse_without_stretch(s1, s2, found)
-    cuts, skipped = stretch_cuts(s1, s2, job, found, guard, max_cycles, progress)
+    cuts, skipped = stretch_cuts(s1, s2, job, found, guard, max_cycles, steps)
     if op.stretch is not None and not cuts:
         n = max(len(e.stretches) for e in found)
         raise InputError(f"faces {i} and {j}: there is no stretch {op.stretch} (the edges "
@@ -140,7 +143,7 @@ def _reversed(tp: Toolpath, plan: PathPlan) -> PathPlan:
 
 
 def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
-                 progress=None, side: str | None = None, work: dict | None = None
+                 steps=None, side: str | None = None, work: dict | None = None
                  ) -> tuple[list[CutSegment], list[Skipped]]:
     """A cut per stretch of ``found`` (every stretch, or stretch ``job.operation.stretch``
     of each edge), in order along each edge, and what was skipped: edges with no feasible
@@ -149,7 +152,8 @@ def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
     ``side``: CLIMB or CONVENTIONAL runs every cut that way (the material on the right of
     the travel for climb; see :func:`climb_measure`), re-running a cut from its other end
     where the edge's own direction is the other way; None keeps the edge's direction.
-    ``work["cycles"]`` (when given) counts every stepper cycle run, re-runs included."""
+    ``work["cycles"]`` (when given) counts every stepper cycle run, re-runs included;
+    ``steps``: the stepper's own ``(cycles, mm)`` callback (``Stepper.run``)."""
     i, j = s1.number, s2.number
     cuts, skipped = [], []
     work = {} if work is None else work
@@ -168,7 +172,7 @@ def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
                 cuts.append(CutSegment(_point_cut(plan), edge=e.edge + 1, stretch=k,
                                        at_limit=True))
                 continue
-            tp = run_stretch(plan, guard, max_cycles, progress)
+            tp = run_stretch(plan, guard, max_cycles, steps)
             work["cycles"] += len(tp) - 1
             at_limit = _reached_limit(tp, st)
             split = None if at_limit else split_at_stop(e, st, tp.points[-1])
@@ -179,7 +183,7 @@ def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
             if side is not None and at_limit and len(tp) > 2:
                 measure = climb_measure(tp)
                 if abs(measure) >= SIDE_MIN and (measure > 0) != (side == CLIMB):
-                    back = run_stretch(_reversed(tp, plan), guard, max_cycles, progress)
+                    back = run_stretch(_reversed(tp, plan), guard, max_cycles, steps)
                     work["cycles"] += len(back) - 1
                     if _reached_limit(back, replace(st, start=st.end, end=st.start)):
                         tp = back
@@ -226,7 +230,7 @@ def _point_cut(plan: PathPlan) -> Toolpath:
         "reached by the plunge"), plan.edge_length)
 
 
-def _from_start(part, job, s1, s2, guard, max_cycles, progress) -> Program:
+def _from_start(part, job, s1, s2, guard, max_cycles, steps) -> Program:
     """One cut from the user's start, moved to the nearest stretch limit when the ball
     cannot sit there (a contact off its face, a third face or the shank in the way)."""
     notes = []
@@ -243,6 +247,6 @@ def _from_start(part, job, s1, s2, guard, max_cycles, progress) -> Program:
         notes.append(note or f"start moved into a stretch ({rule}: {detail})")
         moved = replace(job, operation=replace(job.operation, start=tuple(tan.p)))
         plan = plan_path(s1, s2, moved)
-    tp = run_stretch(plan, guard, max_cycles, progress)
+    tp = run_stretch(plan, guard, max_cycles, steps)
     cut = CutSegment(tp, edge=None, at_limit=tp.stop_reason in (BOUNDARY, COLLISION))
     return entered_program(part, plan.job, [cut], [], notes)

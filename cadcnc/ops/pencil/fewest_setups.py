@@ -34,7 +34,8 @@ from ...program.transform import in_part_coordinates
 from ...core.units import check_axis
 from ..common import safe_height
 from ..entries import entered_program_segments
-from .pencil import CHAIN_GAP, keyword_job, pencil as pencil_one, pencil_program
+from ..run import RunOptions, operation_of
+from .pencil_program import CHAIN_GAP
 
 SPACING = 0.5      # mm between two positions along a concave edge
 REACH_RADII = 5.0  # a ball centre farther than this many R' from its corner's edge counts nothing
@@ -121,13 +122,14 @@ def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
     part = original_part(part)
     samples = _positions(part, job)
     runs, keys = [], []
+    extra = {} if max_cycles is None else {"max_cycles": max_cycles}
+    options = RunOptions(progress=progress, jobs=jobs, **extra)
     for axis in axes:
         sub = replace(job, axis=axis, origin=None if axis != job.axis else job.origin)
         sp = setup_part(part, sub)
         setup = setup_in(sp) or Setup(np.asarray(axis), np.eye(3), np.zeros(3))
-        extra = {} if max_cycles is None else {"max_cycles": max_cycles}
         try:
-            program = pencil_program(sp, sub, progress=progress, jobs=jobs, **extra)
+            program = operation_of(sub).plan(sp, sub, options)   # the Pencil's planner
             error = ""
         except NothingToCutError as e:
             program, error = Program(sub), str(e)
@@ -157,20 +159,6 @@ def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
         taken |= reach_sets[k]
         result.runs.append(run)
     return result
-
-
-def pencil(part, *, setups=None, setup_overlap: float = 0.0, **keywords):
-    """``cadcnc.pencil``: the pencil program of ``part`` (keywords of
-    :func:`cadcnc.ops.pencil.pencil.pencil`, ``axis`` among them), or with ``setups``
-    (AUTO or a list of axes) the :class:`SetupsResult` of :func:`pencil_setups`, each
-    chosen setup's program in ``result.runs`` (not yet gated: :func:`cadcnc.gate_program`
-    with ``run.part``), ``setup_overlap`` mm of lap at their boundaries."""
-    if setups is None:
-        return pencil_one(part, **keywords)
-    progress = keywords.pop("progress", None)
-    keywords.pop("times", None)
-    part, job = keyword_job(part, **keywords)
-    return pencil_setups(part, job, setups, setup_overlap, progress=progress)
 
 
 def _fewest(reach: list[set], universe: set) -> tuple[list[int], int]:

@@ -1,8 +1,8 @@
 """Pencil milling: every inner corner of a part a ball can reach, in one linked program.
 
-:func:`pencil` finds the corners (:func:`~cadcnc.ops.pencil.corners.find_corners`: concave shared
-edges, and blends smaller than the ball, which the ball bridges on the two faces across
-them), cuts every feasible stretch of each (edge corners: :mod:`.stretches` and
+:func:`pencil_program` finds the corners (:func:`~cadcnc.ops.pencil.corners.find_corners`:
+concave shared edges, and blends smaller than the ball, which the ball bridges on the two
+faces across them), cuts every feasible stretch of each (edge corners: :mod:`.stretches` and
 :func:`~cadcnc.ops.path.pair_program.stretch_cuts`; blend corners: the stepper from one seed
 to the other), with the third-face and shank guard inside the stepper, then orders the
 cuts (chains first, where one stops tri-tangent or on a boundary exactly where the next
@@ -27,18 +27,17 @@ from dataclasses import replace
 
 from ...core.errors import CadcncError
 from ...geometry.part import Part
-from ...geometry.setup import setup_part
-from ...core.job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
+from ...core.job import Job, PairPath
+from ...core.progress import Progress
 from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program, Skipped
-from ...core.tolerances import DEFAULT, Tolerances
 from ...core.work_limits import MAX_CYCLES, Heartbeat, refuse_over
 from .corners import BLEND, EDGE, Corner, find_corners
 from ...guard import guard_for
 from ..common import refuse_cycles, require_ball, run_stretch, safe_height
 from ..entries import UNREACHABLE, entered_program_segments
 from ...parallel.tasks import on_workers
-from ..path.pair_program import CLIMB, stretch_cuts
+from ..path.pair_program import stretch_cuts
 from ..path.pair_path import plan_path
 from ..path.stretches import (LIMIT_TOL, MIN_SAMPLES, SPACING, Feasibility,
                               edge_stretches, pair_stretches)
@@ -47,40 +46,8 @@ CHAIN_GAP = 1e-3
 """mm: a cut starting this near another's end continues it (no lift)."""
 
 
-def pencil(part, *, radius: float, allowance: float = 0.0, feed: float = DEFAULT_FEED,
-           period: float = DEFAULT_PERIOD, faces=None, clearance: float | None = None,
-           shank_length: float | None = None, side: str = CLIMB, axis="+Z",
-           tol: Tolerances = DEFAULT, progress=None, times: dict | None = None) -> Program:
-    """The pencil program of ``part`` (a :class:`~cadcnc.geometry.part.Part`, or a CadQuery
-    Workplane or Shape, read with :meth:`Part.from_cadquery`) for a ball of radius
-    ``radius`` (mm) with ``allowance`` (mm): see the module doc. A keyword convenience
-    that builds the :class:`~cadcnc.core.job.Job` of :func:`pencil_program`.
-
-    ``faces``: face numbers to restrict the corners to (both faces of a corner must be
-    among them); ``clearance``: ball-centre Z of the links (default the part's top + 10
-    mm); ``side``: "climb" (default: the material on the right of the travel, for a
-    clockwise spindle) or "conventional"; ``axis``: the tool axis (docs/setups.md: the
-    program is then in the setup's work coordinates); ``progress``, ``times``: see
-    :func:`pencil_program`.
-    """
-    part, job = keyword_job(part, radius, allowance, feed, period, faces, clearance,
-                            shank_length, side, axis, tol)
-    return pencil_program(setup_part(part, job), job, progress=progress, times=times)
-
-
-def keyword_job(part, radius: float, allowance: float = 0.0, feed: float = DEFAULT_FEED,
-                period: float = DEFAULT_PERIOD, faces=None, clearance: float | None = None,
-                shank_length: float | None = None, side: str = CLIMB, axis="+Z",
-                tol: Tolerances = DEFAULT) -> tuple[Part, Job]:
-    """(part, job) of :func:`pencil`'s keywords (a CadQuery part read as a Part)."""
-    if not isinstance(part, Part):
-        part = Part.from_cadquery(part, tol)
-    return part, Job(Tool(radius, allowance, shank_length), feed, period,
-                     Pencil(faces, side), source=part.source, clearance=clearance,
-                     tolerances=tol, axis=axis)
-
-
-def pencil_program(part: Part, job: Job, *, progress=None, times: dict | None = None,
+def pencil_program(part: Part, job: Job, *, progress: Progress | None = None,
+                   times: dict | None = None,
                    max_cycles: int = MAX_CYCLES, clock=time.monotonic,
                    work: dict | None = None, jobs: int | None = 1) -> Program:
     """The pencil program of a :class:`~cadcnc.core.job.Pencil` ``job`` on ``part``.

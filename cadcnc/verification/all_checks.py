@@ -19,7 +19,7 @@ from ..core.tolerances import Tolerances
 from .path_checks import check_feed, check_stop, check_theory, followed_edge, intended_span
 from .probe import offset_surface, shape_distances
 from .reference import check_reference
-from .records import WholePartCheck
+from .check_records import WholePartCheck
 from .report import VerificationReport
 from .surface_checks import SAMPLE_UNSEEDED, check_pair, prepare
 from .whole_part import check_whole_part
@@ -40,7 +40,7 @@ def verify(toolpath, part=None, *, tol: Tolerances | None = None,
     ``sample_unseeded``: how many cycles per face are re-projected without seeds.
     ``reference_spacing_mm``: sample spacing of OCCT's intersection curve.
     ``whole_part``: False skips the ball against the other faces (and along the moves).
-    ``progress(stage, done, total)`` is called as stages advance ("surfaces", "reference",
+    ``progress(done, total, stage)`` is called as stages advance ("surfaces", "reference",
     "whole part").
     """
     require("toolpath", toolpath, Toolpath, "a cadcnc Toolpath")
@@ -56,7 +56,7 @@ def verify(toolpath, part=None, *, tol: Tolerances | None = None,
     f_max = float(np.max(toolpath.commanded[1:])) if len(toolpath) > 1 else 1.0
     t1 = time.perf_counter()
     if progress:
-        progress("reference", 0, 1)
+        progress(0, 1, "reference")
     ref = check_reference(
         *(offset_surface(probes[n], off) for n, off in zip(faces, offsets)),
         toolpath.points, span=span, target=target, cover_radius=COVER_RADIUS_STEPS * f_max,

@@ -1,6 +1,6 @@
-"""Guide-surface finishing: raster passes of the ball over selected faces, one program.
+"""Raster finishing: passes of the ball over selected faces on guide planes, one program.
 
-:func:`finish` samples the selected faces, places vertical guide planes at the pass angle
+:func:`raster_program` samples the selected faces, places vertical guide planes at the pass angle
 (:mod:`.plan`: a fixed stepover, or the spacing that keeps the scallop within a
 height), runs one pass per plane (:func:`~cadcnc.ops.finish.passes.pass_cuts`: the paper's
 guide-surface interpolation, the ball touching the faces, its centre on the plane), every
@@ -18,71 +18,34 @@ mm, feed mm/min, period s, angles degrees.
 
 from __future__ import annotations
 
-import numbers
 import time
 
-import numpy as np
-
 from ...core.errors import InputError
-from ...geometry.part import Part
-from ...core.job import Finish, Job, Tool
-from ...program.program import CutSegment, Program, Skipped
-from ...core.tolerances import DEFAULT, Tolerances
+from ...core.job import Job
+from ...core.progress import Progress
 from ...core.work_limits import MAX_PLANES, Heartbeat
-from .passes import GuidePlane, PassResult, pass_cuts
-from .steep_shallow import strategy_program
-from .waterline import stay_down_links
-from .plan import MAX_SAMPLES, centre_chord, plan_planes, sample_faces
-from .uncut import uncut_report
+from ...geometry.part import Part
+from ...program.program import CutSegment, Program, Skipped
+from ...parallel.pool import check_jobs
+from ..common import FINISH_JOIN as JOIN
 from ..common import safe_height
 from ..entries import entered_program_segments
-from ...parallel.pool import check_jobs
 from ...parallel.tasks import on_workers
-from .setup import pass_setup
-from ...core.job import DEFAULT_FEED, DEFAULT_PERIOD
+from .passes import GuidePlane, PassResult, pass_cuts
+from .plan import MAX_SAMPLES, centre_chord, plan_planes, sample_faces
+from .pass_setup import pass_setup
+from .uncut import uncut_report
+from .waterline import stay_down_links
 
-JOIN = 1e-6
-"""mm: a cut starting this near the last one's end continues it (one pass, chained)."""
 SAMPLES_PER_SPACING = 4
 """The faces are sampled this many times per plane spacing (stepover, or the flat
 spacing of the scallop height)."""
 
 
-def finish(part, faces, *, radius: float, allowance: float = 0.0,
-           stepover: float | None = None, scallop: float | None = None,
-           angle: float = 0.0, pattern: str = "zigzag", feed: float = DEFAULT_FEED,
-           period: float = DEFAULT_PERIOD, clearance: float | None = None,
-           shank_length: float | None = None, tol: Tolerances = DEFAULT,
-           progress=None, max_planes: int = MAX_PLANES, strategy: str = "raster",
-           stepdown: float | None = None, threshold: float = 45.0, side: str = "climb",
-           overlap: float = 0.0) -> Program:
-    """The finishing program of ``faces`` of ``part`` (see the module doc).
-
-    ``part``: a :class:`~cadcnc.geometry.part.Part`, or a CadQuery Workplane or Shape;
-    ``faces``: face numbers (1-based), CadQuery/OCCT faces of the part, or a Workplane
-    selection such as ``wp.faces(">Z")``. ``radius`` R and ``allowance`` C (mm): the ball
-    runs R' = R + C from the faces. Exactly one of ``stepover`` (plane spacing, mm) and
-    ``scallop`` (largest scallop height, mm). ``angle``: the passes' direction to +X (deg);
-    ``pattern``: "zigzag" or "oneway". ``clearance``: ball-centre Z of the retracts
-    (default the part's top + 10 mm). ``progress(done, total, what)`` after each plane. A
-    keyword convenience that builds the :class:`~cadcnc.core.job.Job` of :func:`finish_program`.
-    ``strategy``: "raster", "waterline" (``stepdown`` or ``scallop``; loops ``side``
-    "climb" or "conventional") or "steep-shallow" (waterline where the slope exceeds
-    ``threshold`` deg, raster elsewhere, ``overlap`` mm at the boundary; docs/finish.md).
-    """
-    if not isinstance(part, Part):
-        part = Part.from_cadquery(part, tol)
-    op = Finish(face_numbers(part, faces), stepover, scallop, angle, pattern, stepdown,
-                strategy, threshold, side, overlap)
-    job = Job(Tool(radius, allowance, shank_length), feed, period, op, source=part.source,
-              clearance=clearance, tolerances=tol)
-    return finish_program(part, job, progress=progress, max_planes=max_planes)
-
-
-def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX_PLANES,
-                   clock=time.monotonic, work: dict | None = None,
-                   jobs: int | None = 1) -> Program:
-    """The finishing program of a :class:`~cadcnc.core.job.Finish` ``job`` on ``part``:
+def raster_program(part: Part, job: Job, *, progress: Progress | None = None,
+                   max_planes: int = MAX_PLANES, clock=time.monotonic,
+                   work: dict | None = None, jobs: int | None = 1) -> Program:
+    """The program of a :class:`~cadcnc.core.job.Raster` ``job`` on ``part``:
     ``progress(done, total, what)`` after each plane, and inside a plane at least every
     HEARTBEAT_S seconds of ``clock`` (``done`` then counting the planes finished). The
     planes are estimated before any is placed and refused over ``max_planes``
@@ -94,9 +57,6 @@ def finish_program(part: Part, job: Job, *, progress=None, max_planes: int = MAX
     op, pattern = job.operation, job.operation.pattern
     for n in op.faces:
         part.face(n)  # FaceNumberError names the range
-    if op.strategy != "raster":   # waterline, steep-shallow (this function their raster)
-        return strategy_program(part, job, finish_program, progress=progress,
-                                max_planes=max_planes, clock=clock, work=work)
     work = {} if work is None else work
     plan, samples = plan_for_job(part, job, max_planes=max_planes, work=work)
     total, done = len(plan.offsets), 0
@@ -161,37 +121,3 @@ def plan_for_job(part: Part, job: Job, *, max_planes: int = MAX_PLANES,
                        stepover=op.stepover, scallop=op.scallop, max_planes=max_planes,
                        work=work)
     return plan, samples
-
-
-def face_numbers(part: Part, faces) -> tuple[int, ...]:
-    """The 1-based numbers of ``faces`` in ``part``: numbers, faces of the part (CadQuery
-    or OCCT), or a CadQuery Workplane selection; InputError for anything else."""
-    if hasattr(faces, "vals") and callable(faces.vals):  # a Workplane selection
-        faces = faces.vals()
-    elif isinstance(faces, (numbers.Integral, np.integer)) or hasattr(faces, "wrapped"):
-        faces = [faces]
-    try:
-        items = list(faces)
-    except TypeError:
-        raise InputError(f"faces must be face numbers, CadQuery faces or a Workplane "
-                         f"selection, got {type(faces).__name__}") from None
-    if not items:
-        raise InputError("no face selected: give at least one face")
-    out = []
-    for f in items:
-        if isinstance(f, bool):
-            raise InputError(f"face numbers are integers from 1, got {f!r}")
-        if isinstance(f, (numbers.Integral, np.integer)):
-            part.face(int(f))  # FaceNumberError names the range
-            out.append(int(f))
-            continue
-        kind = getattr(getattr(f, "wrapped", f), "ShapeType", None)
-        if kind is None or type(f).__name__ not in ("Face", "TopoDS_Face"):
-            raise InputError(f"faces must be face numbers or faces, got a "
-                             f"{type(f).__name__}")
-        n = part.face_number(f)
-        if n == 0:
-            raise InputError(f"a face given is not a face of the part {part.source} (a "
-                             "selection from another shape, or a copy of it?)")
-        out.append(n)
-    return tuple(out)
