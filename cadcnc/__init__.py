@@ -18,7 +18,6 @@ from .core.errors import (
     SingularPointError, StartPointError, StepFileError,
 )
 from .core.job import Finish, Job, PairPath, Pencil, Tool
-from .batch import batch  # the function: the name `cadcnc.batch` is not the package
 from .core.tolerances import Tolerances
 
 __version__ = "0.1.0"
@@ -38,13 +37,14 @@ _LAZY = {
     "run": "ops.run", "program_for_job": "ops.path.pair_program",
     "pencil_program": "ops.pencil.pencil", "finish_program": "ops.finish.finish",
     "gate_program": "verification", "read_program": "io.program_json",
-    "BatchPart": "batch.task", "BatchOperation": "batch.task", "Settings": "batch.operate",
+    "BatchPart": "batch.task", "BatchOperation": "batch.task", "Settings": "pipeline.operate",
+    "run_batch": "batch.engine",
 }
 
 __all__ = [
     "CadcncError", "FaceNumberError", "FacePairError", "GeometryError", "InputError",
     "OutputError", "SingularPointError", "StartPointError", "StepFileError", "Job",
-    "PairPath", "Pencil", "Finish", "Tool", "Tolerances", "batch", *_LAZY,
+    "PairPath", "Pencil", "Finish", "Tool", "Tolerances", *_LAZY,
 ]
 
 

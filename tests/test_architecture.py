@@ -161,7 +161,7 @@ def test_no_private_name_imported_across_modules():
 
 
 STAGES = ["core", "interp", "geometry", "guard", "program", "ops", "controller", "io",
-          "verification", "apt", "batch", "cli"]
+          "verification", "apt", "pipeline", "batch", "cli"]
 """The data flow, in the order the code has (docs/architecture.md): a stage imports only from
 itself and the stages before it."""
 TOP = {"cadcnc", "cadcnc.__main__", "cadcnc.workers"}
@@ -205,3 +205,34 @@ def test_exit_codes_come_from_their_one_definition():
             literal += [f"{name}:{node.lineno}: {b.value}" for b in branches
                         if isinstance(b, ast.Constant) and type(b.value) is int and b.value]
     assert literal == []
+
+
+def test_the_cli_has_no_function_local_imports():
+    """The command line imports at the top of its modules only; the one lazy import is the
+    command table's (cadcnc/cli/commands.py, importlib on dispatch)."""
+    local = []
+    for name, path in MODULES.items():
+        if not name.startswith("cadcnc.cli"):
+            continue
+        for fn in ast.walk(ast.parse(path.read_text())):
+            if isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                local += [f"{name}.{fn.name}: line {node.lineno}" for node in ast.walk(fn)
+                          if isinstance(node, (ast.Import, ast.ImportFrom))]
+    assert local == []
+
+
+HANDLER_LINES = 30
+"""The most lines a command's handler may have: parse -> Job -> one pipeline call -> print."""
+
+
+def test_each_command_handler_is_short():
+    from cadcnc.cli.commands import HANDLERS
+
+    long = {}
+    for command, where in HANDLERS.items():
+        module, _, function = where.partition(":")
+        tree = ast.parse(MODULES[module].read_text())
+        fn = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == function)
+        if fn.end_lineno - fn.lineno + 1 > HANDLER_LINES:
+            long[command] = fn.end_lineno - fn.lineno + 1
+    assert long == {}

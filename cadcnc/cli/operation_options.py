@@ -1,6 +1,5 @@
-"""What the operation commands (``path``, ``pencil``, ``finish``) share: their feed and
-output options, and the command itself: options to a Job, one library call, the library's
-verdict, the summary, the outputs written all at once, the library's exit code."""
+"""The options the operation commands (``path``, ``pencil``, ``finish``) share: feed,
+period, outputs, work limit, processes, setup and ``--stream``."""
 
 from __future__ import annotations
 
@@ -63,69 +62,3 @@ def add_max_cycles(p) -> None:
                    help="the machine's LinuxCNC INI for --stream (default: a Tormach PCNC 770)")
     g.add_argument("--jerk", metavar="J", help="jerk limit of every axis for --stream, mm/s^3")
 
-
-
-def operation_command(args, what: str, job_of, *, progress=None,
-                      times: dict | None = None) -> int:
-    """Run one operation from the command line (module doc), its worker processes
-    (``--jobs``) ended when it returns."""
-    from cadcnc import workers
-
-    try:
-        return _operation(args, what, job_of, progress=progress, times=times)
-    finally:
-        workers.close()
-
-
-def _operation(args, what: str, job_of, *, progress=None, times: dict | None = None) -> int:
-    """Run one operation from the command line (module doc). ``job_of(args, source)``
-    builds its Job; ``progress``: the operation's progress callback; ``times``: per-stage
-    seconds (pencil)."""
-    from cadcnc.batch.operate import operate, rendered
-    from cadcnc.geometry.setup import setup_in
-    from cadcnc.io.output_set import OutputSet
-    from cadcnc.io.outputs import SUFFIXES
-
-    from .feedback import say_error, stage_progress
-    from .options import settings_of
-
-    outputs = OutputSet(args.output, SUFFIXES, inputs=[args.step])  # checked before computing
-    machine = None
-    if getattr(args, "stream", None):
-        from cadcnc.io.output_set import check_destination
-
-        from .stream import SUFFIXES as STREAM_SUFFIXES, machine_of
-
-        for out in args.stream:
-            check_destination(out, STREAM_SUFFIXES, [args.step])
-        machine = machine_of(args)
-    job = job_of(args, args.step)
-    settings = settings_of(args)
-    done = operate(args.step, job, what, settings, progress=progress, times=times,
-                   gate_progress=stage_progress(args, f"{what}: gouge check", after_s=1.0))
-    program, part, verdict = done.program, done.part, done.verdict
-    for line in verdict.messages:
-        say_error(line)
-    if not args.quiet:
-        print(program.summary(Path(args.step).name))
-        if setup_in(part) is not None:
-            print("  setup      " + "; ".join(setup_in(part).describe()))
-        print("  verdict    " + ("written" if verdict.write else "nothing written") + (
-            "" if verdict.code == 0 else f" (exit {verdict.code}: see the message above)"))
-        staged = "" if not times else "; " + ", ".join(f"{k} {v:.1f} s"
-                                                       for k, v in times.items())
-        print(f"  time       computed in {done.seconds_computed:.1f} s, gated in "
-              f"{done.seconds_gated:.1f} s{staged}")
-    if verdict.write:
-        outputs.write(rendered(done, args.output, done.what, settings))
-        if not args.quiet:
-            print(f"  wrote      {', '.join(args.output)}")
-    if machine is not None:
-        if verdict.code != 0:
-            say_error(f"cadcnc: {done.what}: not streamed: only a complete, verified program is")
-            return verdict.code
-        from .stream import stream_outputs
-
-        return stream_outputs(program, part, machine, args.stream, tolerances=job.tolerances,
-                              quiet=args.quiet, name=Path(args.step).name, inputs=[args.step])
-    return verdict.code
