@@ -213,8 +213,8 @@ def main(argv: list[str] | None = None) -> int:
         # importing the library (OCCT) takes ~1.5 s: `--help` and usage errors don't pay it;
         # Ctrl-C inside OCCT's C-extension import would surface as an ImportError
         with sigint_deferred():
-            if getattr(args, "jobs", 1) != 1:   # its imports run beside ours
-                workers.start(args.jobs)
+            if getattr(args, "processes", 1) != 1:   # its imports run beside ours
+                workers.start(args.processes)
             run = handler(args.command)   # the library imported now (commands.py)
         return int(run(args) or 0)
     except KeyboardInterrupt:

@@ -49,7 +49,7 @@ def add_max_cycles(p) -> None:
     p.add_argument("--max-cycles", type=int, default=MAX_CYCLES, metavar="N",
                    help=f"interpolation cycles the program may need, estimated before "
                         f"computing and refused over it (default {MAX_CYCLES})")
-    p.add_argument("--jobs", type=int, default=None, metavar="N",
+    p.add_argument("--jobs", dest="processes", type=int, default=None, metavar="N",
                    help="processes: pencil's corners, finishing's planes and the gouge "
                         "gate's cuts run on N cores (default: all; 1: one process); the "
                         "outputs are the same whatever N")

@@ -113,7 +113,7 @@ def settings_of(args, processes: int | None = None) -> Settings:
     processes: ``processes``, else ``--jobs`` (default every core)."""
     return Settings(args.max_cycles, gcode_keywords(args) if wants_gcode(args.output)
                     else None, args.allow_partial, args.allow_gouge,
-                    check_jobs(getattr(args, "jobs", None)) if processes is None
+                    check_jobs(getattr(args, "processes", None)) if processes is None
                     else processes)
 
 

@@ -103,8 +103,19 @@ def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progr
             raise
         raise NothingToCutError(f"{what}: {e}") from None
     t_cut = time.monotonic() - t0
-    join = cut_back_gap(job)
     open_shared(part)  # the cut-back step and the program gate share their work
+    program, verdict = settled_and_judged(program, part, job, step, what, settings,
+                                          gate_progress=gate_progress)
+    return Outcome(part, program, verdict, t_cut, time.monotonic() - t0 - t_cut, what)
+
+
+def settled_and_judged(program: Program, part: Part, job: Job, step, what: str,
+                       settings: Settings, *, gate_progress=None) -> tuple[Program, Verdict]:
+    """``program`` with its gouging cuts cut back (pencil, finish: :func:`settle`) and its
+    :class:`Verdict` (:func:`judge`), as ``settings`` ask; ``job`` gives the links' safe
+    height; ``step`` and ``what`` name the run in messages. NothingToCutError when no cut
+    is left."""
+    join = cut_back_gap(job)
     if join is not None:
         program = settle(program, part, safe_height(part, job), join, f"{step}: {what}",
                          settings.allow_gouge, processes=settings.processes)
@@ -113,7 +124,7 @@ def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progr
     verdict = judge(program, part, f"cadcnc: {what}", gcode=settings.gcode,
                     allow_partial=settings.allow_partial, allow_gouge=settings.allow_gouge,
                     progress=gate_progress, processes=settings.processes)
-    return Outcome(part, program, verdict, t_cut, time.monotonic() - t0 - t_cut, what)
+    return program, verdict
 
 
 def rendered(outcome: Outcome, outputs, what: str, settings: Settings) -> dict:

@@ -19,12 +19,10 @@ from ..core.job import PRINCIPAL_AXES, Job
 from ..geometry.part import load_step
 from ..io.output_set import OutputSet, check_destination
 from ..io.outputs import SUFFIXES, render
-from ..ops.common import safe_height
-from ..ops.pencil.pencil import CHAIN_GAP
 from ..ops.pencil.setups import AUTO, SetupsResult, axis_tag, parse_setups, pencil_setups
 from ..program.program import Program
-from .exit_policy import Verdict, judge, settle, worst
-from .operate import Settings
+from .exit_policy import Verdict, worst
+from .operate import Settings, settled_and_judged
 
 
 @dataclass
@@ -109,20 +107,16 @@ def _judged(run: SetupsRun, step, job: Job, outputs, settings: Settings, codes: 
     for chosen in run.result.runs:
         what = f"pencil (tool axis {chosen.setup.name})"
         try:
-            program = settle(chosen.program, chosen.part,
-                             safe_height(chosen.part, chosen.program.job), CHAIN_GAP,
-                             f"{step}: {what}", settings.allow_gouge)
+            program, verdict = settled_and_judged(
+                chosen.program, chosen.part, chosen.program.job, step, what, settings,
+                gate_progress=gate_progress(what) if gate_progress else None)
         except NothingToCutError as e:
             run.messages.append(f"cadcnc: {e}")
             codes.append(EXIT_NOTHING)
             run.programs.append(SetupProgram(chosen.setup, None, None))
             continue
-        verdict = judge(program, chosen.part, f"cadcnc: {what}", gcode=settings.gcode,
-                        allow_partial=settings.allow_partial,
-                        allow_gouge=settings.allow_gouge,
-                        progress=gate_progress(what) if gate_progress else None,
-                        processes=settings.processes)
-        workers.close()
+        finally:
+            workers.close()
         run.messages += verdict.messages
         codes.append(verdict.code)
         run.programs.append(SetupProgram(chosen.setup, program, verdict))
