@@ -7,7 +7,7 @@ import sys
 
 from cadcnc.core.errors import EXIT_INTERRUPTED
 
-from .app import main as run
+from .commands import load
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -20,7 +20,7 @@ def main(argv: list[str] | None = None) -> int:
     the signal (exit -2) instead of leaving its exit code.
     """
     try:
-        code = run(argv)   # the library is imported in there (commands.py): Ctrl-C caught
+        code = load("cadcnc.cli.app:main")(argv)   # Ctrl-C while it loads is caught
     except KeyboardInterrupt:  # during start-up or argument parsing
         print("cadcnc: interrupted", file=sys.stderr)
         code = EXIT_INTERRUPTED

@@ -1,9 +1,11 @@
 """The command table: each command's handler, imported when the command runs.
 
-This is the command line's one lazy import. Importing the library (OCCT ~1.5 s, numba,
-Dask ~3 s) is paid only by a command that needs it: ``--help`` and usage errors pay
-none, ``cadcnc faces`` only the part's modules (not numba, not the interpolation core).
-Every handler takes the argparse namespace and returns the exit code.
+This is the command line's one lazy import (:func:`load`; :func:`cadcnc.cli.main` loads
+the parser with it too, so that Ctrl-C while it loads is exit 130, not a traceback).
+Importing the library (OCCT ~1.5 s, numba, Dask ~3 s) is paid only by a command that
+needs it: ``--help`` and usage errors pay none, ``cadcnc faces`` only the part's modules
+(not numba, not the interpolation core). Every handler takes the argparse namespace and
+returns the exit code.
 """
 
 from __future__ import annotations
@@ -26,7 +28,12 @@ HANDLERS = {
 """``{command: "module:function"}`` of every command's handler."""
 
 
+def load(target: str) -> Callable:
+    """The function named by ``"module:function"``, its module imported now."""
+    module, _, name = target.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
 def handler(command: str) -> Callable:
     """The handler of ``command``, its module imported now."""
-    module, _, name = HANDLERS[command].partition(":")
-    return getattr(importlib.import_module(module), name)
+    return load(HANDLERS[command])

@@ -3,8 +3,6 @@ period, outputs, work limit, processes, setup and ``--stream``."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from cadcnc.core.job import DEFAULT_FEED as FEED, DEFAULT_PERIOD as PERIOD
 from cadcnc.core.work_limits import MAX_CYCLES
 
