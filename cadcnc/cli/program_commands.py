@@ -30,7 +30,7 @@ def verify(args) -> int:
                          job=None if saved else path_job(args, args.input),
                          progress=progress(args, "verify"),
                          cut_progress=lambda: stage_progress(args, "verify"),
-                         links_progress=stage_progress(args, "verify: links", after_s=1.0))
+                         links_progress=lambda: stage_progress(args, "verify: links", after_s=1.0))
     _print_reports(run, tol, args.json)
     for line in run.messages:
         say_error(line)

@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass, field
 
 from ..core.errors import (EXIT_GOUGE, EXIT_INPUT, EXIT_INTERNAL, EXIT_NOTHING, EXIT_OK,
-                      EXIT_OUTPUT, EXIT_PARTIAL, NothingToCutError)
+                           EXIT_OUTPUT, EXIT_PARTIAL, NothingToCutError)
 from ..program.program import FAILED, STOPPED_SHORT, Program
 from ..program.summary import skipped_counts
 from ..verification.cut_back import cut_back

@@ -14,15 +14,15 @@ from pathlib import Path
 import numpy as np
 
 from ..core.errors import InputError, NothingToCutError
+from ..core.job import Job
+from ..core.work_limits import MAX_CYCLES
 from ..geometry.part import Part, load_step
 from ..geometry.setup import setup_in, setup_part
 from ..io.outputs import render_all
-from ..core.job import Job
 from ..ops.common import safe_height
 from ..ops.run import cut_back_gap
 from ..program.program import Program
 from ..verification.gate_cache import open_shared
-from ..core.work_limits import MAX_CYCLES
 from .exit_policy import Verdict, judge, settle
 from .plan import plan
 

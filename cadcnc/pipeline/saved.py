@@ -65,8 +65,8 @@ def verify_program(source: str, tol: Tolerances, *, part_file: str | None = None
     """Verify every cut of a program against OCCT: the program saved in ``source`` (a
     .json) or computed from ``job`` on the STEP file ``source``; then its links by the
     operations' gate. ``progress``: the computation's ``(cycles, mm)``;
-    ``cut_progress()``: a new ``(stage, done, total)`` callback for each cut's checks;
-    ``links_progress``: the links gate's."""
+    ``cut_progress()`` / ``links_progress()``: a new ``(stage, done, total)`` callback for
+    each cut's checks and for the links gate, made when they start."""
     if job is None:
         program, part = load_saved(source, part_file)
     else:
@@ -90,7 +90,7 @@ def _judge_links(run: VerifyRun, program, part, tol: Tolerances, progress) -> No
     only); a program of cuts alone has no link to judge."""
     if not program.links:
         return
-    gate = gate_program(program, part, tol, progress=progress)
+    gate = gate_program(program, part, tol, progress=progress() if progress else None)
     if any(gate.link_failed):
         run.code = EXIT_GOUGE
         run.messages.append(f"cadcnc: verify: links fail the gouge gate: {gate.message}")
