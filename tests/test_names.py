@@ -11,13 +11,6 @@ PKG = Path(__file__).resolve().parents[1] / "cadcnc"
 ALLOWED = {
     "__init__.py": "a package's own module: Python's name",
     "__main__.py": "``python -m`` of a package: Python's name",
-    "stream.py": "cli/stream.py is the ``cadcnc stream`` command of controller/stream.py; "
-                 "the CLI's modules are being renamed with the pipeline stage (issue 38)",
-    "follow.py": "interp/follow.py and its compiled loop interp/kernel/follow.py: the state "
-                 "developer's stage (issue 38)",
-    "analytic.py": "interp/kernel/analytic.py (surfaces' derivatives) and guard/analytic.py "
-                   "(distances to analytic faces): the kernel is the state developer's "
-                   "(issue 38)",
 }
 
 

@@ -26,9 +26,9 @@ import time
 from pathlib import Path
 
 import cadcnc
+from cadcnc.batch.engine import connect, run_batch
 from cadcnc.core.tolerances import Tolerances
-from cadcnc.batch.engine import batch, connect
-from cadcnc.batch.operate import Settings
+from cadcnc.pipeline.operate import Settings
 from cadcnc.batch.task import BatchOperation, BatchPart
 from cadcnc.io.gcode import blend_for
 
@@ -80,7 +80,7 @@ def one_batch(parts: list[BatchPart], workers: int) -> dict:
     with tempfile.TemporaryDirectory(prefix="cadcnc-batch-bench-") as out:
         load0 = os.getloadavg()
         t0 = time.perf_counter()
-        records = batch(parts, out, workers=workers, force=True)
+        records = run_batch(parts, out, workers=workers, force=True)
         wall = time.perf_counter() - t0
     return {"workers": workers, "wall_s": wall, "load_before": load0,
             "load_after": os.getloadavg(),

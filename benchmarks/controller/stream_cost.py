@@ -8,7 +8,7 @@ every timing):
 - ``plan``: cutting into pieces, planning every piece and the per-period arc lengths, per
   period of the whole stream;
 - ``drive``: per period of a cut, the stream's plan for the kernel (``follow_plan``) and
-  the kernel following it (``interp.follow``: the compiled loop, kernel step included);
+  the kernel following it (``interp.planned_follow``: the compiled loop, kernel step included);
 - ``step``: the bare step, the same cuts' steppers run at the programmed feed in the
   compiled loop (``Stepper.run``), per cycle;
 - ``on top`` = plan + drive - step; ``ratio`` = (plan + drive) / step;
@@ -30,7 +30,7 @@ from cadcnc.controller import Machine, stream_program
 from cadcnc.controller.feed_plan import plan_feed
 from cadcnc.controller.pieces import pieces_of
 from cadcnc.controller.stream import LANDING, follow_plan
-from cadcnc.interp.follow import follow
+from cadcnc.interp.planned_follow import follow
 from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job

@@ -28,8 +28,8 @@ STAGES = {   # stage name: (module, attribute path)
     "guard.margin": ("cadcnc.guard.clearance", "ClearanceGuard.margin"),
     "guard.budget": ("cadcnc.guard.guard", "OperationGuard.budget"),
     "linking": ("cadcnc.ops.entries", "entered_program_segments"),
-    "settle (cut-back)": ("cadcnc.verification.judgement", "settle"),
-    "judge (gate)": ("cadcnc.verification.judgement", "judge"),
+    "settle (cut-back)": ("cadcnc.pipeline.exit_policy", "settle"),
+    "judge (gate)": ("cadcnc.pipeline.exit_policy", "judge"),
     "outputs": ("cadcnc.io.output_set", "OutputSet.write"),
 }
 """Where missing in the code measured (an older tree), a stage is left out."""

@@ -1,19 +1,7 @@
-"""Batches of parts on Dask distributed (docs/batch.md): :func:`batch` runs each part's
-operations as one task on an embedded local cluster or an existing one, writes each
-part's outputs to its own folder and returns the summary's records.
+"""Batches of parts on Dask distributed (docs/batch.md): :func:`~cadcnc.batch.engine.run_batch`
+(``cadcnc.run_batch``) runs each part's operations as one task on an embedded local cluster
+or an existing one, writes each part's outputs to its own folder and returns the summary's
+records; :mod:`~cadcnc.batch.job_file` reads a batch's job file.
 
-:func:`cadcnc.batch.batch` is the entry (``from cadcnc.batch import batch``); the modules
-are ``cadcnc.batch.engine`` and so on.
+Nothing is imported here: Dask and OCCT take about 3 s, which ``import cadcnc`` does not pay.
 """
-
-from __future__ import annotations
-
-
-def batch(parts, out, **options):
-    """The records of a batch: :func:`cadcnc.batch.engine.batch` (same arguments)."""
-    from .engine import batch as run  # Dask and OCCT: about 3 s `import cadcnc` does not pay
-
-    return run(parts, out, **options)
-
-
-__all__ = ["batch"]

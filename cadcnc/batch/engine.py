@@ -62,7 +62,7 @@ class _Planned:
     sets: list[OutputSet]
 
 
-def batch(parts: Sequence[BatchPart], out, *, scheduler: str | None = None,
+def run_batch(parts: Sequence[BatchPart], out, *, scheduler: str | None = None,
           workers: int | None = None, force: bool = False,
           progress: Callable[[Progress], None] | None = None, inputs=()) -> list[Record]:
     """Run every part's operations and return the summary's records (one per part and

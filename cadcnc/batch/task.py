@@ -16,7 +16,7 @@ from distributed import get_worker
 
 from ..core.errors import EXIT_INTERNAL, EXIT_OK, CadcncError
 from ..core.job import Job
-from .operate import Settings, operate, rendered
+from ..pipeline.operate import Settings, operate, rendered
 
 EVENT_TOPIC = "cadcnc-batch"
 """The Dask event topic on which a task says it started (part, worker, pid, host)."""

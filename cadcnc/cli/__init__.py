@@ -7,6 +7,8 @@ import sys
 
 from cadcnc.core.errors import EXIT_INTERRUPTED
 
+from .commands import load
+
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; Ctrl-C while it starts up is exit 130 too, not a traceback.
@@ -18,9 +20,7 @@ def main(argv: list[str] | None = None) -> int:
     the signal (exit -2) instead of leaving its exit code.
     """
     try:
-        from .app import main as run  # inside: Ctrl-C during this import is caught
-
-        code = run(argv)
+        code = load("cadcnc.cli.app:main")(argv)   # Ctrl-C while it loads is caught
     except KeyboardInterrupt:  # during start-up or argument parsing
         print("cadcnc: interrupted", file=sys.stderr)
         code = EXIT_INTERRUPTED

@@ -3,8 +3,8 @@
 Errors the library raises on purpose (:class:`cadcnc.core.errors.CadcncError`) become one line
 ``cadcnc: error: <message>`` on stderr and the error's exit code (2 input, 3 geometry,
 4 output; argparse usage errors are 2 as well; a refused gouge is 5). ``--debug`` shows the
-traceback instead. Every option is defined once here; the commands live in
-:mod:`cadcnc.cli.commands` and :mod:`cadcnc.cli.demo`.
+traceback instead. Every option is defined once here or in the ``*_options`` modules; the
+commands are imported on dispatch from the table of :mod:`cadcnc.cli.commands`.
 """
 
 from __future__ import annotations
@@ -18,7 +18,9 @@ from cadcnc.core.errors import EXIT_INTERRUPTED, CadcncError  # light: the packa
 from cadcnc.core.interrupts import sigint_deferred
 from cadcnc.parallel import pool
 
-from .operation import DEFAULT_FEED, DEFAULT_PERIOD, add_axis_options, add_max_cycles
+from . import batch_options, finish_options, pencil_options, stream_options
+from .commands import handler
+from .operation_options import DEFAULT_FEED, DEFAULT_PERIOD, add_axis_options, add_max_cycles
 
 UNITS = "Units: lengths mm, feed mm/min, period with a unit (4ms, 0.004s, 250us)."
 
@@ -132,11 +134,10 @@ def build_parser() -> argparse.ArgumentParser:
     add_max_cycles(p)
     add_axis_options(p)
 
-    from . import batch, finish, pencil, stream  # light: their commands import the library when run
-    pencil.add_parser(add, _flip_option, _gouge_options, _gcode_options)
-    finish.add_parser(add, _flip_option, _gouge_options, _gcode_options)
-    stream.add_parser(add, _flip_option, _gouge_options)
-    batch.add_parser(add, parser)
+    pencil_options.add_parser(add, _flip_option, _gouge_options, _gcode_options)
+    finish_options.add_parser(add, _flip_option, _gouge_options, _gcode_options)
+    stream_options.add_parser(add, _flip_option, _gouge_options)
+    batch_options.add_parser(add, parser)
 
     p = add("run", "execute an APT-like part program (PATH = P/[...])",
             "Execute an APT-like part program (grammar: docs/notes/apt.md). Prints a summary per "
@@ -212,21 +213,9 @@ def main(argv: list[str] | None = None) -> int:
         # importing the library (OCCT) takes ~1.5 s: `--help` and usage errors don't pay it;
         # Ctrl-C inside OCCT's C-extension import would surface as an ImportError
         with sigint_deferred():
-            if getattr(args, "jobs", 1) != 1:   # its imports run beside ours
-                pool.start(args.jobs)
-            if args.command == "faces":   # reads the part only: no interpolation core
-                from .faces import faces as run
-            else:
-                from . import commands
-
-                from .batch import batch_command
-                from .finish import finish_command
-                from .pencil import pencil_command
-                from .stream import stream_command
-
-                run = {"pencil": pencil_command, "finish": finish_command,
-                       "stream": stream_command, "batch": batch_command}.get(
-                    args.command) or commands.COMMANDS[args.command]
+            if getattr(args, "processes", 1) != 1:   # its imports run beside ours
+                pool.start(args.processes)
+            run = handler(args.command)   # the library imported now (commands.py)
         return int(run(args) or 0)
     except KeyboardInterrupt:
         print("cadcnc: interrupted", file=sys.stderr)

@@ -71,7 +71,7 @@ def operation_of(job, parser, op, path: str, options: dict, outputs: tuple):
         if not hasattr(args, key.replace("-", "_")):   # an abbreviation argparse accepted
             raise job.error(where, f"unknown option of `cadcnc {op.command}`")
     try:
-        return BUILDERS[op.command](args, path), settings_of(args, jobs=1)  # one process a part
+        return BUILDERS[op.command](args, path), settings_of(args, processes=1)  # one a part
     except InputError as e:
         raise job.error(_where_named(str(e), options, op.where), str(e)) from None
 

@@ -1,25 +1,31 @@
-"""``cadcnc faces``: a part's faces, neighbours and concave pairs. It reads the part only:
-neither the interpolation core nor numba is imported, so it starts fast."""
+"""``cadcnc faces``: a part's faces, neighbours and concave pairs
+(:func:`cadcnc.pipeline.part_faces.faces_of`), printed. It reads the part only: neither the
+interpolation core nor numba is imported, so it starts fast."""
 
 from __future__ import annotations
 
 import json
 
-from cadcnc.geometry.part import load_step
-from cadcnc.geometry.faces_report import concave_edges, faces_report
+from cadcnc.geometry.faces_report import concave_edges
+from cadcnc.pipeline.part_faces import faces_of
 
 from .feedback import say_error
 
 
 def faces(args) -> int:
-    part = load_step(args.step, flip_material=args.flip_material)
-    data = faces_report(part)
-    for line in part.warnings:
+    data, warnings = faces_of(args.step, args.flip_material)
+    for line in warnings:
         say_error(f"cadcnc: faces: OCCT's STEP reader: {line}")
     if args.json:
         print(json.dumps(data, indent=1))
         return 0
-    print(f"{args.step}: {len(part)} faces; material side: {data['material']['rule']}")
+    _print_faces(args.step, data)
+    return 0
+
+
+def _print_faces(step, data: dict) -> None:
+    """The faces table and the concave pairs, for people."""
+    print(f"{step}: {data['n_faces']} faces; material side: {data['material']['rule']}")
     if data["material"].get("sewing"):
         sewn = data["material"]["sewing"]
         print(f"sewn at {sewn['tolerance_mm']:g} mm: largest edge tolerance "
@@ -32,13 +38,12 @@ def faces(args) -> int:
         print(f"{f['number']:>4}  {f['kind']:<10} {f['area_mm2']:>11.2f}  {nb}")
     if not data["concave_pairs"]:
         print("\nno concave pairs: no two faces meet in an inner corner a ball can follow")
-        return 0
+        return
     print("\nconcave pairs, the candidates for `cadcnc path --faces I J` "
           "(a ball can sit in these corners):")
     for i, j, k, e in concave_edges(data):
         print(f"  {i:>3} {j:<3}  edge {k}: {'closed' if e['closed'] else 'open'}, "
               f"{e['length_mm']:.3f} mm, material angle {_angles(e['angle_deg'])} deg")
-    return 0
 
 
 def _angles(rng) -> str:

@@ -5,6 +5,8 @@ from __future__ import annotations
 import sys
 import time
 
+from cadcnc.core.work_limits import HEARTBEAT_S, Heartbeat
+
 
 def say_error(text: str) -> None:
     print(text, file=sys.stderr, flush=True)
@@ -28,8 +30,6 @@ def stage_progress(args, label: str, after_s: float = 0.0, clock=time.monotonic)
     it runs, with its count; None with --quiet. ``clock`` is injectable for tests."""
     if args.quiet:
         return None
-    from cadcnc.core.work_limits import HEARTBEAT_S, Heartbeat
-
     seen = set()
     start = clock()
     beat = Heartbeat(say_error, HEARTBEAT_S, clock)

@@ -1,5 +1,5 @@
 """Command-line strings to the library's typed records: a Job for every command, the
-tolerances and the G-code writer's keywords."""
+tolerances, the run's settings, the machine and the G-code writer's keywords."""
 
 from __future__ import annotations
 
@@ -7,15 +7,18 @@ import dataclasses
 import math
 from pathlib import Path
 
-from cadcnc.batch.operate import Settings
+from cadcnc.controller.machine import Machine, read_machine_ini
 from cadcnc.core.errors import InputError
-from cadcnc.io.gcode import blend_for
 from cadcnc.core.job import Job, PairPath, Pencil, Tool, check_number, finishing
 from cadcnc.core.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT, Tolerances
 from cadcnc.core.units import parse_duration, parse_feed, parse_length, parse_point
+from cadcnc.io.gcode import blend_for
 from cadcnc.parallel.pool import check_jobs
+from cadcnc.pipeline.operate import Settings
 
-JOB_OPTIONS = ("faces", "radius")  # feed and period have defaults (cadcnc/cli/operation.py)
+from .feedback import say_error
+
+JOB_OPTIONS = ("faces", "radius")  # feed and period have defaults (operation_options.py)
 
 
 def tolerances(args) -> Tolerances:
@@ -104,13 +107,25 @@ BUILDERS = {"path": path_job, "pencil": pencil_job, "finish": finish_job}
 operations through it)."""
 
 
-def settings_of(args, jobs: int | None = None) -> Settings:
+def settings_of(args, processes: int | None = None) -> Settings:
     """How an operation command's program is judged and written: ``--max-cycles``, the
     G-code keywords when a .ngc is among the outputs, ``--allow-partial/gouge``, and the
-    processes: ``jobs``, else ``--jobs`` (default every core)."""
+    processes: ``processes``, else ``--jobs`` (default every core)."""
     return Settings(args.max_cycles, gcode_keywords(args) if wants_gcode(args.output)
                     else None, args.allow_partial, args.allow_gouge,
-                    check_jobs(getattr(args, "jobs", None)) if jobs is None else jobs)
+                    check_jobs(getattr(args, "processes", None)) if processes is None
+                    else processes)
+
+
+def machine_of(args) -> Machine:
+    """The Machine of --machine / --jerk (InputError on a bad file or value)."""
+    jerk = None if args.jerk is None else parse_length(args.jerk, "jerk", allow_zero=False)
+    if args.machine is not None:
+        return read_machine_ini(args.machine, jerk,
+                                warn=lambda text: say_error(f"cadcnc: warning: {text}"))
+    m = Machine.default()
+    return m if jerk is None else dataclasses.replace(
+        m, max_jerk=(jerk,) * 3, source=m.source.split(",")[0] + f", jerk {jerk:g}")
 
 
 def clearance(args) -> float | None:

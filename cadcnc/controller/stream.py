@@ -3,7 +3,7 @@
 :func:`stream_program` plans the feed (:mod:`.feed_plan`), then computes each period's
 position on the exact path: a cut's by its own stepper re-run with the per-cycle feed
 override (the kernel computes every position, following the plan in its compiled loop,
-:mod:`cadcnc.interp.follow`; the step commanded each period is the planned arc length
+:mod:`cadcnc.interp.planned_follow`; the step commanded each period is the planned arc length
 minus the distance the kernel has travelled), a link move's in closed form. The steppers
 come from the caller (``steppers(cut_index, segment, period)``, built
 where the part's faces are, e.g. :func:`cadcnc.ops.stream_steppers.stepper_factory`); a
@@ -22,7 +22,7 @@ import numpy as np
 from ..core.errors import GeometryError
 from ..core.progress import Progress
 from ..interp.cycle import CLOSED, END
-from ..interp.follow import follow
+from ..interp.planned_follow import follow
 from ..program.program import Program
 from .feed_plan import MAX_PERIODS, FeedPlan, PlanError, plan_feed
 from .machine import AXES, Machine

@@ -43,7 +43,7 @@ from OCP.TopExp import TopExp
 from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.gp import gp_Pnt
 
-from .analytic import AnalyticFace
+from .analytic_faces import AnalyticFace
 from .face_distance import FaceDistance
 from ..core.tolerances import DEFAULT
 

@@ -154,7 +154,7 @@ def test_the_gate_catches_a_gouging_link():
     """A link forced through the boss (its rapid lowered to Z 2.8, under the boss top) is
     refused by the library's verdict with the link named, and allowed only on request."""
     from cadcnc.program.program import LinkSegment, Program
-    from cadcnc.verification.judgement import judge
+    from cadcnc.pipeline.exit_policy import judge
 
     part = cadcnc.load_step(BOSS)
     job = Job(Tool(3.0), 1500.0, 0.004, PairPath(faces=(1, 6), edge=None))
@@ -231,10 +231,10 @@ def test_verify_judges_the_links_too(tmp_path):
 
 def test_verify_refuses_a_program_over_its_point_limit(tmp_path, monkeypatch):
     """Work is bounded before it starts: over the limit, verify names the estimate."""
-    from cadcnc.cli import program_commands
+    from cadcnc.pipeline import saved
 
     out = tmp_path / "s.json"
     cadcnc_cli("path", SHELF, *SHELF_JOB, "-o", out, "-q", check=0)
-    monkeypatch.setattr(program_commands, "MAX_VERIFY_POINTS", 100)
+    monkeypatch.setattr(saved, "MAX_VERIFY_POINTS", 100)
     run = cadcnc_cli("verify", out)
     assert run.returncode == 2 and "points, over the limit of 100" in run.stderr

@@ -54,11 +54,11 @@ def test_gate_refusal_writes_nothing(program, tmp_path):
     assert "nothing written" in run.stderr
 
 
-@pytest.mark.parametrize("where", ["cadcnc.verification.gate_program",
+@pytest.mark.parametrize("where", ["cadcnc.pipeline.streaming.gate_program",
                                    "cadcnc.io.output_set.os.replace"])
 def test_ctrl_c_leaves_no_file(program, tmp_path, monkeypatch, where):
     import cadcnc.io.output_set  # noqa: F401 - the module patched by name
-    import cadcnc.verification  # noqa: F401
+    import cadcnc.pipeline.streaming  # noqa: F401
 
     def interrupt(*args, **kwargs):
         raise KeyboardInterrupt

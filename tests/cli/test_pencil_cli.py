@@ -11,7 +11,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from cadcnc.cli import operation as operation_cli
+from cadcnc.cli import operation_options as operation_cli
 from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_json import read_program
 from cadcnc.core import job as job_module

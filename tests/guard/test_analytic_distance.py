@@ -20,7 +20,7 @@ from OCP.BRepPrimAPI import BRepPrimAPI_MakeTorus
 from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
 
 import cadcnc
-from cadcnc.guard.analytic import AnalyticFace
+from cadcnc.guard.analytic_faces import AnalyticFace
 from cadcnc.geometry.boxes import optimal_box
 from cadcnc.geometry.part import Part
 

@@ -23,7 +23,7 @@ from cadcnc.ops.common import safe_height
 from cadcnc.program.linking import linked
 from cadcnc.program.program import Program
 from cadcnc.program.toolpath import toolpath_piece
-from cadcnc.verification.judgement import judge
+from cadcnc.pipeline.exit_policy import judge
 from helpers.cli import cadcnc_cli
 from helpers.fixtures import FIXTURES, fixture_path
 

@@ -22,7 +22,7 @@ from cadcnc.ops.path.stretches import EdgeStretches, Limit, Stretch, too_tight
 from cadcnc.ops.pencil.pencil_program import pencil_program
 from cadcnc.ops.common import safe_height
 from cadcnc.core.tolerances import DEFAULT
-from cadcnc.verification.judgement import judge, settle
+from cadcnc.pipeline.exit_policy import judge, settle
 from cadcnc.core.work_limits import HEARTBEAT_S, WorkLimitError
 
 _parts: dict = {}

@@ -134,7 +134,7 @@ def test_bad_setups_exit_2(shared_corner, tmp_path, bad):
 
 def test_worst_exit_code():
     from cadcnc.core.errors import EXIT_GOUGE, EXIT_NOTHING, EXIT_OK, EXIT_PARTIAL
-    from cadcnc.verification.judgement import worst
+    from cadcnc.pipeline.exit_policy import worst
 
     assert worst([]) == EXIT_OK
     assert worst([EXIT_OK, EXIT_NOTHING]) == EXIT_NOTHING

@@ -5,7 +5,7 @@ Top-level keys: ``parts`` (paths or glob patterns, relative to the file), ``oper
 (tables: ``command``, optional ``name`` and ``parts``, and the command's options),
 ``options`` (every operation's), ``per_part`` (options by part file name), ``out`` and
 ``outputs``. The options themselves are checked by the command's own parser
-(:mod:`cadcnc.cli.batch`).
+(:mod:`cadcnc.cli.batch_jobs`).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from cadcnc.core.errors import InputError
+from ..core.errors import InputError
 
 TOP_KEYS = ("parts", "operations", "options", "per_part", "out", "outputs")
 OPERATION_KEYS = ("command", "name", "parts")

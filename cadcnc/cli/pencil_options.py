@@ -1,6 +1,7 @@
-"""``cadcnc pencil``: every inner corner of a part in one program, gated, written all at once.
+"""``cadcnc pencil``'s options: every inner corner of a part in one program, gated, written
+all at once (registered by :mod:`cadcnc.cli.app` with :func:`add_parser`; the command is
+:func:`cadcnc.cli.operation_commands.pencil`).
 
-Options are defined here (registered by :mod:`cadcnc.cli.app` with :func:`add_parser`).
 Exit codes like ``path``: 0 for a complete program that passed the gouge gate (every cut,
 then every move of the whole program, links included, as written), 5 a gouge, 6 partial
 (a cut stopped short), with ``--allow-gouge`` / ``--allow-partial`` to write anyway.
@@ -8,8 +9,7 @@ then every move of the whole program, links included, as written), 5 a gouge, 6 
 
 from __future__ import annotations
 
-from .feedback import say_error
-from .operation import add_operation_options, operation_command
+from .operation_options import add_operation_options
 
 
 def add_parser(add, job_flip, gouge, gcode) -> None:
@@ -39,16 +39,3 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
     job_flip(p)
     gouge(p)
     gcode(p)
-
-
-def pencil_command(args) -> int:
-    from .options import pencil_job
-
-    if args.setups is not None:
-        from .setups import setups_command
-
-        return setups_command(args)
-
-    report = None if args.quiet else (
-        lambda done, total, what: say_error(f"cadcnc: pencil: corner {done}/{total} ({what})"))
-    return operation_command(args, "pencil", pencil_job, progress=report, times={})

@@ -1,6 +1,7 @@
-"""The policy that decides what a command writes and which exit code it returns, for every
-operation: cut gouging cuts back (pencil, finish), gate the whole program as written, and
-judge partial and gouging programs (refused unless the user allows them).
+"""The exit-code policy: what a run writes and which exit code it returns, for every
+operation. Gouging cuts are cut back (pencil, finish), the whole program is gated as written
+(:mod:`cadcnc.verification.written_gate`, the measurement), and partial and gouging
+programs are refused unless the user allows them.
 
 Exit codes (docs/reliability.md) are those of :mod:`cadcnc.core.errors`: 0 only for a complete
 program whose every cut and every written move passed the gouge gate; 5 a gouge; 6 partial.
@@ -12,12 +13,12 @@ import math
 from dataclasses import dataclass, field
 
 from ..core.errors import (EXIT_GOUGE, EXIT_INPUT, EXIT_INTERNAL, EXIT_NOTHING, EXIT_OK,
-                      EXIT_OUTPUT, EXIT_PARTIAL, NothingToCutError)
-from ..io.program_gcode import program_written_moves
+                           EXIT_OUTPUT, EXIT_PARTIAL, NothingToCutError)
 from ..program.program import FAILED, STOPPED_SHORT, Program
 from ..program.summary import skipped_counts
-from .cut_back import cut_back
-from .program_gate import ProgramGate, gate_program
+from ..verification.cut_back import cut_back
+from ..verification.program_gate import ProgramGate
+from ..verification.written_gate import gate_written
 
 
 @dataclass
@@ -32,12 +33,12 @@ class Verdict:
 
 
 def settle(program: Program, part, z_safe: float, join: float, what: str,
-           allow_gouge: bool = False, *, jobs: int | None = 1) -> Program:
+           allow_gouge: bool = False, *, processes: int | None = 1) -> Program:
     """The program with each gouging cut cut back to its last verified point and the rest
     listed as skipped (unless ``allow_gouge``); NothingToCutError when no cut is left.
-    ``jobs``: processes gating the cuts (None: every core)."""
+    ``processes``: processes gating the cuts (None: every core)."""
     if not allow_gouge:
-        program = cut_back(program, part, z_safe, join, jobs=jobs)
+        program = cut_back(program, part, z_safe, join, jobs=processes)
     if not program.cuts:
         raise NothingToCutError(f"{what}: no cut left: "
                                 f"{skipped_counts(program) or 'nothing to cut'}")
@@ -46,12 +47,12 @@ def settle(program: Program, part, z_safe: float, join: float, what: str,
 
 def judge(program: Program, part, what: str, *, gcode: dict | None = None,
           allow_partial: bool = False, allow_gouge: bool = False, progress=None,
-          jobs: int | None = 1) -> Verdict:
+          processes: int | None = 1) -> Verdict:
     """The :class:`Verdict` on ``program``. With G-code options ``gcode`` (keywords of
     :func:`~cadcnc.io.program_gcode.program_ngc`) the gate checks the moves as written
     (points dropped, rounded, tool-tip offset taken back, links); else the program's own
     points. A partial program exits 6 and is written only with ``allow_partial``; a
-    gouging one exits 5 and is written only with ``allow_gouge``. ``jobs``: processes
+    gouging one exits 5 and is written only with ``allow_gouge``. ``processes``: processes
     gating the cuts (None: every core); the verdict does not depend on it."""
     verdict = Verdict(True, EXIT_OK)
     if not program.complete:
@@ -64,10 +65,7 @@ def judge(program: Program, part, what: str, *, gcode: dict | None = None,
             "" if allow_partial else "; nothing written (--allow-partial writes it)"))
     if not verdict.write:
         return verdict
-    moves = None if gcode is None else program_written_moves(program, **gcode)
-    gate = gate_program(program, part, program.job.tolerances, moves=moves,
-                        blend_mm=0.0 if gcode is None else gcode["blend"], progress=progress,
-                        jobs=jobs)
+    gate = gate_written(program, part, gcode, progress=progress, jobs=processes)
     verdict.gate = gate
     if gate.ok:
         return verdict
@@ -77,7 +75,7 @@ def judge(program: Program, part, what: str, *, gcode: dict | None = None,
         verdict.messages.append(f"{what}: {why}; written anyway (--allow-gouge)")
     else:
         verdict.messages.append(f"{what}: refused: {why}; nothing written. "
-                                f"{_hint(program, gate, gcode)}--allow-gouge writes it")
+                                f"{hint(program, gate, gcode)}--allow-gouge writes it")
     return verdict
 
 
@@ -93,7 +91,7 @@ def worst(codes) -> int:
                default=EXIT_OK)
 
 
-def _hint(program: Program, gate: ProgramGate, gcode: dict | None) -> str:
+def hint(program: Program, gate: ProgramGate, gcode: dict | None) -> str:
     """What may help, only where it can: fewer dropped points when only moves between
     written points cut; a smaller ball for a shallow side cut (not in the material)."""
     bad = [(seg, r) for seg, r in zip(program.cuts, gate.results) if not r.ok]

@@ -1,6 +1,7 @@
-"""``cadcnc finish``: raster finishing of selected faces in one program, gated, written.
+"""``cadcnc finish``'s options: raster finishing of selected faces in one program, gated,
+written (registered by :mod:`cadcnc.cli.app` with :func:`add_parser`; the command is
+:func:`cadcnc.cli.operation_commands.finish`).
 
-Options are defined here (registered by :mod:`cadcnc.cli.app` with :func:`add_parser`).
 Exit codes as ``pencil``: 0 for a complete program that passed the gouge gate (every cut,
 then every move of the whole program, links included, as written), 5 a gouge, 6 partial
 (a cut stopped short), 2 bad input, with ``--allow-gouge`` / ``--allow-partial`` to write
@@ -9,12 +10,7 @@ anyway.
 
 from __future__ import annotations
 
-import time
-
-from .feedback import say_error
-from .operation import add_operation_options, operation_command
-
-PROGRESS_EVERY_S = 1.0  # s between two progress lines on stderr
+from .operation_options import add_operation_options
 
 
 def add_parser(add, job_flip, gouge, gcode) -> None:
@@ -59,25 +55,3 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
     job_flip(p)
     gouge(p)
     gcode(p)
-
-
-def finish_command(args) -> int:
-    from .options import finish_job
-
-    return operation_command(args, "finish", finish_job, progress=_progress(args))
-
-
-def _progress(args):
-    """A progress(done, total, what) callback: a stderr line at most every second, and
-    the last plane, or None with --quiet."""
-    if args.quiet:
-        return None
-    last = [time.monotonic()]
-
-    def report(done: int, total: int, what: str) -> None:
-        now = time.monotonic()
-        if now - last[0] >= PROGRESS_EVERY_S or done == total:
-            last[0] = now
-            say_error(f"cadcnc: finish: plane {done}/{total} ({what})")
-
-    return report

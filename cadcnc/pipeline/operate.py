@@ -1,6 +1,6 @@
 """One operation on one STEP part, end to end, as ``cadcnc path``/``pencil``/``finish`` run
-it: load, compute (:func:`cadcnc.run`), cut gouging cuts back, gate and judge
-(:mod:`cadcnc.verification.judgement`), render the outputs by suffix
+it: load, plan (:func:`~cadcnc.pipeline.program_plan.plan`), cut gouging cuts back, gate and judge
+(:mod:`cadcnc.pipeline.exit_policy`), render the outputs by suffix
 (:mod:`cadcnc.io.outputs`). The command line and every batch task call this one function,
 so that a part in a batch gives the bytes it gives alone.
 """
@@ -14,16 +14,17 @@ from pathlib import Path
 import numpy as np
 
 from ..core.errors import InputError, NothingToCutError
+from ..core.job import Job
+from ..core.work_limits import MAX_CYCLES
 from ..geometry.part import Part, load_step
 from ..geometry.setup import setup_in, setup_part
 from ..io.outputs import render_all
-from ..core.job import Job
 from ..ops.common import safe_height
-from ..ops.run import cut_back_gap, run
+from ..ops.run import cut_back_gap
 from ..program.program import Program
 from ..verification.gate_cache import open_shared
-from ..verification.judgement import Verdict, judge, settle
-from ..core.work_limits import MAX_CYCLES
+from .exit_policy import Verdict, judge, settle
+from .program_plan import plan
 
 
 @dataclass(frozen=True)
@@ -32,20 +33,20 @@ class Settings:
     limit), ``gcode`` (keywords of :func:`~cadcnc.io.program_gcode.program_ngc` when a
     .ngc is written, else None: the gate then checks the program's own points),
     ``allow_partial`` / ``allow_gouge`` (write a partial or gouging program anyway),
-    ``jobs``: processes computing and gating (:mod:`cadcnc.parallel`; a batch task runs
-    one)."""
+    ``processes``: processes computing and gating (:mod:`cadcnc.parallel`; a batch task
+    runs one; the ``--jobs`` option)."""
 
     max_cycles: int = MAX_CYCLES
     gcode: dict | None = field(default=None, hash=False)
     allow_partial: bool = False
     allow_gouge: bool = False
-    jobs: int = 1
+    processes: int = 1
 
 
 @dataclass
 class Outcome:
     """What :func:`operate` leaves: the part (turned to its setup), the program, the
-    verdict, the seconds spent computing (load and :func:`cadcnc.run`) and settling and
+    verdict, the seconds spent computing (load and :func:`~cadcnc.pipeline.program_plan.plan`) and settling and
     gating, and ``what``: the operation's name in messages, with its tool axis."""
 
     part: Part
@@ -81,7 +82,7 @@ def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progr
             times: dict | None = None, gate_progress=None) -> Outcome:
     """Run ``job`` on the STEP file ``step`` and judge it (module doc). ``what``: the
     command's name in messages ("pencil"); ``progress`` and ``times``: as
-    :func:`cadcnc.run`; ``gate_progress``: the gate's ``(done, total, stage)`` callback.
+    :func:`~cadcnc.pipeline.program_plan.plan`; ``gate_progress``: the gate's ``(done, total, stage)`` callback.
     Raises the library's errors (bad face number, nothing to cut, ...)."""
     if settings.max_cycles < 1:
         raise InputError(f"--max-cycles must be at least 1, got {settings.max_cycles}")
@@ -95,24 +96,35 @@ def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progr
         if n is not None:
             part.face(n)   # face numbers checked before anything is computed
     try:
-        program = run(part, job, progress=progress, times=times,
-                      max_cycles=settings.max_cycles, jobs=settings.jobs)
+        program = plan(part, job, progress=progress, times=times,
+                       max_cycles=settings.max_cycles, processes=settings.processes)
     except NothingToCutError as e:   # a setup that reaches nothing says which it is
         if setup_in(part) is None:
             raise
         raise NothingToCutError(f"{what}: {e}") from None
     t_cut = time.monotonic() - t0
-    join = cut_back_gap(job)
     open_shared(part)  # the cut-back step and the program gate share their work
+    program, verdict = settled_and_judged(program, part, job, step, what, settings,
+                                          gate_progress=gate_progress)
+    return Outcome(part, program, verdict, t_cut, time.monotonic() - t0 - t_cut, what)
+
+
+def settled_and_judged(program: Program, part: Part, job: Job, step, what: str,
+                       settings: Settings, *, gate_progress=None) -> tuple[Program, Verdict]:
+    """``program`` with its gouging cuts cut back (pencil, finish: :func:`settle`) and its
+    :class:`Verdict` (:func:`judge`), as ``settings`` ask; ``job`` gives the links' safe
+    height; ``step`` and ``what`` name the run in messages. NothingToCutError when no cut
+    is left."""
+    join = cut_back_gap(job)
     if join is not None:
         program = settle(program, part, safe_height(part, job), join, f"{step}: {what}",
-                         settings.allow_gouge, jobs=settings.jobs)
+                         settings.allow_gouge, processes=settings.processes)
     elif not program.cuts:
         raise NothingToCutError(f"{step}: {what}: nothing to cut")
     verdict = judge(program, part, f"cadcnc: {what}", gcode=settings.gcode,
                     allow_partial=settings.allow_partial, allow_gouge=settings.allow_gouge,
-                    progress=gate_progress, jobs=settings.jobs)
-    return Outcome(part, program, verdict, t_cut, time.monotonic() - t0 - t_cut, what)
+                    progress=gate_progress, processes=settings.processes)
+    return program, verdict
 
 
 def rendered(outcome: Outcome, outputs, what: str, settings: Settings) -> dict:
@@ -120,5 +132,5 @@ def rendered(outcome: Outcome, outputs, what: str, settings: Settings) -> dict:
     the ball and the part's file name."""
     job = outcome.program.job
     title = f"{what} R {job.tool.radius:g} of {Path(job.source or '').name}"
-    return render_all(outcome.program, outputs, outcome.part, title, settings.jobs,
+    return render_all(outcome.program, outputs, outcome.part, title, settings.processes,
                       **(settings.gcode or {}))

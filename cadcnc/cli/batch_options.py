@@ -1,15 +1,14 @@
-"""``cadcnc batch JOBFILE``: many parts, each with its operations, on Dask (docs/batch.md).
+"""``cadcnc batch JOBFILE``'s options: many parts, each with its operations, on Dask
+(docs/batch.md); the command is :func:`cadcnc.cli.batch_command.batch`.
 
 The job file is read and every part's every operation turned into a Job before any work:
 each operation's options go through the parser of its own command (``cadcnc pencil
 --help`` lists them), so a job file takes exactly the command line's options, and a
 mistake is named by its line and key (exit 2). Then one library call,
-:func:`cadcnc.batch`, the summary printed, and the batch's exit code.
+:func:`cadcnc.run_batch`, the summary printed, and the batch's exit code.
 """
 
 from __future__ import annotations
-
-from .feedback import say_error
 
 
 def add_parser(add, commands) -> None:
@@ -32,25 +31,3 @@ def add_parser(add, commands) -> None:
     p.add_argument("--force", action="store_true",
                    help="run every part again, unchanged ones too")
     p.set_defaults(commands=commands)
-
-
-def batch_command(args) -> int:
-    from cadcnc.batch import batch
-    from cadcnc.batch.records import batch_exit, summary_table
-    from cadcnc.core.work_limits import sigterm_as_interrupt
-
-    from . import jobfile
-    from .batch_jobs import batch_parts
-
-    job = jobfile.read(args.jobfile)
-    parts = batch_parts(job, args.commands)
-    report = None if args.quiet else (lambda p: say_error(f"cadcnc: batch: {p}"))
-    with sigterm_as_interrupt():   # the local cluster shut down as after Ctrl-C
-        records = batch(parts, job.out, scheduler=args.scheduler,
-                        workers=args.workers, force=args.force, progress=report,
-                        inputs=[args.jobfile])
-    code = batch_exit(records)
-    if not args.quiet:
-        print(summary_table(records))
-        print(f"wrote {job.out / 'summary.csv'}, {job.out / 'summary.json'}; exit {code}")
-    return code

@@ -1,4 +1,5 @@
-"""``cadcnc demo``: the main job on the bundled part, verified, with every output."""
+"""The demo (``cadcnc demo``): the main job on the bundled part, verified, with every
+output, and every corner of the part in one pencil program."""
 
 from __future__ import annotations
 
@@ -6,19 +7,17 @@ import json
 from dataclasses import replace
 from pathlib import Path
 
-import cadcnc
-from cadcnc.core.errors import EXIT_GOUGE, OutputError, StepFileError
-from cadcnc.io.gcode import blend_for
-from cadcnc.io.output_set import OutputSet
-from cadcnc.io.outputs import SUFFIXES, render
-from cadcnc.core.job import Job, PairPath, Pencil, Tool
-from cadcnc.ops.common import single_cut_program
-from cadcnc.ops.path.pair_path import path_for_job
-from cadcnc.ops.run import run
-from cadcnc.verification import verify
-from cadcnc.verification.judgement import judge
-
-from .feedback import progress
+from ..core.errors import EXIT_GOUGE, OutputError, StepFileError
+from ..core.job import Job, PairPath, Pencil, Tool
+from ..geometry.part import load_step
+from ..io.gcode import blend_for
+from ..io.output_set import OutputSet
+from ..io.outputs import SUFFIXES, render
+from ..ops.common import single_cut_program
+from ..ops.path.pair_path import path_for_job
+from ..verification import verify
+from .exit_policy import judge
+from .program_plan import plan
 
 FIXTURE = "bspline_boss.step"
 FACES = (4, 5)  # the B-spline top and the cylindrical boss
@@ -27,7 +26,7 @@ JOB = Job(Tool(3.0), feed=1500.0, period=0.004, operation=PairPath(faces=FACES))
 
 def demo_step() -> Path:
     """The bundled demo part: package data if shipped, else the source tree's fixtures."""
-    pkg = Path(cadcnc.__file__).resolve().parent
+    pkg = Path(__file__).resolve().parents[1]
     for candidate in (pkg / "data" / FIXTURE, pkg.parent / "fixtures" / FIXTURE):
         if candidate.is_file():
             return candidate
@@ -48,21 +47,22 @@ FILES = ("path.json", "path.csv", "path.ngc", "demo.apt", "verification.txt",
          "verification.json", "path.png", "pencil.json", "pencil.png")
 
 
-def demo(args) -> int:
+def run_demo(out, say, progress=None) -> int:
+    """Run the demo into the folder ``out``; ``say(text)``: its narrative for the user,
+    ``progress``: the path's ``(cycles, mm)`` callback. The exit code."""
     step = demo_step()
-    out = Path(args.out)
+    out = Path(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise OutputError(f"{out}: cannot create the demo folder ({e.strerror})") from e
     outputs = OutputSet([out / name for name in FILES], SUFFIXES + (".apt", ".txt"),
                         inputs=[step])
-    say = (lambda *a: None) if args.quiet else print
     job = replace(JOB, source=str(step))
     i, j = job.operation.faces
     say(f"cadcnc demo: faces {i} (B-spline top) and {j} (cylindrical boss) of {step}")
-    part = cadcnc.load_step(step)
-    tp = path_for_job(part, job, progress=progress(args, "demo"))
+    part = load_step(step)
+    tp = path_for_job(part, job, progress=progress)
     program = single_cut_program(part, job, tp)
     say(program.summary(step.name))
     report = verify(tp, part)
@@ -81,7 +81,7 @@ def demo(args) -> int:
     contents[out / "demo.apt"] = demo_program(step, job)
     contents[out / "verification.txt"] = report.format_table() + "\n"
     contents[out / "verification.json"] = json.dumps(d, indent=1) + "\n"
-    pen = run(part, replace(job, operation=Pencil()))  # every corner of the part, linked
+    pen = plan(part, replace(job, operation=Pencil()))  # every corner of the part, linked
     say(f"pencil R {job.tool.radius:g}: {len(pen.cuts)} cuts, {pen.cut_length:.1f} mm cut, "
         f"{pen.link_length:.1f} mm of links, {len(pen.skipped)} corners skipped")
     contents[out / "pencil.json"] = render(pen, "pencil.json")

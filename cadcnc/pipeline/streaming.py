@@ -1,0 +1,167 @@
+"""A program as one position per servo period: planned, checked, gated, written, and
+optionally executed in LinuxCNC's HAL (``cadcnc stream``, and the operations' ``--stream``).
+
+Before any work: every destination checked against the inputs and the machine's INI, the
+periods estimated and refused over ``max_periods`` (exit 2). Before anything is written:
+the positions checked against the machine's limits and the program's ends
+(:mod:`cadcnc.verification.stream_check`, exit 5, nothing written or executed), then gated
+against the part (exit 5 unless ``allow_gouge``). With ``hal`` the gated stream is then run
+by :func:`cadcnc.controller.hal.run_hal_loop`: exit 6 when the machine executed less.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..controller.feed_plan import plan_feed
+from ..controller.hal import HalError, hal_available, run_hal_loop, summary as hal_summary
+from ..controller.pieces import pieces_of
+from ..controller.stream import stream_program, stream_text
+from ..core.errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL, InputError
+from ..core.tolerances import DEFAULT
+from ..core.work_limits import MAX_STREAM_PERIODS, Ticker, refuse_over, sigterm_as_interrupt
+from ..geometry.part import load_step
+from ..io.output_set import OutputSet
+from ..io.program_json import read_program
+from ..ops.stream_steppers import stepper_factory
+from ..verification import gate_program
+from ..verification.stream_check import check_program_on_part, check_stream
+
+SUFFIXES = (".npy", ".txt")
+
+
+@dataclass
+class StreamRun:
+    """What a stream left: the exit ``code``, ``messages`` for the user (stderr), the
+    stream (None when refused before it was computed), the files ``written``, and the HAL
+    run's report (None without HAL) with ``fell_short``: it executed less than the stream."""
+
+    code: int
+    messages: list[str] = field(default_factory=list)
+    stream: object = None
+    written: list[str] = field(default_factory=list)
+    hal_report: str | None = None
+    fell_short: bool = False
+
+
+def stream_saved(program_file, part_file, machine, outputs, *, ini=None, tolerances=DEFAULT,
+                 flip_material: bool = False, say=None, **options) -> StreamRun:
+    """Stream the program saved in ``program_file`` on its part (``part_file``, default
+    the STEP file it records) to ``outputs`` (.npy, .txt); ``ini``: the machine's INI
+    file (an input no output may overwrite); ``options``: as :func:`stream_to`."""
+    program = read_program(program_file)
+    source = part_file or program.job.source
+    if not source:
+        raise InputError(f"{program_file}: the program names no part: give --part PART.step")
+    inputs = [program_file, source, ini]
+    if outputs:   # every destination against every input before any work
+        OutputSet(outputs, SUFFIXES, inputs=inputs)
+    part = load_step(source, flip_material=flip_material)
+    check_program_on_part(program, part, str(program_file), str(source), tolerances.gouge)
+    return stream_to(program, part, machine, outputs, tolerances=tolerances, say=say,
+                     inputs=inputs, **options)
+
+
+def stream_to(program, part, machine, outputs, *, feed=None, planned=True, tolerances=None,
+              allow_gouge=False, hal=False, say=None, inputs=(),
+              max_periods=MAX_STREAM_PERIODS) -> StreamRun:
+    """Stream ``program`` on ``part`` to ``machine`` and write it to ``outputs`` (a list
+    of paths, .npy / .txt); optionally execute it in HAL (module doc). ``say``: progress
+    on stderr (a heartbeat at least every 5 s), or None; SIGTERM counts as Ctrl-C.
+    Raises the library's errors (InputError, GeometryError, HalError ...)."""
+    if hal:
+        missing = hal_available()
+        if missing:
+            raise HalError(f"--hal: HAL tools {missing} (install linuxcnc-uspace)")
+    inputs = [i for i in inputs if i is not None] + [machine.source]
+    with sigterm_as_interrupt(), Ticker(say, "cadcnc: stream") as tick:
+        return _stream(program, part, machine, list(outputs), tick, feed=feed,
+                       planned=planned, tolerances=tolerances, allow_gouge=allow_gouge,
+                       hal=hal, say=say, inputs=inputs, max_periods=max_periods)
+
+
+def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, allow_gouge,
+            hal, say, inputs, max_periods) -> StreamRun:
+    """:func:`stream_to` inside its heartbeat and SIGTERM handler."""
+    outputs = OutputSet(outs, SUFFIXES, inputs=inputs) if outs else None
+    tick.stage = "planning the feed"
+    stream = _planned_stream(program, machine, stepper_factory(part), tick, feed=feed,
+                             planned=planned, max_periods=max_periods, say=say)
+    tick.stage = "checking the stream against the machine's limits"
+    contents = _contents(stream.positions, outputs)
+    problems = _limits_broken(program, machine, stream.positions, contents)
+    if problems:
+        return StreamRun(EXIT_GOUGE, [f"cadcnc: stream: {line}" for line in problems[:8]] + [
+            "cadcnc: stream: over the machine's limits: nothing written"
+            + (" or executed" if hal else "") + " (exit 5)"])
+    tick.stage = "gating the stream against the part"
+    gate = gate_program(program, part, tolerances or DEFAULT,
+                        moves=stream.segment_moves(program))
+    if not gate.ok and not allow_gouge:
+        return StreamRun(EXIT_GOUGE, [f"cadcnc: stream: {gate.message}; nothing written "
+                                      "(--allow-gouge writes it)"])
+    done = StreamRun(EXIT_OK if gate.ok else EXIT_GOUGE, stream=stream)
+    if outputs is not None:
+        tick.stage = "writing"
+        outputs.write(contents)
+        done.written = [str(d) for d in outputs.destinations]
+    if hal:
+        tick.stage = "executing in HAL"
+        result = run_hal_loop(stream.positions, machine, limits="machine")
+        done.hal_report = hal_summary(result)
+        done.fell_short = bool(result.clipped or result.underruns or result.overruns)
+        if done.fell_short:
+            done.messages.append(
+                f"cadcnc: stream: HAL executed less than the stream: {result.clipped} "
+                f"samples clipped by limit3, {result.underruns} underruns, "
+                f"{result.overruns} samples lost")
+            done.code = max(done.code, EXIT_PARTIAL)
+    return done
+
+
+def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_periods, say):
+    """The stream, its periods estimated and bounded before the positions are computed,
+    progress reported (the plan is made once here to count the periods first)."""
+    total = plan_feed(pieces_of(program, machine, feed), machine, planned).periods
+    refuse_over("the stream", total, max_periods, "servo periods",
+                "raise the feed or the machine's limits, or give --max-periods N "
+                "(each 24 bytes in memory)")
+    if say is not None:
+        say(f"cadcnc: stream: {total} periods of {machine.period * 1e3:g} ms "
+            f"(cycle {total * machine.period:.3f} s) to compute")
+    tick.stage = f"streaming {total} periods"
+
+    def progress(done: int, total: int, what: str) -> None:
+        tick.stage = f"streaming: {done}/{total} {what}"
+
+    return stream_program(program, machine, steppers, feed=feed, planned=planned,
+                          max_periods=max_periods, progress=progress)
+
+
+def _contents(positions, outputs) -> dict:
+    """``{destination: bytes or str}`` of every output (.npy, .txt)."""
+    contents = {}
+    for dest in (outputs.destinations if outputs is not None else ()):
+        if dest.suffix.lower() == ".npy":
+            buf = io.BytesIO()
+            np.save(buf, positions)
+            contents[dest] = buf.getvalue()
+        else:
+            contents[dest] = stream_text(positions)
+    return contents
+
+
+def _limits_broken(program, machine, positions, contents) -> list[str]:
+    """What breaks the machine's limits or misses the program's ends: in the positions,
+    and in each .txt's numbers as written (9 decimals)."""
+    limits = (machine.max_velocity, machine.max_acceleration, machine.max_jerk)
+    ends = (program.segments[0].points[0], program.segments[-1].points[-1])
+    found = check_stream(positions, machine.period, limits, *ends).problems
+    for dest, text in contents.items():
+        if isinstance(text, str) and not found:
+            rows = np.fromstring(text, dtype=np.float64, sep=" ").reshape(-1, 3)
+            found = check_stream(rows, machine.period, limits, *ends, what=str(dest)).problems
+    return found
