@@ -126,7 +126,8 @@ def kernel(mode: dict) -> dict:
 def finishing(ocl: bool) -> list[str]:
     """The slab row: cadcnc.finish's time per point; OpenCAMLib's beside it with ``ocl``."""
     import cadcnc  # noqa: PLC0415
-    from benchmarks.finishing import finish_vs_ocl as fv, freeform_slab  # noqa: PLC0415
+    from benchmarks.finishing import finish_vs_ocl as fv  # noqa: PLC0415
+    from benchmarks.finishing import freeform_slab
 
     log("operations: finish on the free-form slab")
     fv.warm_up()

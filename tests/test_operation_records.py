@@ -10,7 +10,15 @@ import pytest
 
 from cadcnc.core.errors import InputError
 from cadcnc.core.job import (
-    OPERATIONS, Job, PairPath, Pencil, Raster, SteepShallow, Tool, Waterline, finishing,
+    OPERATIONS,
+    Job,
+    PairPath,
+    Pencil,
+    Raster,
+    SteepShallow,
+    Tool,
+    Waterline,
+    finishing,
 )
 from cadcnc.ops.run import REGISTRY, cut_back_gap, run
 

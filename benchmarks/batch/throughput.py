@@ -26,13 +26,12 @@ import time
 from pathlib import Path
 
 import cadcnc
-from cadcnc.batch.engine import connect, run_batch
-from cadcnc.core.tolerances import Tolerances
-from cadcnc.pipeline.operate import Settings
-from cadcnc.batch.task import BatchOperation, BatchPart
-from cadcnc.io.gcode import blend_for
-
 from benchmarks import ROOT
+from cadcnc.batch.engine import connect, run_batch
+from cadcnc.batch.task import BatchOperation, BatchPart
+from cadcnc.core.tolerances import Tolerances
+from cadcnc.io.gcode import blend_for
+from cadcnc.pipeline.operate import Settings
 
 STEP_SUFFIXES = (".step", ".stp")
 

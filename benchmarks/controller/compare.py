@@ -46,8 +46,6 @@ from pathlib import Path
 
 import numpy as np
 
-from cadcnc.testing.topp_bound import va_bound
-from cadcnc.testing.contour_reference import Arc, Offsets, PathReference
 from benchmarks.controller.linuxcnc_baseline import violations
 from benchmarks.controller.stream_cost import programs
 from cadcnc.controller import Machine, stream_program
@@ -56,6 +54,8 @@ from cadcnc.controller.hal.linuxcnc_sim import run_ngc
 from cadcnc.io.gcode import simplify
 from cadcnc.io.program_gcode import program_ngc
 from cadcnc.ops.stream_steppers import stepper_factory
+from cadcnc.testing.contour_reference import Arc, Offsets, PathReference
+from cadcnc.testing.topp_bound import va_bound
 
 QUANTUM = 1e-9          # mm: the samples' resolution
 FEED = 10_000.0         # mm/min

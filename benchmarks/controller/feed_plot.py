@@ -15,12 +15,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from benchmarks.controller.stream_cost import programs
 from cadcnc.controller import Machine, stream_program  # noqa: E402
 from cadcnc.controller.pieces import constant_speed  # noqa: E402
 from cadcnc.ops.stream_steppers import stepper_factory  # noqa: E402
-
 from cadcnc.testing.topp_bound import bound_feed, va_bound
-from benchmarks.controller.stream_cost import programs
 
 OUT = Path(__file__).resolve().parents[2] / "docs" / "img" / "controller_feed.png"
 

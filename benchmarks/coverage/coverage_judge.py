@@ -20,9 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cadcnc.testing import coverage_oracle, coverage_sewing
-
 from benchmarks.coverage.coverage_paths import distance_to_polylines
+from cadcnc.testing import coverage_oracle, coverage_sewing
 
 COVERED = 5e-3  # mm: a feasible position within this of a cut polyline is covered
 CACHE_ENV = "COVERAGE_JUDGE_CACHE"

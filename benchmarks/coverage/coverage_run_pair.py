@@ -22,8 +22,8 @@ def main(argv: list[str]) -> int:
     step, i, j, radius, feed, period, out = argv
     import cadcnc
     from cadcnc.core.errors import CadcncError
-    from cadcnc.io.program_json import program_to_dict
     from cadcnc.core.job import Job, PairPath, Tool
+    from cadcnc.io.program_json import program_to_dict
     from cadcnc.ops.path.pair_program import program_for_job, safe_height
     from cadcnc.program.linking import linked
     from cadcnc.program.program import Program

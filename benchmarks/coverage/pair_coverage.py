@@ -33,9 +33,8 @@ import numpy as np
 
 from benchmarks import ROOT
 from benchmarks.coverage.coverage_judge import covered, judge_pair_cached, missed_runs
-from cadcnc.testing.coverage_oracle import TOL, Oracle, read_shape
 from benchmarks.coverage.coverage_paths import classify, run_faces, run_path
-
+from cadcnc.testing.coverage_oracle import TOL, Oracle, read_shape
 
 _ORACLES: dict[str, Oracle] = {}
 SHOWN_CORRECTION = 1e-4  # mm: face_distance corrections listed (smaller: far below 1 um)

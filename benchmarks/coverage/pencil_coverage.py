@@ -38,8 +38,12 @@ from benchmarks import ROOT
 from benchmarks.coverage.coverage_judge import covered, judge_pair_cached, missed_runs
 from benchmarks.coverage.coverage_paths import cadcnc_command, classify, distance_to_polylines
 from benchmarks.coverage.pair_coverage import (
-    judge_path, oracle_for, pairs_of, spread, unique_corrections)
-
+    judge_path,
+    oracle_for,
+    pairs_of,
+    spread,
+    unique_corrections,
+)
 
 
 def _children_cpu() -> float:

@@ -36,11 +36,10 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 from scipy.spatial import cKDTree
 
-from cadcnc.geometry.mesh import face_triangles
-from cadcnc.core.trim_labels import INSIDE
-from cadcnc.verification.probe import FaceProbe
-
 from benchmarks import ROOT
+from cadcnc.core.trim_labels import INSIDE
+from cadcnc.geometry.mesh import face_triangles
+from cadcnc.verification.probe import FaceProbe
 
 ANGULAR = 0.1  # rad: cadquery's default angular tolerance of Shape.tessellate
 

@@ -34,11 +34,11 @@ from pathlib import Path
 import numpy as np
 
 import cadcnc
-from cadcnc.geometry.boxes import optimal_box
-from cadcnc.verification import gate_program
 from benchmarks import ROOT
 from benchmarks.finishing import freeform_slab
 from benchmarks.finishing.finish_bench_tools import FaceDistances, run_ocl, tessellate
+from cadcnc.geometry.boxes import optimal_box
+from cadcnc.verification import gate_program
 
 R, FEED, PERIOD = 3.0, 1500.0, 0.004
 SPACING = FEED * PERIOD / 60.0    # 0.1 mm: cadcnc's step, OCL's point spacing

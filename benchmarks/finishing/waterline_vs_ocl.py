@@ -37,11 +37,11 @@ from pathlib import Path
 import numpy as np
 
 import cadcnc
-from cadcnc.ops.finish.shortcut import finish
-from cadcnc.geometry.offset_section import loop_count, offset_face
-from cadcnc.verification import gate_program
 from benchmarks import ROOT
 from benchmarks.finishing.finish_bench_tools import FaceDistances, tessellate
+from cadcnc.geometry.offset_section import loop_count, offset_face
+from cadcnc.ops.finish.shortcut import finish
+from cadcnc.verification import gate_program
 
 FIXTURES = json.loads((ROOT / "fixtures" / "waterline_fixtures.json").read_text())
 RADIUS = {"dome": 3.0, "wall": 3.0, "boss": 2.0}

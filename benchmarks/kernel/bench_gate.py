@@ -17,10 +17,9 @@ import resource
 import time
 
 import cadcnc
+from benchmarks import ROOT
 from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.verification import gouge_gate
-
-from benchmarks import ROOT
 
 CASES = {  # fixture, faces, ball radius (mm), edge length (mm)
     "torus_cone": ("torus_cone.step", 1, 2, 3.0, 97.78685),

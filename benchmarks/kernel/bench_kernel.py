@@ -34,12 +34,10 @@ from OCP.GeomAPI import GeomAPI_IntSS
 from OCP.gp import gp_Pnt, gp_Vec
 
 import cadcnc
-from cadcnc.interp.compiled import new_stepper
-from cadcnc.ops.path.pair_path import intersection_path
-from cadcnc.ops.path.pair_path import pair_job, plan_path
-
 from benchmarks import ROOT
 from benchmarks.kernel.latency import latency, percentiles
+from cadcnc.interp.compiled import new_stepper
+from cadcnc.ops.path.pair_path import intersection_path, pair_job, plan_path
 
 CASES = [("bspline_boss", 4, 5), ("crossing_cylinders", 1, 2), ("sphere_cylinder", 1, 2),
          ("torus_cone", 1, 2)]

@@ -18,8 +18,8 @@ import time
 from pathlib import Path
 
 import numpy as np
-from OCP.gp import gp_Pnt2d
 from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
+from OCP.gp import gp_Pnt2d
 from OCP.IFSelect import IFSelect_RetDone
 from OCP.STEPControl import STEPControl_Reader
 from OCP.TopAbs import TopAbs_FACE

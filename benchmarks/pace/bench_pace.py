@@ -29,17 +29,17 @@ import tempfile
 import time
 
 import cadcnc
+from benchmarks.finishing import freeform_slab
+from cadcnc.core.job import Job, Pencil, Raster, Tool
 from cadcnc.io.gcode import blend_for
 from cadcnc.io.outputs import render
 from cadcnc.io.program_gcode import program_written_moves
-from cadcnc.core.job import Raster, Job, Pencil, Tool
 from cadcnc.ops.common import safe_height
 from cadcnc.ops.run import cut_back_gap
+from cadcnc.parallel.pool import kept_pools
 from cadcnc.verification import gate_program
 from cadcnc.verification.cut_back import cut_back
 from cadcnc.verification.gate_cache import shared_gates
-from cadcnc.parallel.pool import kept_pools
-from benchmarks.finishing import freeform_slab
 
 clock, cpu = time.perf_counter, time.process_time
 

@@ -19,10 +19,10 @@ import tempfile
 import time
 
 import cadcnc
+from benchmarks.pace.bench_pace import pencil_case, slab_case
 from cadcnc.io.outputs import render
 from cadcnc.ops.finish import finish
 from cadcnc.ops.pencil import pencil_program as pencil  # the module
-from benchmarks.pace.bench_pace import pencil_case, slab_case
 
 
 def timed_stage(module, name: str, calls: list):

@@ -23,10 +23,10 @@ import time
 import numpy as np
 
 import cadcnc
-from cadcnc.io.program_json import read_program
 from benchmarks.finishing.finish_bench_tools import run_ocl, tessellate
 from benchmarks.finishing.finish_vs_ocl import ocl_points, plane_frame
 from benchmarks.pace.bench_pace import slab_case
+from cadcnc.io.program_json import read_program
 
 
 def command(path: str, top: int, out: str, jobs: int) -> float:

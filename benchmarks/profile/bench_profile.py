@@ -45,7 +45,6 @@ def offset_boss(folder: Path) -> str:
     from OCP.BRepOffset import BRepOffset_Skin
     from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeOffsetShape
     from OCP.GeomAbs import GeomAbs_Intersection
-
     from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
 
     from cadcnc.geometry.part import load_step

@@ -38,10 +38,10 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.coverage.coverage_judge import covered, judge_pair
-from cadcnc.testing.coverage_oracle import Oracle
 from benchmarks.coverage.coverage_paths import cadcnc_command, classify, distance_to_polylines
 from benchmarks.coverage.pair_coverage import judge_path, spread
 from benchmarks.coverage.pencil_coverage import MOVE_RE
+from cadcnc.testing.coverage_oracle import Oracle
 
 AXES = ("+Z", "-Z", "+X", "-X", "+Y", "-Y")
 

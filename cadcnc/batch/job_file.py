@@ -13,9 +13,10 @@ from __future__ import annotations
 import glob
 import json
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
+
+import tomllib
 
 from ..core.errors import InputError
 

@@ -18,8 +18,8 @@ from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 from ..core.errors import EXIT_OK, EXIT_PARTIAL, InputError
-from ..io.atomic import write_text
 from ..core.jsonable import plain
+from ..io.atomic import write_text
 from .task import BatchPart, OperationResult
 
 STATE = "batch-part.json"

@@ -3,7 +3,8 @@ period, outputs, work limit, processes, setup and ``--stream``."""
 
 from __future__ import annotations
 
-from cadcnc.core.job import DEFAULT_FEED as FEED, DEFAULT_PERIOD as PERIOD
+from cadcnc.core.job import DEFAULT_FEED as FEED
+from cadcnc.core.job import DEFAULT_PERIOD as PERIOD
 from cadcnc.core.work_limits import MAX_CYCLES
 
 DEFAULT_FEED = f"{FEED:g}"  # the job's defaults as the options' text

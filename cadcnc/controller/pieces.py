@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..interp.cycle import MAX_TURN
 from ..core.job import check_number
+from ..interp.cycle import MAX_TURN
 from ..program.program import Program
 from .machine import Machine
 

@@ -18,13 +18,30 @@ from dataclasses import dataclass, field
 
 from .errors import InputError
 from .operations import (  # noqa: F401 - the records a Job holds, named where the Job is
-    FINISH_FIELDS, FINISHING, OPERATIONS, SIDES, Finishing, PairPath, Pencil, Raster,
-    SteepShallow, Waterline, finishing,
+    FINISH_FIELDS,
+    FINISHING,
+    OPERATIONS,
+    SIDES,
+    Finishing,
+    PairPath,
+    Pencil,
+    Raster,
+    SteepShallow,
+    Waterline,
+    finishing,
 )
 from .tolerances import DEFAULT, Tolerances
 from .tool import SHANK_LENGTH_RADII, Tool  # noqa: F401 - the Job's tool
-from .units import PRINCIPAL_AXES, axis_name, check_axis  # noqa: F401 - the Job's axis
-from .units import Point, check_faces, check_number, check_point, shown  # noqa: F401 - checks of every record
+from .units import (  # noqa: F401 - the Job's axis  # noqa: F401 - checks of every record
+    PRINCIPAL_AXES,
+    Point,
+    axis_name,
+    check_axis,
+    check_faces,
+    check_number,
+    check_point,
+    shown,
+)
 
 DEFAULT_FEED = 1500.0  # mm/min: with DEFAULT_PERIOD, the paper's 0.1 mm step
 DEFAULT_PERIOD = 0.004  # s: the interpolation period

@@ -7,7 +7,6 @@ from dataclasses import dataclass, fields
 
 from .errors import InputError
 
-
 STRETCH_TANGENT_MARGIN = 2.0
 """The stretch search's tangent limit over the interpolator's (``stretch_tangent_sin``)."""
 STREAM_LIMIT_SLACK = 1e-6

@@ -11,6 +11,7 @@ import numpy as np
 from OCP.Bnd import Bnd_Box
 from OCP.BRepBndLib import BRepBndLib
 
+
 def optimal_box(shape, use_triangulation: bool) -> tuple[np.ndarray, np.ndarray]:
     """(lo (3,), hi (3,)) of OCCT's optimal axis-aligned bounding box of a shape, mm (of
     its geometry, or of its triangulation)."""

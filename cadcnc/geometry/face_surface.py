@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from OCP.BRep import BRep_Tool
@@ -21,17 +22,22 @@ from OCP.BRepTools import BRepTools
 from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
-from OCP.Precision import Precision
 from OCP.GProp import GProp_GProps
+from OCP.Precision import Precision
 from OCP.ShapeAnalysis import ShapeAnalysis_Surface
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
+from OCP.TopoDS import TopoDS_Face
 
-from .boxes import optimal_box
-from . import differential as dg
-from .surface_data import SURFACE_KINDS, SurfaceData, as_topods_face, surface_data
 from ..core.errors import GeometryError, InputError, SingularPointError
 from ..core.tolerances import DEFAULT, Tolerances
+from . import differential as dg
+from .boxes import optimal_box
+from .surface_data import SURFACE_KINDS, SurfaceData, as_topods_face, surface_data
+
+if TYPE_CHECKING:   # built on first use (trim_grid imports the compiled reader)
+    from .trim_grid import TrimGrid
 from ..core.trim_labels import BOUNDARY, INSIDE, OUTSIDE
+
 
 @dataclass(frozen=True)
 class Derivatives:

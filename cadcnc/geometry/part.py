@@ -24,12 +24,12 @@ from OCP.TopoDS import TopoDS, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
 from ..core.errors import FaceNumberError, InputError, StepFileError
+from ..core.tolerances import DEFAULT, Tolerances
 from .differential import cross
 from .face_surface import FaceSurface
 from .material_side import FLIPPED, SOLID, SurfaceModel, material_sides
 from .sewing import file_faces, sew
 from .step_file import read_step
-from ..core.tolerances import DEFAULT, Tolerances
 
 CONCAVE, CONVEX, TANGENT, MIXED = "concave", "convex", "tangent", "mixed"
 

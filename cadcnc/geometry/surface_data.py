@@ -61,8 +61,8 @@ from OCP.GeomAbs import (
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Face
 
-from . import bspline_blob
 from ..core.errors import InputError
+from . import bspline_blob
 
 SURFACE_KINDS = {
     GeomAbs_Plane: "plane",

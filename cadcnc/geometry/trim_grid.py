@@ -49,10 +49,10 @@ from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.gp import gp_Pnt2d
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT
 
-from .fclass_polygon import classifier_tolerance, polygon_bands  # noqa: F401 (re-exported)
-from .trim_cells import layout, paint, regions, segment_blocks, segment_lists
 from ..core.trim_labels import BOUNDARY, CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, INSIDE, OUTSIDE
 from ..interp.kernel.trim_lookup import lookup
+from .fclass_polygon import classifier_tolerance, polygon_bands  # noqa: F401 (re-exported)
+from .trim_cells import layout, paint, regions, segment_blocks, segment_lists
 
 
 def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:

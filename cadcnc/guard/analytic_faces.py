@@ -15,9 +15,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-from OCP.TopAbs import TopAbs_IN
 from OCP.gp import gp_Pnt2d
+from OCP.TopAbs import TopAbs_IN
 
 EPS = 1e-12   # relative: below this a direction or radius is degenerate
 

@@ -34,18 +34,18 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from OCP.BRep import BRep_Builder
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_IsInFace
-from OCP.BRep import BRep_Builder
-from OCP.TopoDS import TopoDS_Compound
+from OCP.gp import gp_Pnt
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_VERTEX
 from OCP.TopExp import TopExp
+from OCP.TopoDS import TopoDS_Compound
 from OCP.TopTools import TopTools_IndexedMapOfShape
-from OCP.gp import gp_Pnt
 
+from ..core.tolerances import DEFAULT
 from .analytic_faces import AnalyticFace
 from .face_distance import FaceDistance
-from ..core.tolerances import DEFAULT
 
 TIE = 1e-9  # mm: margins this close are the same contact
 BOX_SLACK = 1e-4  # mm added to each face box: OCCT's optimal box is tight, not outer-exact

@@ -35,14 +35,14 @@ import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
-from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_ExtCF, BRepExtrema_ExtPF
 from OCP.BRepClass import BRepClass_FaceClassifier
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_ExtCF, BRepExtrema_ExtPF
 from OCP.GeomAbs import GeomAbs_BezierCurve, GeomAbs_BSplineCurve
+from OCP.gp import gp_Pnt, gp_Pnt2d
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_IN
 from OCP.TopExp import TopExp
-from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.TopoDS import TopoDS
-from OCP.gp import gp_Pnt, gp_Pnt2d
+from OCP.TopTools import TopTools_IndexedMapOfShape
 
 from .face_boxes import SLACK, flat_knots, pole_support
 

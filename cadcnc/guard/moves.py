@@ -16,11 +16,13 @@ import math
 import numpy as np
 from OCP.BRep import BRep_Builder
 from OCP.BRepBuilderAPI import (
-    BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon,
+    BRepBuilderAPI_MakeEdge,
+    BRepBuilderAPI_MakeFace,
+    BRepBuilderAPI_MakePolygon,
 )
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-from OCP.TopoDS import TopoDS_Compound
 from OCP.gp import gp_Pnt
+from OCP.TopoDS import TopoDS_Compound
 
 from .clearance import face_boxes
 

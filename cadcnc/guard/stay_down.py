@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .moves import MoveClearance
 from ..core.trim_labels import OUTSIDE
+from .moves import MoveClearance
 
 NEWTON = 6
 """Newton steps towards the foot of a point on a face (the witness is valid at any step)."""

@@ -35,8 +35,8 @@ from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
 from OCP.GeomAbs import GeomAbs_BSplineCurve, GeomAbs_Line
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_VERTEX
 from OCP.TopExp import TopExp
-from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.TopoDS import TopoDS
+from OCP.TopTools import TopTools_IndexedMapOfShape
 
 from ..core.trim_labels import INSIDE, OUTSIDE
 from .cells import DROPS, REUSE, HeightCells, shared

@@ -24,15 +24,28 @@ from ..core.job import check_number, check_step
 from ..core.tolerances import DEFAULT
 from ..core.trim_labels import OUTSIDE
 from .cycle import (
-    BOUNDARY, CLOSED, COLLISION, CORRECTION_SINGULAR, CURVATURE, DIVERGED, END, MAX_CYCLES,
+    BOUNDARY,
+    CLOSED,
+    COLLISION,
+    CORRECTION_SINGULAR,
+    CURVATURE,
+    DIVERGED,
+    END,
+    MAX_CYCLES,
+    MOVE_UNDEFINED,
+    SINGULAR,
+    TANGENT,
     Contact,
-    MOVE_UNDEFINED, SINGULAR, TANGENT, boundary_detail, curvature_detail, diverged_detail,
-    singular_detail, tangent_detail,
+    boundary_detail,
+    curvature_detail,
+    diverged_detail,
+    singular_detail,
+    tangent_detail,
 )
 from .kernel import entry as E
 from .kernel import follow as KF
-from .kernel import step as K
 from .kernel import layout as L
+from .kernel import step as K
 from .record import ROW, PathRecord
 from .stepper import Stepper, Tangency
 from .vec3 import Vec

@@ -14,14 +14,30 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from ..core.job import MIN_STEP, check_number, check_step
-from .cycle import (
-    BOUNDARY, CLOSED, COLLISION, CURVATURE, DIVERGED, END, MAX_CYCLES, SINGULAR, Contact, StopCycle,
-    SurfaceLike, Track, accurate_step, advance, boundary_detail, check_curvature,
-    diverged_detail, singular_detail, track,
-)
-from .landing import LANDING_TOL, MAX_TRIALS, land
 from ..core.tolerances import DEFAULT, Tolerances
 from ..core.trim_labels import OUTSIDE
+from .cycle import (
+    BOUNDARY,
+    CLOSED,
+    COLLISION,
+    CURVATURE,
+    DIVERGED,
+    END,
+    MAX_CYCLES,
+    SINGULAR,
+    Contact,
+    StopCycle,
+    SurfaceLike,
+    Track,
+    accurate_step,
+    advance,
+    boundary_detail,
+    check_curvature,
+    diverged_detail,
+    singular_detail,
+    track,
+)
+from .landing import LANDING_TOL, MAX_TRIALS, land
 from .record import PathRecord
 from .vec3 import Vec, dot, norm, scale, sub
 

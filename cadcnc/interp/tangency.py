@@ -12,9 +12,9 @@ import math
 import numpy as np
 
 from ..core.errors import StartPointError
+from ..core.tolerances import DEFAULT, Tolerances
 from .stepper import Tangency
 from .vec3 import add, axpy, cross, dot, norm, scale, sub
-from ..core.tolerances import DEFAULT, Tolerances
 
 
 def offset_point_and_jacobian(surface, offset: float, u: float, w: float):

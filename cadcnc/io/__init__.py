@@ -6,7 +6,13 @@ from .outputs import PROGRAM_CSV_COLUMNS, SUFFIXES, check_output, program_csv, r
 from .plot import write_picture
 from .toolpath_csv import CSV_COLUMNS, read_csv, toolpath_csv, write_csv
 from .toolpath_json import (
-    ARRAYS, FORMAT, VERSION, read_json, toolpath_from_dict, toolpath_to_dict, write_json,
+    ARRAYS,
+    FORMAT,
+    VERSION,
+    read_json,
+    toolpath_from_dict,
+    toolpath_to_dict,
+    write_json,
 )
 
 __all__ = [

@@ -13,7 +13,6 @@ from pathlib import Path
 
 from ..core.errors import OutputError
 
-
 NAME_MAX = 255  # bytes in one file name on common file systems
 _TEMP_ROOM = 16  # bytes the temporary name adds: ".", mkstemp's 8 characters, ".tmp", a dot
 

@@ -16,14 +16,14 @@ from pathlib import Path
 
 from ..core.errors import OutputError
 from ..geometry.setup import job_setup
-from ..program.program import Program
-from ..program.transform import in_part_coordinates
-from .program_gcode import program_ngc
-from .program_json import join_pieces, json_pieces, program_json, segments_text
 from ..parallel.pool import check_jobs
 from ..parallel.tasks import on_workers
-from .program_plot import program_picture_bytes
+from ..program.program import Program
+from ..program.transform import in_part_coordinates
 from .output_set import check_destination
+from .program_gcode import program_ngc
+from .program_json import join_pieces, json_pieces, program_json, segments_text
+from .program_plot import program_picture_bytes
 from .toolpath_csv import CSV_COLUMNS, toolpath_rows
 
 SUFFIXES = (".json", ".csv", ".ngc", ".png", ".glb")

@@ -18,14 +18,22 @@ import re
 import numpy as np
 
 from ..core.errors import InputError
-from ..core.job import check_number
-from ..core.job import SAFE_MARGIN
+from ..core.job import SAFE_MARGIN, check_number
 from ..program.linking import linked
 from ..program.program import CutSegment, Program
 from .atomic import write_text
 from .gcode import (
-    WORD, DEFAULT_GOUGE, DEFAULT_TOLERANCE, comment, num, blend_for, blend_word, digits_for,
-    programmed_moves, programmed_points, simplify,
+    DEFAULT_GOUGE,
+    DEFAULT_TOLERANCE,
+    WORD,
+    blend_for,
+    blend_word,
+    comment,
+    digits_for,
+    num,
+    programmed_moves,
+    programmed_points,
+    simplify,
 )
 
 

@@ -28,8 +28,7 @@ import os
 
 import numpy as np
 
-from ..core.errors import require
-from ..core.errors import InputError
+from ..core.errors import InputError, require
 from ..core.job import Job
 from ..core.jsonable import plain
 from ..geometry.setup import Setup

@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 
 from ..core.errors import OutputError
+from ..core.job import axis_name
 from ..geometry.mesh import tessellate
 from ..geometry.setup import job_setup, original_part
-from ..core.job import axis_name
 from ..program.program import Program
 from ..program.transform import in_part_coordinates
 from .output_set import write_one

@@ -12,7 +12,6 @@ from ..core.errors import InputError
 from ..program.toolpath import Toolpath
 from .atomic import write_text
 
-
 CSV_COLUMNS = (
     ["cycle", "t_s", "x", "y", "z", "step", "commanded"]
     + [f"q{i}{a}" for i in (1, 2) for a in "xyz"]

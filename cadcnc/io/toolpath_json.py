@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 
 from ..core.errors import InputError
-from ..interp.error_bounds import SurfaceBounds
 from ..core.job import Job
 from ..core.jsonable import plain
+from ..interp.error_bounds import SurfaceBounds
 from ..program.toolpath import Toolpath
 from .atomic import write_text
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 from ..core.errors import GeometryError, InputError
 from ..core.job import SAFE_MARGIN, Job
+from ..core.work_limits import MAX_CYCLES, refuse_over
 from ..program.linking import linked
 from ..program.program import CutSegment, Program
 from ..program.toolpath import Toolpath, toolpath_from_record
-from ..core.work_limits import MAX_CYCLES, refuse_over
 from .path.pair_path import PathPlan, stepper_for
 
 FINISH_JOIN = 1e-6

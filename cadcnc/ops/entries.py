@@ -30,14 +30,14 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..interp.cycle import END
-from ..guard import FINISH_OWN_SHARE, PAIR_OWN_SHARE, MoveClearance, guard_for
 from ..core.job import Job
+from ..guard import FINISH_OWN_SHARE, PAIR_OWN_SHARE, MoveClearance, guard_for
+from ..interp.cycle import END
+from ..parallel.pool import check_jobs
+from ..parallel.tasks import on_workers
 from ..program.linking import Visit, linked
 from ..program.program import CutSegment, LinkSegment, Skipped
 from ..program.toolpath import toolpath_piece
-from ..parallel.pool import check_jobs
-from ..parallel.tasks import on_workers
 
 UNREACHABLE = "unreachable"
 SIDES = ((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, -1.0, 0.0))

@@ -18,8 +18,8 @@ import numpy as np
 
 from ..interp.compiled import new_stepper
 from ..interp.stepper import Tangency
-from .finish.passes import GuidePlane
 from .finish.pass_setup import GUIDE_MARGIN, guide_face
+from .finish.passes import GuidePlane
 
 END_REACHED = 1e-12  # mm
 ROLLED = "rolled over"   # the stop detail of a convex roll-over arc (ops/finish/transitions.py)

@@ -37,10 +37,10 @@ import os
 import signal
 import threading
 import time
-from contextlib import contextmanager
-from contextvars import ContextVar
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Any, Callable, Iterator, Sequence
 
 from ..core.errors import CadcncError, InputError

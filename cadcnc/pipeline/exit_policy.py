@@ -12,8 +12,16 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ..core.errors import (EXIT_GOUGE, EXIT_INPUT, EXIT_INTERNAL, EXIT_NOTHING, EXIT_OK,
-                           EXIT_OUTPUT, EXIT_PARTIAL, NothingToCutError)
+from ..core.errors import (
+    EXIT_GOUGE,
+    EXIT_INPUT,
+    EXIT_INTERNAL,
+    EXIT_NOTHING,
+    EXIT_OK,
+    EXIT_OUTPUT,
+    EXIT_PARTIAL,
+    NothingToCutError,
+)
 from ..program.program import FAILED, STOPPED_SHORT, Program
 from ..program.summary import skipped_counts
 from ..verification.cut_back import cut_back

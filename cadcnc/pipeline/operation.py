@@ -14,7 +14,8 @@ from ..io.output_set import OutputSet, check_destination
 from ..io.outputs import SUFFIXES
 from ..parallel.pool import kept_pools
 from .operate import Outcome, Settings, operate, rendered
-from .streaming import SUFFIXES as STREAM_SUFFIXES, StreamRun, stream_to
+from .streaming import SUFFIXES as STREAM_SUFFIXES
+from .streaming import StreamRun, stream_to
 
 
 @dataclass(frozen=True)

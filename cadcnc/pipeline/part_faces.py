@@ -3,8 +3,8 @@ neither the interpolation core nor numba is imported, so it starts fast."""
 
 from __future__ import annotations
 
-from ..geometry.part import load_step
 from ..geometry.faces_report import faces_report
+from ..geometry.part import load_step
 
 
 def faces_of(step, flip_material: bool = False) -> tuple[dict, list[str]]:

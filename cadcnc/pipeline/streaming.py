@@ -17,7 +17,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..controller.feed_plan import plan_feed
-from ..controller.hal import HalError, hal_available, run_hal_loop, summary as hal_summary
+from ..controller.hal import HalError, hal_available, run_hal_loop
+from ..controller.hal import summary as hal_summary
 from ..controller.pieces import pieces_of
 from ..controller.stream import stream_program, stream_text
 from ..core.errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL, InputError

@@ -14,12 +14,11 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from ..interp.cycle import CLOSED, END, PAPER_INVERSE_LIMIT
+from ..core.job import Job
 from ..interp.bounds_compiled import pair_bounds
+from ..interp.cycle import CLOSED, END, PAPER_INVERSE_LIMIT
 from ..interp.error_bounds import SurfaceBounds
 from ..interp.record import PathRecord
-from ..core.job import Job
-
 
 INTENDED_STOPS = (END, CLOSED)
 """Stops that end a path where it was meant to end; any other stop leaves it partial."""

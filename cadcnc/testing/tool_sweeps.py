@@ -15,8 +15,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from OCP.BRepBuilderAPI import (BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace,
-                                BRepBuilderAPI_MakePolygon)
+from OCP.BRepBuilderAPI import (
+    BRepBuilderAPI_MakeEdge,
+    BRepBuilderAPI_MakeFace,
+    BRepBuilderAPI_MakePolygon,
+)
 from OCP.gp import gp_Pnt
 
 TOL = 1e-3  # mm: the gouge limit

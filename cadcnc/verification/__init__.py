@@ -26,14 +26,22 @@ theory, stop), :mod:`.reference` (OCCT's intersection curve), :mod:`.gate`, :mod
 
 from __future__ import annotations
 
+from .all_checks import verify
+from .check_records import (
+    Criterion,
+    FeedCheck,
+    ReferenceCheck,
+    StopCheck,
+    SurfaceCheck,
+    SweepCheck,
+    SweepHit,
+    TheoryRow,
+    WholePartCheck,
+    WholePartHit,
+)
 from .gate import GateResult, gouge_gate
 from .program_gate import ProgramGate, gate_program
-from .check_records import (
-    Criterion, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, SweepCheck, SweepHit,
-    TheoryRow, WholePartCheck, WholePartHit,
-)
 from .report import VerificationReport
-from .all_checks import verify
 
 __all__ = [
     "verify", "gouge_gate", "GateResult", "gate_program", "ProgramGate", "VerificationReport", "SurfaceCheck",

@@ -13,13 +13,13 @@ import time
 
 import numpy as np
 
-from ..program.toolpath import Toolpath
 from ..core.errors import require
 from ..core.tolerances import Tolerances
+from ..program.toolpath import Toolpath
+from .check_records import WholePartCheck
 from .path_checks import check_feed, check_stop, check_theory, followed_edge, intended_span
 from .probe import offset_surface, shape_distances
 from .reference import check_reference
-from .check_records import WholePartCheck
 from .report import VerificationReport
 from .surface_checks import SAMPLE_UNSEEDED, check_pair, prepare
 from .whole_part import check_whole_part

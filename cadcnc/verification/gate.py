@@ -14,11 +14,11 @@ refuses the path. docs/notes/gate.md states what is checked and the bound it use
 from __future__ import annotations
 
 import math
-from ..program.toolpath import Toolpath
-from ..core.errors import require
 from dataclasses import dataclass, field
 
+from ..core.errors import require
 from ..core.tolerances import Tolerances
+from ..program.toolpath import Toolpath
 from .check_records import SweepCheck, WholePartHit, strict_max
 from .gate_cache import cache_for, toolpath_key
 from .surface_checks import SAMPLE_UNSEEDED, check_pair, prepare, resolve_part

@@ -26,6 +26,7 @@ import numpy as np
 from ..core.tolerances import Tolerances
 from .material import Material, PartFaces
 
+
 class GateCache:
     """What gates on ``part`` with tolerances ``tol`` share (module doc)."""
 

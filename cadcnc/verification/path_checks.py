@@ -8,11 +8,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry.part import CONCAVE
 from ..core.tolerances import Tolerances
 from ..core.trim_labels import INSIDE
+from ..geometry.part import CONCAVE
+from .check_records import (
+    BOUND_NAMES,
+    FeedCheck,
+    ReferenceCheck,
+    StopCheck,
+    SurfaceCheck,
+    TheoryRow,
+)
 from .probe import FaceProbe
-from .check_records import BOUND_NAMES, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, TheoryRow
 
 SHORTENED_LAST_STEP = ("end", "closed", "boundary")  # stop reasons that may land short
 

@@ -21,8 +21,8 @@ from OCP.BRepGProp import BRepGProp
 from OCP.BRepTools import BRepTools
 from OCP.GeomAbs import GeomAbs_Plane
 from OCP.GeomLib import GeomLib_IsPlanarSurface
+from OCP.gp import gp_Ax3, gp_Dir, gp_Pln
 from OCP.GProp import GProp_GProps
-from OCP.gp import gp_Ax3, gp_Dir, gp_Pln, gp_Pnt
 from OCP.TopAbs import TopAbs_FORWARD, TopAbs_WIRE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS

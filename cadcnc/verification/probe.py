@@ -18,19 +18,18 @@ from OCP.BRepClass import BRepClass_FaceClassifier
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_IsInFace
 from OCP.BRepTools import BRepTools
 from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
+from OCP.ElSLib import ElSLib
 from OCP.Extrema import Extrema_GenLocateExtPS
 from OCP.Geom import Geom_OffsetSurface
+from OCP.GeomAbs import GeomAbs_Cylinder, GeomAbs_Plane, GeomAbs_Sphere, GeomAbs_Torus
 from OCP.GeomAdaptor import GeomAdaptor_Surface
 from OCP.GeomAPI import GeomAPI_IntSS, GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
-from OCP.ElSLib import ElSLib
-from OCP.GeomAbs import (GeomAbs_Cylinder, GeomAbs_Plane, GeomAbs_Sphere,
-                          GeomAbs_Torus)
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
 
-from ..geometry.boxes import optimal_box
 from ..core.tolerances import DEFAULT, Tolerances
 from ..core.trim_labels import BOUNDARY, INSIDE, OUTSIDE
+from ..geometry.boxes import optimal_box
 from .box_face import whole_box
 from .face_boundary import FaceEdges
 

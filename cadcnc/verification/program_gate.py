@@ -13,13 +13,13 @@ against the whole part exactly once. The program passes only when every cut pass
 from __future__ import annotations
 
 import math
-from ..program.program import Program
-from ..core.errors import require
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.errors import require
 from ..core.tolerances import Tolerances
+from ..program.program import Program
 from .gate import GateResult, gouge_gate
 from .gate_cache import shared_gates
 from .gate_jobs import gate_cuts

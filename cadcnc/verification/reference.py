@@ -18,8 +18,6 @@ from . import probe as occt
 from .check_records import ReferenceCheck
 
 
-
-
 def nearest(a: np.ndarray, b: np.ndarray, chunk: int = 64) -> np.ndarray:
     """Index into ``b`` of the nearest point to each row of ``a`` (brute force, chunked)."""
     out = np.empty(len(a), dtype=int)

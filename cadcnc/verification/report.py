@@ -14,8 +14,16 @@ from dataclasses import dataclass, field
 from ..core.jsonable import plain
 from ..core.tolerances import DEFAULT, Tolerances
 from .check_records import (
-    Criterion, FeedCheck, ReferenceCheck, StopCheck, SurfaceCheck, SweepCheck, TheoryRow,
-    WholePartCheck, WholePartHit, strict_max,
+    Criterion,
+    FeedCheck,
+    ReferenceCheck,
+    StopCheck,
+    SurfaceCheck,
+    SweepCheck,
+    TheoryRow,
+    WholePartCheck,
+    WholePartHit,
+    strict_max,
 )
 from .table import format_table
 from .verdict import criteria

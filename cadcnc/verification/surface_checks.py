@@ -10,12 +10,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.errors import InputError
-from ..geometry.part import load_step
-from ..geometry.setup import setup_part
 from ..core.tolerances import Tolerances
 from ..core.trim_labels import OUTSIDE
-from .probe import FaceProbe
+from ..geometry.part import load_step
+from ..geometry.setup import setup_part
 from .check_records import SurfaceCheck, cycle_ranges
+from .probe import FaceProbe
 
 PERCENTILES = (50, 95, 99)
 SAMPLE_UNSEEDED = 64  # cycles per face re-projected without seeds (plus the worst ones)

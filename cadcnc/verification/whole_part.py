@@ -17,9 +17,16 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..core.tolerances import Tolerances
-from .probe import FaceProbe
-from .check_records import SurfaceCheck, SweepCheck, SweepHit, WholePartCheck, WholePartHit, cycle_ranges
+from .check_records import (
+    SurfaceCheck,
+    SweepCheck,
+    SweepHit,
+    WholePartCheck,
+    WholePartHit,
+    cycle_ranges,
+)
 from .material import Material, PartFaces
+from .probe import FaceProbe
 from .sweep import Polyline
 
 FAR_MATCH_STEPS = 4.0  # a move farther than 4 steps from the centre found near it is

@@ -9,7 +9,6 @@ from cadcnc import apt
 from cadcnc.core.errors import FacePairError, InputError, ProgramSyntaxError, StepFileError
 from cadcnc.core.job import Job
 from cadcnc.core.tolerances import DEFAULT, Tolerances
-
 from helpers.fixtures import FIXTURES, fixture_path, load_fixture
 
 GOOD = f"""$$ both saddle edges, then part of one at a higher feed

@@ -26,7 +26,6 @@ from pathlib import Path
 import pytest
 
 from helpers.cli import cadcnc_cli
-
 from helpers.fixtures import FIXTURES
 
 pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
@@ -146,9 +145,9 @@ def test_rerun_skips_unchanged_parts_without_starting_a_cluster(embedded):
 
 
 def test_job_hash_follows_the_part_options_and_outputs(tmp_path):
+    import cadcnc
     from cadcnc.batch.records import job_hash
     from cadcnc.batch.task import BatchOperation, BatchPart
-    import cadcnc
 
     step = tmp_path / "a.step"
     shutil.copy(FIXTURES / "step_block.step", step)

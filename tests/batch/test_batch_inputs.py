@@ -8,7 +8,6 @@ import json
 import shutil
 
 from helpers.cli import cadcnc_cli
-
 from helpers.fixtures import FIXTURES
 
 STEP = FIXTURES / "step_block.step"

@@ -12,7 +12,9 @@ import numpy as np
 import pytest
 
 import cadcnc
-from benchmarks.finishing import finish_bench_tools as tools, finish_vs_ocl, freeform_slab as slab
+from benchmarks.finishing import finish_bench_tools as tools
+from benchmarks.finishing import finish_vs_ocl
+from benchmarks.finishing import freeform_slab as slab
 
 R = 3.0
 

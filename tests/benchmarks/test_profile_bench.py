@@ -4,13 +4,13 @@ they wrap shows here rather than as a silently empty table."""
 
 from __future__ import annotations
 
-import pytest
-
 import json
 import os
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 from helpers.fixtures import FIXTURES
 

@@ -14,13 +14,11 @@ import shutil
 import numpy as np
 import pytest
 
-from cadcnc.core.errors import StepFileError
-from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.cli.app import main
+from cadcnc.core.errors import StepFileError
 from cadcnc.io import read_csv, read_json
-
+from cadcnc.ops.path.pair_path import intersection_path
 from helpers.cli import cadcnc_cli, in_folder
-
 from helpers.fixtures import FIXTURES, fixture_path, load_fixture
 
 BOSS = str(FIXTURES / "bspline_boss.step")

@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 
 import cadcnc
+from cadcnc.core.job import Job, PairPath, Tool
+from cadcnc.io.outputs import PROGRAM_CSV_COLUMNS
 from cadcnc.io.program_gcode import segment_moves
 from cadcnc.io.program_json import read_program
 from cadcnc.io.toolpath_csv import CSV_COLUMNS
-from cadcnc.io.outputs import PROGRAM_CSV_COLUMNS
-from cadcnc.core.job import Job, PairPath, Tool
 from cadcnc.ops import common
 from cadcnc.ops.path import pair_program
 from helpers.cli import cadcnc_cli
@@ -153,8 +153,8 @@ def test_a_clearance_below_the_top_is_refused_with_the_lowest_allowed(tmp_path):
 def test_the_gate_catches_a_gouging_link():
     """A link forced through the boss (its rapid lowered to Z 2.8, under the boss top) is
     refused by the library's verdict with the link named, and allowed only on request."""
-    from cadcnc.program.program import LinkSegment, Program
     from cadcnc.pipeline.exit_policy import judge
+    from cadcnc.program.program import LinkSegment, Program
 
     part = cadcnc.load_step(BOSS)
     job = Job(Tool(3.0), 1500.0, 0.004, PairPath(faces=(1, 6), edge=None))

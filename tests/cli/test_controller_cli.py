@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from helpers.cli import cadcnc_cli
-
 from helpers.fixtures import FIXTURES
 
 BLOCK = FIXTURES / "step_block.step"

@@ -5,17 +5,15 @@ from __future__ import annotations
 
 import csv
 import json
-import re
-import subprocess
 
 import numpy as np
 import pytest
 
 from cadcnc.cli import operation_options as operation_cli
-from cadcnc.io.gcode import programmed_moves
-from cadcnc.io.program_json import read_program
 from cadcnc.core import job as job_module
 from cadcnc.core.units import parse_duration, parse_feed
+from cadcnc.io.gcode import programmed_moves
+from cadcnc.io.program_json import read_program
 from cadcnc.testing.rs274 import move_points
 from helpers.cli import cadcnc_cli
 from helpers.fixtures import FIXTURES

@@ -13,11 +13,9 @@ import numpy as np
 import pytest
 
 from cadcnc.controller.hal.session import remove_stale
-from cadcnc.verification.stream_check import check_stream
 from cadcnc.core.work_limits import Ticker
-
+from cadcnc.verification.stream_check import check_stream
 from helpers.cli import cadcnc_cli
-
 from helpers.fixtures import FIXTURES
 
 BLOCK = FIXTURES / "step_block.step"
@@ -90,7 +88,7 @@ def test_a_stream_over_the_limits_exits_5_and_writes_nothing(program, tmp_path):
 def test_check_refuses_what_the_planner_would_write(program, tmp_path, monkeypatch):
     """The check does not trust the planner: positions nudged past the velocity limit
     after planning are refused (exit 5), nothing written."""
-    import cadcnc.pipeline.streaming as stream   # the names the stream run calls
+    import cadcnc.pipeline.streaming as stream  # the names the stream run calls
 
     real = stream.stream_program
 
@@ -232,7 +230,7 @@ def test_sigterm_while_an_output_set_is_written_leaves_no_temporary_file(tmp_pat
 def test_the_txt_is_checked_as_printed(program, tmp_path, monkeypatch):
     """The .txt's numbers, not only the array they were printed from: a text that breaks
     the limits is refused with its name, and neither file is written."""
-    import cadcnc.pipeline.streaming as stream   # the names the stream run calls
+    import cadcnc.pipeline.streaming as stream  # the names the stream run calls
 
     real = stream.stream_text
 

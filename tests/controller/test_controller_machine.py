@@ -8,7 +8,6 @@ import pytest
 
 from cadcnc.controller.machine import Machine, read_machine_ini
 from cadcnc.core.errors import InputError
-
 from helpers.cli import cadcnc_cli
 
 SAMPLE = Path("/usr/share/doc/linuxcnc/examples/sample-configs/by_machine/tormach/pcnc-770.ini")

@@ -17,7 +17,6 @@ from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.ops.stream_steppers import stepper_factory
-
 from cadcnc.testing.topp_bound import va_bound
 from helpers.fixtures import FIXTURES
 from helpers.programs import pencil_run

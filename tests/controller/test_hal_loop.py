@@ -26,7 +26,11 @@ pytestmark = [pytest.mark.slow,  # over about 5 s a test (pyproject.toml)
                                  reason="halrun not installed (apt install linuxcnc-uspace)")]
 
 from cadcnc.controller.hal import (  # noqa: E402
-    HalError, HalSession, rtapi_pids, run_hal_loop, write_stream_txt,
+    HalError,
+    HalSession,
+    rtapi_pids,
+    run_hal_loop,
+    write_stream_txt,
 )
 
 HAL_TOOLS = {"rtapi_app", "halrun", "halcmd", "halstreamer", "halsampler"}

@@ -15,9 +15,7 @@ import pytest
 from cadcnc.controller.ini_file import leading_number
 from cadcnc.controller.machine import IniWarning, read_machine_ini
 from cadcnc.core.errors import InputError
-
 from helpers.cli import cadcnc_cli
-
 from helpers.fixtures import FIXTURES
 
 # 4 mm of the block's straight corner (faces 3 and 8), as in test_controller_cli.py

@@ -10,12 +10,10 @@ import pytest
 
 import cadcnc
 from cadcnc.core.errors import InputError
+from cadcnc.core.job import Job, PairPath, Pencil, Raster, Tool
 from cadcnc.io.outputs import PROGRAM_CSV_COLUMNS
 from cadcnc.io.program_json import program_json, read_program
-from cadcnc.core.job import Raster, Job, PairPath, Pencil, Tool
-
 from helpers.cli import cadcnc_cli
-
 from helpers.fixtures import FIXTURES
 
 _PARTS: dict = {}

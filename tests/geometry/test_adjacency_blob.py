@@ -14,18 +14,21 @@ import pickle
 
 import numpy as np
 import pytest
-from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRep import BRep_Builder
+from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
-from OCP.TopoDS import TopoDS_Compound
 from OCP.gp import gp_Pnt
+from OCP.TopoDS import TopoDS_Compound
 
 import cadcnc
 from cadcnc.geometry.part import Part
-from cadcnc.geometry.part_bytes import (adjacency_record, part_blob, part_from_blob,
-                                        take_adjacency_record)
+from cadcnc.geometry.part_bytes import (
+    adjacency_record,
+    part_blob,
+    part_from_blob,
+    take_adjacency_record,
+)
 from cadcnc.geometry.setup import setup_in, setup_of, setup_part
-
 from helpers.fixtures import FIXTURES
 
 EXACT = ("faces", "edge_class", "length", "closed")

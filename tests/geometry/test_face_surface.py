@@ -9,15 +9,18 @@ import numpy as np
 import pytest
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.Geom import (
-    Geom_BezierSurface, Geom_BSplineCurve, Geom_OffsetSurface, Geom_SurfaceOfLinearExtrusion,
+    Geom_BezierSurface,
+    Geom_BSplineCurve,
+    Geom_OffsetSurface,
+    Geom_SurfaceOfLinearExtrusion,
     Geom_SurfaceOfRevolution,
 )
 from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 
-from cadcnc.core.trim_labels import BOUNDARY, INSIDE, OUTSIDE
 from cadcnc.core.errors import SingularPointError
+from cadcnc.core.trim_labels import BOUNDARY, INSIDE, OUTSIDE
 from cadcnc.geometry.face_surface import FaceSurface
 
 V = cq.Vector

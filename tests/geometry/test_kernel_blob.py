@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers.fixtures import FIXTURES as FOLDER
-from helpers.fixtures import load_fixture
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d
 from OCP.Geom import Geom_BSplineSurface
@@ -19,6 +17,8 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
 from cadcnc.geometry import bspline_blob
+from helpers.fixtures import FIXTURES as FOLDER
+from helpers.fixtures import load_fixture
 
 FIXTURES = ["abc_fold.step", "bspline_boss", "crossing_cylinders", "ellipse_pocket"]
 """abc_fold (no sidecar entry, loaded by file) has the rational ones."""

@@ -18,13 +18,13 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
 import cadcnc
+from cadcnc.core.trim_labels import CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, SEGMENTS
 from cadcnc.geometry import fclass_polygon
 from cadcnc.geometry.polygon_points import pcurve_points, surface_points
 from cadcnc.geometry.surface_data import surface_data
 from cadcnc.geometry.trim_grid import TrimGrid, classifier_tolerance
-from cadcnc.interp.tangency import _solve4
-from cadcnc.core.trim_labels import CELL_INSIDE, CELL_MIXED, CELL_OUTSIDE, SEGMENTS
 from cadcnc.interp.kernel.trim_lookup import lookup
+from cadcnc.interp.tangency import _solve4
 
 FIXTURES = Path(__file__).resolve().parents[2] / "fixtures"
 NAMES = ["bspline_boss", "crossing_cylinders", "sphere_cylinder", "torus_cone"]

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import cadquery as cq
 import pytest
-from helpers.fixtures import FIXTURES, FIXTURE_NAMES, SIDECAR, load_fixture
 from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.STEPControl import STEPControl_Reader
 from OCP.TopAbs import TopAbs_FACE
@@ -14,6 +13,7 @@ from OCP.TopTools import TopTools_IndexedMapOfShape
 
 import cadcnc
 from cadcnc.core.errors import FaceNumberError, StepFileError
+from helpers.fixtures import FIXTURE_NAMES, FIXTURES, SIDECAR, load_fixture
 
 
 @pytest.mark.parametrize("name", FIXTURE_NAMES)

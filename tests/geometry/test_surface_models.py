@@ -14,8 +14,11 @@ import math
 import numpy as np
 import pytest
 from OCP.BRep import BRep_Builder
-from OCP.BRepBuilderAPI import (BRepBuilderAPI_Copy, BRepBuilderAPI_MakeVertex,
-                                BRepBuilderAPI_Transform)
+from OCP.BRepBuilderAPI import (
+    BRepBuilderAPI_Copy,
+    BRepBuilderAPI_MakeVertex,
+    BRepBuilderAPI_Transform,
+)
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepGProp import BRepGProp
 from OCP.gp import gp_Pnt, gp_Trsf, gp_Vec
@@ -23,12 +26,12 @@ from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Compound
 
 import cadcnc
-from cadcnc.ops.path.pair_path import intersection_path
-from cadcnc.geometry.material_side import CLOSED_SHELL, FLIPPED, OPEN_LEVEL, OPEN_SHELL, VOID
+from cadcnc.core.tolerances import DEFAULT
 from cadcnc.geometry.faces_report import faces_report
+from cadcnc.geometry.material_side import CLOSED_SHELL, FLIPPED, OPEN_LEVEL, OPEN_SHELL, VOID
 from cadcnc.geometry.sewing import file_faces, inconsistent_edges, sew
 from cadcnc.geometry.step_file import read_step
-from cadcnc.core.tolerances import DEFAULT
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.verification import gouge_gate
 from cadcnc.verification.material import IN, OUT, Material, PartFaces
 from helpers.cli import cadcnc_cli

@@ -20,10 +20,9 @@ from OCP.BRepPrimAPI import BRepPrimAPI_MakeTorus
 from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
 
 import cadcnc
-from cadcnc.guard.analytic_faces import AnalyticFace
 from cadcnc.geometry.boxes import optimal_box
 from cadcnc.geometry.part import Part
-
+from cadcnc.guard.analytic_faces import AnalyticFace
 from helpers.fixtures import FIXTURES
 
 FIXTURE_FACES = ["pocket", "torus_cone", "sphere_cylinder", "crossing_cylinders"]

@@ -8,7 +8,6 @@ off the fixtures' construction (fixtures/build_stretch_fixtures.py), not compute
 from __future__ import annotations
 
 import copy
-
 import json
 import math
 
@@ -16,7 +15,6 @@ import pytest
 
 import cadcnc
 from cadcnc.guard.clearance import ClearanceGuard
-
 from helpers.fixtures import FIXTURES
 
 SIDECAR = json.loads((FIXTURES / "stretch_fixtures.json").read_text())

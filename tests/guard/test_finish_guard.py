@@ -8,13 +8,11 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.guard.clearance import ClearanceGuard
 from cadcnc.guard.box_tree import BoxTree
 from cadcnc.guard.cells import FaceBoxes, HeightCells
+from cadcnc.guard.clearance import ClearanceGuard
 from cadcnc.guard.guard import OperationGuard
-
 from helpers.face_cells import random_cell_boxes
-
 from helpers.fixtures import FIXTURES
 
 

@@ -13,7 +13,6 @@ from OCP.gp import gp_Pnt
 
 import cadcnc
 from cadcnc.guard.clearance import ClearanceGuard
-
 from helpers.fixtures import FIXTURES
 
 
@@ -45,7 +44,7 @@ def test_clipped_distance_is_exact_below_cap(face, cap):
 def test_rho_above_bounds_the_points_above(name, face):
     """BoxTree.rho_above: no point of the face above z0 is horizontally nearer to p than
     the bound it returns (dense samples of the face, OCCT evaluation)."""
-    from cadcnc.guard.box_tree import BoxTree   # noqa: PLC0415
+    from cadcnc.guard.box_tree import BoxTree  # noqa: PLC0415
 
     part = cadcnc.load_step(FIXTURES / name)
     f = part.face(face)
@@ -76,9 +75,9 @@ def test_face_distance_is_distshapeshape(name, pair):
     """guard/face_distance.py: OCCT's pieces, the edges only where they can win, give the
     distance and the own-edge verdict of BRepExtrema_DistShapeShape of the whole face (to
     1e-12 mm), for random vertical segments about every curved face of the part."""
-    from OCP.BRepExtrema import BRepExtrema_IsInFace   # noqa: PLC0415
+    from OCP.BRepExtrema import BRepExtrema_IsInFace  # noqa: PLC0415
 
-    from cadcnc.guard.face_distance import FaceDistance   # noqa: PLC0415
+    from cadcnc.guard.face_distance import FaceDistance  # noqa: PLC0415
 
     part = cadcnc.load_step(FIXTURES / name)
     g = ClearanceGuard(part, pair, 3.0, 30.0)

@@ -15,6 +15,7 @@ from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeOffsetShape
 from OCP.GeomAbs import GeomAbs_Intersection
 
 import cadcnc
+from cadcnc.core.job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
 from cadcnc.geometry.part import Part
 from cadcnc.guard import guard as guard_module
 from cadcnc.guard.box_tree import BoxTree
@@ -22,8 +23,6 @@ from cadcnc.guard.cells import BOUNDED_KINDS
 from cadcnc.guard.clearance import ClearanceGuard
 from cadcnc.guard.face_distance import FaceDistance
 from cadcnc.io.program_json import program_json
-from cadcnc.core.job import DEFAULT_FEED, DEFAULT_PERIOD, Job, PairPath, Pencil, Tool
-
 from helpers.fixtures import FIXTURES
 
 

@@ -19,9 +19,7 @@ from cadcnc.guard.cells import FaceBoxes, HeightCells, bounded
 from cadcnc.guard.clearance import ClearanceGuard
 from cadcnc.guard.face_boxes import face_cells, normal_box
 from cadcnc.guard.guard import OperationGuard
-
 from helpers.face_cells import random_cell_boxes
-
 from helpers.fixtures import FIXTURES
 
 
@@ -60,7 +58,7 @@ def test_normal_box_contains_the_normal(offset_boss):
     surface = boxes.surface
     (u0, u1), (w0, w1) = f.u_range, f.w_range
     rng = np.random.default_rng(4)
-    from cadcnc.guard.face_boxes import _poles_2d   # noqa: PLC0415 - the test's own probe
+    from cadcnc.guard.face_boxes import _poles_2d  # noqa: PLC0415 - the test's own probe
     for _ in range(20):
         a, b = np.sort(rng.uniform(u0, u1, 2))
         c, d = np.sort(rng.uniform(w0, w1, 2))

@@ -18,7 +18,6 @@ import pytest
 from cadcnc.geometry import differential as dg
 from cadcnc.interp.cycle import Contact
 from cadcnc.interp.error_bounds import surface_curvatures
-
 from helpers.fixtures import load_fixture
 
 FIXTURES = ["bspline_boss", "torus_cone", "crossing_cylinders", "ellipse_pocket", "dome_pole"]

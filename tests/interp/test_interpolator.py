@@ -7,18 +7,23 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from helpers.fixtures import CONCAVE_PAIRS, load_fixture
 from OCP.BRep import BRep_Tool
 from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve, GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt
 
 import cadcnc
-from cadcnc.ops.path.pair_path import intersection_path, intersection_paths
-from cadcnc.interp.cycle import CLOSED, END
-from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for
-from cadcnc.interp.compiled import new_stepper
-from cadcnc.interp.stepper import Tangency
 from cadcnc.core.tolerances import DEFAULT
+from cadcnc.interp.compiled import new_stepper
+from cadcnc.interp.cycle import CLOSED, END
+from cadcnc.interp.stepper import Tangency
+from cadcnc.ops.path.pair_path import (
+    intersection_path,
+    intersection_paths,
+    pair_job,
+    plan_path,
+    stepper_for,
+)
+from helpers.fixtures import CONCAVE_PAIRS, load_fixture
 
 FEED, PERIOD = 1500.0, 0.004      # the paper's example: f = 0.1 mm
 R = 3.0

@@ -15,11 +15,11 @@ import dataclasses
 
 import numpy as np
 import pytest
-from helpers.fixtures import load_fixture
 
 from cadcnc.interp.error_bounds import pair_bounds
 from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for
 from cadcnc.program.toolpath import toolpath_from_record
+from helpers.fixtures import load_fixture
 
 CASES = [("bspline_boss", 4, 5), ("torus_cone", 1, 2), ("crossing_cylinders", 1, 2)]
 CURVATURES = ("k", "k_max", "k_min", "tau")

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers.fixtures import load_fixture
 
 from cadcnc.interp.compiled import CompiledStepper, new_stepper
 from cadcnc.interp.stepper import Stepper
 from cadcnc.ops.path.pair_path import pair_job, plan_path
+from helpers.fixtures import load_fixture
 from helpers.pinned import CASES, radius_for
 
 

@@ -33,17 +33,29 @@ from pathlib import Path
 import numba
 import numpy as np
 import pytest
+from OCP import GeomAbs
 from OCP.Bnd import Bnd_Box
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_NurbsConvert
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakeTorus
 from OCP.Geom import (
-    Geom_BezierCurve, Geom_BezierSurface, Geom_BSplineCurve, Geom_BSplineSurface,
-    Geom_Circle, Geom_CylindricalSurface, Geom_Ellipse, Geom_Hyperbola, Geom_Line,
-    Geom_OffsetSurface, Geom_Parabola, Geom_SphericalSurface, Geom_SurfaceOfLinearExtrusion,
-    Geom_SurfaceOfRevolution, Geom_ToroidalSurface, Geom_TrimmedCurve,
+    Geom_BezierCurve,
+    Geom_BezierSurface,
+    Geom_BSplineCurve,
+    Geom_BSplineSurface,
+    Geom_Circle,
+    Geom_CylindricalSurface,
+    Geom_Ellipse,
+    Geom_Hyperbola,
+    Geom_Line,
+    Geom_OffsetSurface,
+    Geom_Parabola,
+    Geom_SphericalSurface,
+    Geom_SurfaceOfLinearExtrusion,
+    Geom_SurfaceOfRevolution,
+    Geom_ToroidalSurface,
+    Geom_TrimmedCurve,
 )
-from OCP import GeomAbs
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
 from OCP.STEPControl import STEPControl_Reader
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt

@@ -6,13 +6,13 @@ import math
 
 import numpy as np
 import pytest
-from helpers.fixtures import load_fixture
 
+from cadcnc.interp.compiled import new_stepper
 from cadcnc.interp.cycle import BOUNDARY, COLLISION, STOP_REASONS
 from cadcnc.interp.landing import LANDING_TOL, MAX_TRIALS, land
-from cadcnc.interp.compiled import new_stepper
 from cadcnc.interp.stepper import Stepper
 from cadcnc.ops.path.pair_path import pair_job, plan_path
+from helpers.fixtures import load_fixture
 from helpers.pinned import CASES, radius_for
 
 F = 0.1  # mm: feed 1500 mm/min, period 4 ms

@@ -7,12 +7,12 @@ import math
 import cadquery as cq
 import numpy as np
 import pytest
-from helpers.fixtures import SIDECAR, load_fixture
 
 import cadcnc
 from cadcnc.core.errors import FacePairError, GeometryError, StartPointError
-from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.interp.cycle import BOUNDARY, CLOSED, CURVATURE, END, MAX_CYCLES, SINGULAR, TANGENT
+from cadcnc.ops.path.pair_path import intersection_path
+from helpers.fixtures import SIDECAR, load_fixture
 
 KW = dict(feed=1500.0, period=0.004)  # step 0.1 mm
 

@@ -8,14 +8,13 @@ import re
 import numpy as np
 import pytest
 
-from cadcnc.ops.path.pair_path import intersection_paths
 from cadcnc.io.gcode import DEFAULT_TOLERANCE, digits_for, programmed_points, simplify
 from cadcnc.io.program_gcode import to_ngc
-
-from cadcnc.testing.rs274 import DECIMALS as RS274_DECIMALS, feed_points
+from cadcnc.ops.path.pair_path import intersection_paths
+from cadcnc.testing.rs274 import DECIMALS as RS274_DECIMALS
+from cadcnc.testing.rs274 import feed_points
 from helpers.fixtures import fixture_path, load_fixture
 from helpers.marks import needs_rs274
-
 
 
 @pytest.fixture(scope="module")

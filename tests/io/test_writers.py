@@ -3,19 +3,23 @@
 from __future__ import annotations
 
 import json
-from dataclasses import fields
 
 import numpy as np
 import pytest
 
-from cadcnc.interp.error_bounds import SurfaceBounds
 from cadcnc.core.errors import InputError, OutputError
 from cadcnc.io import (
-    ARRAYS, CSV_COLUMNS, atomic_write, check_output, read_csv, read_json, toolpath_from_dict,
-    toolpath_to_dict, write_csv, write_json,
+    CSV_COLUMNS,
+    atomic_write,
+    check_output,
+    read_csv,
+    read_json,
+    toolpath_from_dict,
+    toolpath_to_dict,
+    write_csv,
+    write_json,
 )
 from cadcnc.io.program_gcode import write_ngc
-
 from helpers.fixtures import fixture_path
 from helpers.programs import assert_same_path
 

@@ -10,8 +10,8 @@ import pytest
 
 import cadcnc
 from cadcnc.core.errors import InputError
-from cadcnc.io.program_gcode import program_ngc, program_written_moves, segment_moves
 from cadcnc.core.job import Job, Pencil, Raster, Tool
+from cadcnc.io.program_gcode import program_ngc, program_written_moves, segment_moves
 from helpers.fixtures import FIXTURES
 
 pytestmark = pytest.mark.slow

@@ -11,21 +11,25 @@ OCCT's BRepExtrema (not by cadcnc's guard). Bad axes exit 2.
 from __future__ import annotations
 
 import json
-import re
-import shutil
-import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
-from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-from OCP.gp import gp_Pnt
 
-from cadcnc.testing.rs274 import RS274, moves as rs274_moves
+from cadcnc.testing.rs274 import RS274
+from cadcnc.testing.rs274 import moves as rs274_moves
 from helpers.cli import cadcnc_cli
-from helpers.six_pockets import (AXES, DIGITS, FACTS, GOUGE, R, SHANK, STEP, distance,
-                                 face_distance, written_transform)
+from helpers.six_pockets import (
+    AXES,
+    DIGITS,
+    FACTS,
+    GOUGE,
+    SHANK,
+    STEP,
+    R,
+    distance,
+    face_distance,
+    written_transform,
+)
 
 
 @pytest.fixture(scope="module")

@@ -15,10 +15,21 @@ import json
 import numpy as np
 import pytest
 
-from cadcnc.testing.rs274 import RS274, moves as rs274_moves
+from cadcnc.testing.rs274 import RS274
+from cadcnc.testing.rs274 import moves as rs274_moves
 from helpers.cli import cadcnc_cli
-from helpers.six_pockets import (AXES, DIGITS, FACTS, GOUGE, R, SHANK, STEP, distance,
-                                 face_distance, written_transform)
+from helpers.six_pockets import (
+    AXES,
+    DIGITS,
+    FACTS,
+    GOUGE,
+    SHANK,
+    STEP,
+    R,
+    distance,
+    face_distance,
+    written_transform,
+)
 
 pytestmark = pytest.mark.slow  # about 48 s of CPU: a quarter of the fast tier
 

@@ -14,16 +14,16 @@ import re
 import numpy as np
 import pytest
 
-from cadcnc.testing.coverage_oracle import Oracle, read_shape
-from cadcnc.testing.tool_sweeps import TOL, entries_at, entry_exists, links_check
 import cadcnc
 from cadcnc.core.errors import EXIT_GOUGE, EXIT_NOTHING, EXIT_OK
 from cadcnc.core.job import Job, PairPath, Tool
 from cadcnc.ops.common import safe_height
+from cadcnc.pipeline.exit_policy import judge
 from cadcnc.program.linking import linked
 from cadcnc.program.program import Program
 from cadcnc.program.toolpath import toolpath_piece
-from cadcnc.pipeline.exit_policy import judge
+from cadcnc.testing.coverage_oracle import Oracle, read_shape
+from cadcnc.testing.tool_sweeps import TOL, entries_at, entry_exists, links_check
 from helpers.cli import cadcnc_cli
 from helpers.fixtures import FIXTURES, fixture_path
 

@@ -10,9 +10,9 @@ import pytest
 
 import cadcnc
 from cadcnc.guard.moves import MoveClearance
+from cadcnc.ops.finish.plan import centre_chord, plan_planes, sample_faces
 from cadcnc.ops.finish.raster import plan_for_job
 from cadcnc.ops.finish.shortcut import finish
-from cadcnc.ops.finish.plan import centre_chord, plan_planes, sample_faces
 from cadcnc.ops.finish.uncut import uncut_report
 from cadcnc.verification import gate_program
 from cadcnc.verification.probe import shape_distances

@@ -18,15 +18,14 @@ import pytest
 
 import cadcnc
 from cadcnc.core.errors import InputError
-from cadcnc.core.job import Raster, Job, Tool
+from cadcnc.core.job import Job, Raster, Tool
+from cadcnc.core.work_limits import HEARTBEAT_S, MAX_PLANES, WorkLimitError
 from cadcnc.ops.finish.check import planned_intervals
-from cadcnc.ops.finish.raster import raster_program
+from cadcnc.ops.finish.pass_setup import pass_setup
 from cadcnc.ops.finish.passes import GuidePlane, _Pass
 from cadcnc.ops.finish.plan import centre_chord
-from cadcnc.ops.finish.pass_setup import pass_setup
+from cadcnc.ops.finish.raster import raster_program
 from cadcnc.program.program import FAILED, STOPPED_SHORT
-from cadcnc.core.work_limits import HEARTBEAT_S, MAX_PLANES, WorkLimitError
-
 from helpers.fixtures import FIXTURES
 
 pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
@@ -111,7 +110,8 @@ def test_wall_crossings_at_one_s_are_ordered_by_height():
 def horizontal_cylinder():
     """A block 40 x 30 x 10 with a cylinder r 5, axis along Y at z 13, fused on its top
     (its face wraps under the equator down to the block: an underside on both sides)."""
-    import cadquery as cq   # only this test builds a part (about 3 s to import)
+    import cadquery as cq  # only this test builds a part (about 3 s to import)
+
     from cadcnc.geometry.part import Part
 
     base = cq.Workplane().box(40, 30, 10, centered=(True, True, False)).val()

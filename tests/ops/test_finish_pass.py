@@ -14,19 +14,18 @@ import pytest
 from OCP.BRep import BRep_Builder
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+from OCP.gp import gp_Pnt
 from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS_Compound
-from OCP.gp import gp_Pnt
 
 import cadcnc
-from cadcnc.interp.cycle import COLLISION
 from cadcnc.core.job import Job, PairPath, Tool
+from cadcnc.interp.cycle import COLLISION
 from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
 from cadcnc.verification.probe import FaceProbe
 from cadcnc.verification.surface_checks import check_surface
 from cadcnc.verification.whole_part import check_whole_part
-
 from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "finish_fixtures.json").read_text())

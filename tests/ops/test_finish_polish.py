@@ -6,7 +6,6 @@ import numpy as np
 
 import cadcnc
 from cadcnc.ops.finish.polish import face_derivatives
-
 from helpers.fixtures import FIXTURES
 
 

@@ -16,14 +16,13 @@ import pytest
 import cadcnc
 import cadcnc.ops.finish.crossings as crossings_module
 import cadcnc.ops.finish.passes as pass_module
-from cadcnc.core.job import Raster, Job, PairPath, Tool
+from cadcnc.core.job import Job, PairPath, Raster, Tool
+from cadcnc.ops.finish.check import pass_problems
+from cadcnc.ops.finish.pass_setup import pass_setup
+from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
 from cadcnc.ops.finish.raster import plan_for_job
 from cadcnc.ops.finish.shortcut import finish
-from cadcnc.ops.finish.check import pass_problems
-from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
-from cadcnc.ops.finish.pass_setup import pass_setup
 from cadcnc.program.program import FAILED, CutSegment
-
 from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "finish_fixtures.json").read_text())

@@ -7,7 +7,7 @@ import pytest
 
 import cadcnc
 from cadcnc.io.program_cq import to_cq
-from cadcnc.ops.path.pair_program import CLIMB, climb_measure
+from cadcnc.ops.path.pair_program import climb_measure
 from cadcnc.verification import gouge_gate
 from helpers.fixtures import FIXTURES, load_fixture
 from helpers.programs import pencil_run
@@ -153,9 +153,9 @@ def test_the_guard_keeps_own_face_edges_within_the_written_programs_allowance():
     the gouge limit less G64 P (blend_for) and the G-code's rounding (tolerance / 10, the
     rule of digits_for): every operation's guard (pencil's, path's) must stop the ball inside that, with room for the
     chords between points; third faces keep the 1 nm rule."""
-    from cadcnc.io.gcode import DEFAULT_TOLERANCE, blend_for, digits_for
     from cadcnc.core.job import Job, PairPath, Tool
     from cadcnc.guard import guard_for
+    from cadcnc.io.gcode import DEFAULT_TOLERANCE, blend_for, digits_for
 
     part = load_fixture("pocket")
     job = Job(Tool(3.0, 0.0), 1500.0, 0.004, PairPath(faces=(9, 12), edge=0))

@@ -13,17 +13,17 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.testing.moves_judge import polyline_depths
 from cadcnc.core.errors import EXIT_NOTHING, InputError, NothingToCutError
 from cadcnc.core.job import Job, PairPath, Pencil, Tool
+from cadcnc.core.tolerances import DEFAULT
+from cadcnc.core.work_limits import HEARTBEAT_S, WorkLimitError
+from cadcnc.ops.common import safe_height
 from cadcnc.ops.path.pair_path import plan_path
 from cadcnc.ops.path.pair_program import program_for_job, stretch_cuts
 from cadcnc.ops.path.stretches import EdgeStretches, Limit, Stretch, too_tight
 from cadcnc.ops.pencil.pencil_program import pencil_program
-from cadcnc.ops.common import safe_height
-from cadcnc.core.tolerances import DEFAULT
 from cadcnc.pipeline.exit_policy import judge, settle
-from cadcnc.core.work_limits import HEARTBEAT_S, WorkLimitError
+from cadcnc.testing.moves_judge import polyline_depths
 
 _parts: dict = {}
 
@@ -35,7 +35,7 @@ def l_part(length: float = 10.0, sliver: float | None = None):
     concave edge ``sliver`` mm long."""
     key = (length, sliver)
     if key not in _parts:
-        import cadquery as cq   # ~3 s: only the tests that build a part pay it
+        import cadquery as cq  # ~3 s: only the tests that build a part pay it
 
         a = cq.Workplane().box(20, length, 5, centered=False)
         b = cq.Workplane().box(8, length, 5, centered=False).translate((0, 0, 5))

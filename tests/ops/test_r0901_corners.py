@@ -27,13 +27,11 @@ import numpy as np
 import pytest
 
 import cadcnc
+from cadcnc.core.tolerances import DEFAULT
 from cadcnc.geometry.setup import job_setup, setup_part
 from cadcnc.interp.cycle import Contact
 from cadcnc.ops.path.stretches import TANGENT, pair_stretches
-from cadcnc.core.tolerances import DEFAULT
-
 from cadcnc.testing.occt import occt_distance as distance
-
 from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "r0901_corners.json").read_text())

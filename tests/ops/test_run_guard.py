@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from cadcnc.interp.cycle import COLLISION
-from cadcnc.ops.path.pair_path import pair_job, plan_path
 from cadcnc.ops.common import run_stretch
+from cadcnc.ops.path.pair_path import pair_job, plan_path
 from helpers.fixtures import SIDECAR, load_fixture
 
 

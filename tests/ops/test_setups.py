@@ -40,8 +40,9 @@ def box(x0, y0, z0, x1, y1, z1):
 @pytest.fixture(scope="module")
 def shared_corner(tmp_path_factory):
     """(part, floor, wall, STEP path) of the part of the module doc."""
-    import cadcnc
     import cadquery as cq
+
+    import cadcnc
 
     shape = (box(0, 0, 0, 40, 30, 10).union(box(0, 0, 10, 20, 30, 20))
              .union(box(20, 0, 10, 40, 2, 20)).union(box(20, 28, 10, 40, 30, 20))

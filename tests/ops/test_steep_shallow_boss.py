@@ -21,9 +21,9 @@ import pytest
 from scipy.spatial import cKDTree
 
 import cadcnc
-from cadcnc.core.job import Raster, Job, Tool
-from cadcnc.ops.finish.raster import plan_for_job
+from cadcnc.core.job import Job, Raster, Tool
 from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
+from cadcnc.ops.finish.raster import plan_for_job
 from cadcnc.program.program import FAILED
 from helpers.fixtures import FIXTURES
 

@@ -24,9 +24,7 @@ from cadcnc.geometry.setup import setup_in, setup_part
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.stretch_split import split_at_stop
 from cadcnc.ops.path.stretches import pair_stretches
-
 from cadcnc.testing.occt import occt_distance as distance
-
 from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "grazed_hole.json").read_text())

@@ -18,12 +18,11 @@ import pytest
 
 import cadcnc
 from cadcnc.core.errors import EXIT_NOTHING, NothingToCutError
-from cadcnc.guard import guard_for
 from cadcnc.core.job import Tool
+from cadcnc.guard import guard_for
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.stretch_paths import nearest_start, stretch_paths
 from cadcnc.ops.path.stretches import COLLISION, REASONS, Feasibility, pair_stretches
-
 from helpers.fixtures import FIXTURES
 
 SIDECAR = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
@@ -174,7 +173,7 @@ class _Window:
 
 
 def test_a_stretch_across_the_seam_of_a_closed_edge_is_one_stretch():
-    from cadcnc.ops.path.stretches import _refine, _stretches, EdgeStretches
+    from cadcnc.ops.path.stretches import EdgeStretches, _refine, _stretches
 
     curve, feas = _Circle(), _Window()
     grid = np.arange(0.0, 10.0, 0.2)

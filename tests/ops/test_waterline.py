@@ -12,14 +12,14 @@ import pytest
 
 import cadcnc
 from cadcnc.core.errors import InputError
-from cadcnc.geometry.offset_section import loop_count, offset_face
 from cadcnc.core.job import Job, SteepShallow, Tool, Waterline, finishing
+from cadcnc.core.work_limits import WorkLimitError
+from cadcnc.geometry.offset_section import loop_count, offset_face
 from cadcnc.ops.finish.levels import CRITICAL_MM, critical_heights, plan_levels
 from cadcnc.ops.finish.loops import level_cuts
-from cadcnc.ops.finish.plan import sample_faces
 from cadcnc.ops.finish.pass_setup import pass_setup
+from cadcnc.ops.finish.plan import sample_faces
 from cadcnc.verification.probe import shape_distances
-from cadcnc.core.work_limits import WorkLimitError
 from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "waterline_fixtures.json").read_text())

@@ -12,10 +12,7 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
-
 import cadcnc
-
 from helpers.fixtures import FIXTURES
 
 FACTS = json.loads((FIXTURES / "entry_fixtures.json").read_text())["entry_side"]

@@ -18,7 +18,6 @@ import cadcnc
 from cadcnc.core.job import Job, Pencil, Tool
 from cadcnc.ops.pencil import pencil_program
 from cadcnc.program.linking import TWO_OPT_MAX, order_cuts
-
 from helpers.fixtures import FIXTURES
 
 

@@ -129,7 +129,8 @@ def test_rs274_reads_the_program_moves(two_cuts, tmp_path):
     import subprocess
 
     from cadcnc.io.program_gcode import program_ngc
-    from cadcnc.testing.rs274 import DECIMALS as RS274_DECIMALS, RS274
+    from cadcnc.testing.rs274 import DECIMALS as RS274_DECIMALS
+    from cadcnc.testing.rs274 import RS274
 
     if RS274 is None:
         pytest.skip("LinuxCNC rs274 not installed")

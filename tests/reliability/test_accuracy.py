@@ -24,13 +24,11 @@ from OCP.GeomLProp import GeomLProp_SLProps
 from OCP.gp import gp_Pnt
 
 import cadcnc
-from cadcnc.ops.path.pair_path import intersection_path
-from cadcnc.interp.cycle import CLOSED, CURVATURE, DIVERGED, END, paper_inverse_ratio, track
-from cadcnc.interp.compiled import new_stepper
 from cadcnc.core.job import MIN_STEP, Job, PairPath, Tool
-from cadcnc.ops.path.pair_path import pair_job, plan_path, stepper_for
 from cadcnc.core.tolerances import DEFAULT
-
+from cadcnc.interp.compiled import new_stepper
+from cadcnc.interp.cycle import CLOSED, CURVATURE, DIVERGED, END, paper_inverse_ratio, track
+from cadcnc.ops.path.pair_path import intersection_path, pair_job, plan_path, stepper_for
 from helpers.fixtures import FIXTURES, load_fixture
 
 ACC = DEFAULT.accuracy   # 1e-3 mm

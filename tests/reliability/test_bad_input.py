@@ -8,18 +8,15 @@ from __future__ import annotations
 
 import json
 import os
-import stat
 
 import numpy as np
 import pytest
 
 import cadcnc
 from cadcnc.core.errors import FaceNumberError, StepFileError
-from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.core.job import Job, PairPath, Tool
-
+from cadcnc.ops.path.pair_path import intersection_path
 from helpers.cli import cadcnc_cli
-
 from helpers.fixtures import FIXTURES, load_fixture
 
 BOSS = FIXTURES / "bspline_boss.step"

@@ -16,12 +16,11 @@ from pathlib import Path
 import pytest
 
 import cadcnc
+from cadcnc.core.errors import InputError
+from cadcnc.core.job import Job, PairPath, Pencil, Raster, Tool
+from cadcnc.core.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT
 from cadcnc.io.program_cq import to_cq
 from cadcnc.verification import gouge_gate, verify
-from cadcnc.core.errors import InputError
-from cadcnc.core.job import Raster, Job, PairPath, Pencil, Tool
-from cadcnc.core.tolerances import BOUNDS, CHORD_TOLERANCE_MAX, DEFAULT
-
 from helpers.cli import cadcnc_cli
 from helpers.fixtures import FIXTURES
 from helpers.programs import pencil_run

@@ -25,15 +25,14 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import cadcnc
-from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.core.errors import CadcncError
 from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_gcode import to_ngc
-from cadcnc.verification import gouge_gate
-
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.testing.moves_judge import polyline_depths
-from helpers.fixtures import FIXTURES, load_fixture
 from cadcnc.testing.rs274 import feed_points
+from cadcnc.verification import gouge_gate
+from helpers.fixtures import FIXTURES, load_fixture
 
 pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)
 

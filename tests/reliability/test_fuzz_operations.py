@@ -18,7 +18,6 @@ from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 import cadcnc
-
 from benchmarks.reliability.fuzz_operations import CASES, judged, trial_args
 from helpers.cli import cadcnc_cli
 from helpers.fixtures import FIXTURES

@@ -13,7 +13,6 @@ import pytest
 
 import cadcnc
 from benchmarks.reliability.fuzz_stream import PROGRAMS, draw, judged, write_programs
-
 from helpers.fixtures import FIXTURES
 
 SEEDS = (0, 1, 2, 3, 5, 6)   # seed 4 (20 us, 47 s) left to the benchmark

@@ -25,19 +25,16 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.core.errors import InputError
+from cadcnc.core.tolerances import DEFAULT, Tolerances
 from cadcnc.io.gcode import programmed_moves
 from cadcnc.io.program_gcode import to_ngc
-from cadcnc.core.tolerances import DEFAULT, Tolerances
-from cadcnc.verification import gouge_gate, verify
-from cadcnc.verification import whole_part
+from cadcnc.ops.path.pair_path import intersection_path
+from cadcnc.verification import gouge_gate, verify, whole_part
 from cadcnc.verification.bounds import point_box_distance, segment_lower_bound
 from cadcnc.verification.material import IN, OUT, Material, PartFaces
 from cadcnc.verification.probe import FaceProbe
-
 from helpers.cli import BOSS_JOB, cadcnc_cli
-
 from helpers.fixtures import FIXTURES, fixture_path, load_fixture
 
 pytestmark = pytest.mark.slow  # over about 5 s a test (pyproject.toml)

@@ -16,7 +16,6 @@ import time
 import pytest
 
 from helpers.cli import cadcnc_cli
-
 from helpers.fixtures import FIXTURES
 
 BOSS = FIXTURES / "bspline_boss.step"

@@ -17,11 +17,16 @@ import dataclasses
 
 import numpy as np
 import pytest
+from OCP.GeomAbs import (
+    GeomAbs_BSplineSurface,
+    GeomAbs_Cylinder,
+    GeomAbs_Sphere,
+    GeomAbs_SurfaceOfExtrusion,
+    GeomAbs_Torus,
+)
 
 import cadcnc
-from OCP.GeomAbs import (GeomAbs_BSplineSurface, GeomAbs_Cylinder, GeomAbs_Sphere,
-                         GeomAbs_SurfaceOfExtrusion, GeomAbs_Torus)
-from cadcnc.core.job import Raster, Job, Tool
+from cadcnc.core.job import Job, Raster, Tool
 from cadcnc.program.program import CutSegment, Program
 from cadcnc.verification import gate_program
 from cadcnc.verification.gate_cache import shared_gates
@@ -30,7 +35,6 @@ from cadcnc.verification.probe import FaceProbe
 from cadcnc.verification.whole_part import _match, window_match
 from helpers.fixtures import FIXTURES
 from helpers.gate_results import DEPTH, same
-
 
 
 def _load(name: str):

@@ -22,13 +22,12 @@ from OCP.BRepTopAdaptor import BRepTopAdaptor_FClass2d
 from OCP.gp import gp_Pnt2d
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_IN
 from OCP.TopExp import TopExp
-from OCP.TopTools import TopTools_IndexedMapOfShape
 from OCP.TopoDS import TopoDS
+from OCP.TopTools import TopTools_IndexedMapOfShape
 
 import cadcnc
 from cadcnc.core.trim_labels import INSIDE
 from cadcnc.verification.probe import INNER_MARGIN, FaceProbe, project_on_curve
-
 from helpers.fixtures import FIXTURES
 
 PARTS = ["finish_slab", "bspline_boss", "finish_boss", "r0901_fillet"]

@@ -23,12 +23,19 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.core.tolerances import Tolerances
 from cadcnc.core.trim_labels import TRIM_STATES
+from cadcnc.ops.path.pair_path import intersection_path
 from cadcnc.verification import (
-    FeedCheck, GateResult, StopCheck, TheoryRow, VerificationReport, WholePartCheck,
-    WholePartHit, gouge_gate, verify,
+    FeedCheck,
+    GateResult,
+    StopCheck,
+    TheoryRow,
+    VerificationReport,
+    WholePartCheck,
+    WholePartHit,
+    gouge_gate,
+    verify,
 )
 from cadcnc.verification.probe import FaceProbe
 from helpers.fixtures import CONCAVE_PAIRS, FIXTURES, fixture_path, load_fixture

@@ -20,9 +20,8 @@ from pathlib import Path
 import pytest
 
 import cadcnc
-from cadcnc.core.errors import EXIT_INTERNAL, EXIT_INTERRUPTED
+from cadcnc.core.errors import EXIT_INTERNAL, EXIT_INTERRUPTED, InputError
 from cadcnc.geometry.part_bytes import part_blob, part_from_blob
-from cadcnc.core.errors import InputError
 from cadcnc.parallel.pool import START_ENV, WorkerError, map_ordered, start_method
 from helpers.cli import cadcnc_cli
 from helpers.fixtures import FIXTURES

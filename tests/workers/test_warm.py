@@ -4,10 +4,10 @@ nothing afresh."""
 
 from __future__ import annotations
 
-import pytest
-
 import subprocess
 import sys
+
+import pytest
 
 pytestmark = pytest.mark.slow  # two subprocesses that start and warm workers: about 26 s
 

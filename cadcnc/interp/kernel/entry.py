@@ -12,8 +12,17 @@ import numpy as np
 
 from .layout import ARG_U, ARG_W, C1, C2, CYCLES, MARGIN
 from .step import (
-    DONE, MAX_CYCLES, RECORD_FULL, commit_kept, commit_trial, keep, move_to, state_margin, step,
-    trial, write_row,
+    DONE,
+    MAX_CYCLES,
+    RECORD_FULL,
+    commit_kept,
+    commit_trial,
+    keep,
+    move_to,
+    state_margin,
+    step,
+    trial,
+    write_row,
 )
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)

@@ -50,8 +50,7 @@ import numba
 import numpy as np
 
 from .analytic import elementary
-from .bspline import (BASIS_SCRATCH, MAX_DEGREE, near_knot, normalize_periodic,
-                      surface_derivatives)
+from .bspline import BASIS_SCRATCH, MAX_DEGREE, near_knot, normalize_periodic, surface_derivatives
 from .swept import UNSUPPORTED, extrusion, revolution
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)

@@ -26,7 +26,7 @@ import math
 import numba
 import numpy as np
 
-from .layout import CYCLES, P, TRAVELLED
+from .layout import CYCLES, TRAVELLED, P
 from .step import DONE, MAX_CYCLES, RECORD_FULL, step
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)

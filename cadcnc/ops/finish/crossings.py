@@ -35,8 +35,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from ...geometry.face_surface import FaceSurface
 from ...geometry.face_edges import BoundaryEdge, boundary_edges
+from ...geometry.face_surface import FaceSurface
 from ...interp.cycle import Contact, inverse_exact
 from ...interp.vec3 import add, cross, dot, norm
 

@@ -34,8 +34,8 @@ import numpy as np
 
 from ...core.errors import InputError
 from ...core.work_limits import MAX_PLANES, refuse_over
-from .polish import face_derivatives
 from .plan import FaceSamples, across, adaptive_offsets, centre_chord, planes_estimate
+from .polish import face_derivatives
 from .slope import strip_pairs
 
 FLAT_DEG = 5.0

@@ -31,16 +31,16 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...core.errors import CadcncError
-from ...geometry.offset_section import SectionWire, section_wires
-from ...interp.cycle import BOUNDARY, CLOSED, COLLISION, END
-from ...interp.compiled import new_stepper
-from ...interp.stepper import Tangency
 from ...core.job import Job, PairPath
+from ...geometry.offset_section import SectionWire, section_wires
+from ...interp.compiled import new_stepper
+from ...interp.cycle import BOUNDARY, CLOSED, COLLISION, END
+from ...interp.stepper import Tangency
 from ...program.program import FAILED, STOPPED_SHORT, CutSegment, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
+from .pass_setup import PassSetup, guide_face
 from .polish import polish
 from .resume import PASS_CYCLES, clear_again, free_run, last_state, xyz
-from .pass_setup import PassSetup, guide_face
 
 Z = np.array([0.0, 0.0, 1.0])
 X = np.array([1.0, 0.0, 0.0])

@@ -14,12 +14,12 @@ from typing import Sequence
 import numpy as np
 
 from ...core.errors import InputError
+from ...core.job import Job
 from ...geometry.face_surface import FaceSurface
 from ...geometry.guide_plane import plane_surface
 from ...geometry.part import Part
-from ...core.job import Job
-from .crossings import FaceEdges
 from ...guard import FINISH_OWN_SHARE, guard_for
+from .crossings import FaceEdges
 
 GUIDE_MARGIN = 10.0  # mm beyond the part's bounding box: the guide face's half size
 

@@ -33,11 +33,11 @@ from typing import Sequence
 import numpy as np
 
 from ...core.errors import CadcncError, GeometryError
-from ...geometry.part import Part
-from ...interp.cycle import BOUNDARY, COLLISION, END
-from ...interp.compiled import new_stepper
-from ...interp.stepper import Tangency
 from ...core.job import Job, PairPath
+from ...geometry.part import Part
+from ...interp.compiled import new_stepper
+from ...interp.cycle import BOUNDARY, COLLISION, END
+from ...interp.stepper import Tangency
 from ...program.program import FAILED, STOPPED_SHORT, CutSegment, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
 from .check import along_pass, pass_problems

@@ -25,15 +25,15 @@ from ...core.job import Job
 from ...core.progress import Progress
 from ...core.work_limits import MAX_PLANES, Heartbeat
 from ...geometry.part import Part
-from ...program.program import CutSegment, Program, Skipped
 from ...parallel.pool import check_jobs
+from ...parallel.tasks import on_workers
+from ...program.program import CutSegment, Program, Skipped
 from ..common import FINISH_JOIN as JOIN
 from ..common import safe_height
 from ..entries import entered_program_segments
-from ...parallel.tasks import on_workers
+from .pass_setup import pass_setup
 from .passes import GuidePlane, PassResult, pass_cuts
 from .plan import MAX_SAMPLES, centre_chord, plan_planes, sample_faces
-from .pass_setup import pass_setup
 from .uncut import uncut_report
 from .waterline import stay_down_links
 

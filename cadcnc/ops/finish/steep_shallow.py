@@ -27,11 +27,11 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ...geometry.part import Part
 from ...core.job import Job
 from ...core.progress import Progress
-from ...program.program import CutSegment, Program
 from ...core.work_limits import MAX_PLANES
+from ...geometry.part import Part
+from ...program.program import CutSegment, Program
 from .plan import FaceSamples, plan_planes
 from .raster import raster_program
 from .uncut import UncutReport, uncut_report

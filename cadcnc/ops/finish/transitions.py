@@ -28,11 +28,11 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ...core.errors import StartPointError
+from ...core.job import PairPath
 from ...geometry.part import CONCAVE, CONVEX, TANGENT
 from ...interp.cycle import END
 from ...interp.stepper import Tangency
 from ...interp.tangency import solve_tangency
-from ...core.job import PairPath
 from ...program.toolpath import Toolpath
 from .check import along_pass
 from .crossings import ROOT_XTOL, Crossing

@@ -20,20 +20,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...core.job import Job
+from ...core.progress import Progress
+from ...core.work_limits import MAX_PLANES, Heartbeat
 from ...geometry.offset_section import offset_face
 from ...geometry.part import Part
 from ...guard.stay_down import StayDown
-from ...core.job import Job
-from ...core.progress import Progress
 from ...program.program import CutSegment, Program, Skipped
-from ...core.work_limits import MAX_PLANES, Heartbeat
 from ..common import FINISH_JOIN as JOIN
 from ..common import safe_height
 from ..entries import entered_program_segments
 from .levels import CRITICAL_MM, LevelPlan, check_stepdown, critical_heights, plan_levels
 from .loops import level_cuts
-from .plan import MAX_SAMPLES, FaceSamples, centre_chord, sample_faces
 from .pass_setup import pass_setup
+from .plan import MAX_SAMPLES, FaceSamples, centre_chord, sample_faces
 from .uncut import uncut_report
 
 SAMPLES_PER_SPACING = 4

@@ -13,14 +13,14 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ...core.errors import FacePairError, GeometryError, InputError, StartPointError
+from ...core.job import Job, PairPath, Tool
+from ...core.progress import Progress, cycles_progress
+from ...core.tolerances import DEFAULT, Tolerances
 from ...geometry.face_surface import FaceSurface
 from ...geometry.part import CONCAVE
 from ...interp.compiled import new_stepper
 from ...interp.stepper import Stepper, Tangency
 from ...interp.tangency import solve_tangency
-from ...core.job import Job, PairPath, Tool
-from ...core.progress import Progress, cycles_progress
-from ...core.tolerances import DEFAULT, Tolerances
 from ...program.toolpath import Toolpath, toolpath_from_record
 
 

@@ -23,15 +23,15 @@ from dataclasses import replace
 import numpy as np
 
 from ...core.errors import InputError, NothingToCutError, StartPointError
-from ...interp.cycle import BOUNDARY, COLLISION
-from ...interp.stepper import Tangency
 from ...core.job import Job
 from ...core.progress import Progress, cycles_progress
+from ...guard import guard_for
+from ...interp.cycle import BOUNDARY, COLLISION
+from ...interp.stepper import Tangency
 from ...program.program import STOPPED_SHORT, CutSegment, Program, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
 from ..common import require_ball, run_stretch, safe_height
 from ..entries import entered_program_segments
-from ...guard import guard_for
 from .pair_path import PathPlan, plan_path, shared_edge_for, stepper_for
 from .stretch_paths import nearest_start, plan_for_stretch, refuse_without_stretch
 from .stretch_split import split_at_stop

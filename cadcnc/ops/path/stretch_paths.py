@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...core.errors import NothingToCutError
-from ...guard.clearance import ClearanceGuard
 from ...core.job import Job
+from ...guard.clearance import ClearanceGuard
 from ...program.toolpath import Toolpath
 from .pair_path import PathPlan, run_plan
 from .stretches import EdgeStretches, Feasibility, Stretch, pair_stretches

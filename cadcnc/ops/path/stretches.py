@@ -35,15 +35,15 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ...core.errors import GeometryError, StartPointError
-from ...guard.clearance import ClearanceGuard
+from ...core.job import Job
+from ...core.tolerances import Tolerances
 from ...geometry.edge_curve import EdgeCurve
 from ...geometry.part import CONCAVE
+from ...guard import guard_for
+from ...guard.clearance import ClearanceGuard
 from ...interp.cycle import Contact
 from ...interp.stepper import Tangency
 from ...interp.tangency import solve_tangency
-from ...core.job import Job
-from ...core.tolerances import Tolerances
-from ...guard import guard_for
 from .centre_curve import polyline_length, travel_direction
 
 SPACING = 0.4       # mm of edge between samples (refined to MAX_CHORD of centres)

@@ -24,11 +24,11 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ...core.errors import GeometryError
+from ...core.job import Tool
+from ...core.tolerances import DEFAULT, Tolerances
 from ...geometry.blends import Blend, find_blends
 from ...geometry.part import CONCAVE, MIXED, TANGENT, Part
-from ...core.job import Tool
 from ...program.program import Skipped
-from ...core.tolerances import DEFAULT, Tolerances
 from ..path.stretches import too_tight
 
 EDGE, BLEND = "edge", "blend"

@@ -24,14 +24,14 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...core.errors import CadcncError, InputError, NothingToCutError
+from ...core.job import PRINCIPAL_AXES, Job, Pencil, axis_name
+from ...core.units import check_axis
 from ...geometry.edge_curve import EdgeCurve
 from ...geometry.part import CONCAVE, Part
 from ...geometry.setup import Setup, original_part, setup_in, setup_part
-from ...core.job import PRINCIPAL_AXES, Job, Pencil, axis_name
 from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program
 from ...program.transform import in_part_coordinates
-from ...core.units import check_axis
 from ..common import safe_height
 from ..entries import entered_program_segments
 from ..run import RunOptions, operation_of

@@ -24,23 +24,28 @@ import math
 import time
 from dataclasses import replace
 
-
 from ...core.errors import CadcncError
-from ...geometry.part import Part
 from ...core.job import Job, PairPath
 from ...core.progress import Progress
+from ...core.work_limits import MAX_CYCLES, Heartbeat, refuse_over
+from ...geometry.part import Part
+from ...guard import guard_for
+from ...parallel.tasks import on_workers
 from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program, Skipped
-from ...core.work_limits import MAX_CYCLES, Heartbeat, refuse_over
-from .corners import BLEND, EDGE, Corner, find_corners
-from ...guard import guard_for
 from ..common import refuse_cycles, require_ball, run_stretch, safe_height
 from ..entries import UNREACHABLE, entered_program_segments
-from ...parallel.tasks import on_workers
-from ..path.pair_program import stretch_cuts
 from ..path.pair_path import plan_path
-from ..path.stretches import (LIMIT_TOL, MIN_SAMPLES, SPACING, Feasibility,
-                              edge_stretches, pair_stretches)
+from ..path.pair_program import stretch_cuts
+from ..path.stretches import (
+    LIMIT_TOL,
+    MIN_SAMPLES,
+    SPACING,
+    Feasibility,
+    edge_stretches,
+    pair_stretches,
+)
+from .corners import BLEND, EDGE, Corner, find_corners
 
 CHAIN_GAP = 1e-3
 """mm: a cut starting this near another's end continues it (no lift)."""
