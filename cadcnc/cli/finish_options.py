@@ -32,9 +32,9 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
                          "guide planes, mm")
     spacing.add_argument("--scallop", metavar="H", help="largest scallop height, mm: the "
                          "planes' spacing follows the faces' curvature and slope")
-    p.add_argument("--angle", default="0", metavar="A",
+    p.add_argument("--angle", metavar="A",
                    help="direction of the passes, degrees from +X (default 0)")
-    p.add_argument("--pattern", choices=("zigzag", "oneway"), default="zigzag",
+    p.add_argument("--pattern", choices=("zigzag", "oneway"),
                    help="zigzag (default: every other pass reversed, staying down where the "
                         "move is verified clear) or oneway (every pass the same way, "
                         "retracting between)")
@@ -45,11 +45,11 @@ def add_parser(add, job_flip, gouge, gcode) -> None:
                    "docs/finish.md)")
     p.add_argument("--stepdown", metavar="D", help="waterline: distance between levels, mm "
                    "(or --scallop: the levels' spacing follows the walls' slope)")
-    p.add_argument("--threshold", default="45", metavar="A", help="steep-shallow: slope "
+    p.add_argument("--threshold", metavar="A", help="steep-shallow: slope "
                    "in degrees from horizontal above which waterline cuts (default 45)")
-    p.add_argument("--side", choices=("climb", "conventional"), default="climb",
+    p.add_argument("--side", choices=("climb", "conventional"),
                    help="waterline loops: climb (default) or conventional")
-    p.add_argument("--overlap", default="0", metavar="MM", help="steep-shallow: the "
+    p.add_argument("--overlap", metavar="MM", help="steep-shallow: the "
                    "regions overlap this much at their boundary, mm (default 0)")
     add_operation_options(p, "stock allowance left on the faces")
     job_flip(p)

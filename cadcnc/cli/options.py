@@ -91,15 +91,22 @@ def finish_job(args, source: str) -> Job:
     if all(v is None for v in spacing.values()):
         raise InputError("give --stepover S or --scallop H (raster), --stepdown D or "
                          "--scallop H (waterline): the passes' spacing")
+    given = {name: _degrees(args, name) for name in ("angle", "threshold")
+             if getattr(args, name) is not None}
+    given.update({name: getattr(args, name) for name in ("pattern", "side")
+                  if getattr(args, name) is not None})
+    if args.overlap is not None:
+        given["overlap"] = parse_length(args.overlap, "overlap")
+    return job_of(args, finishing(args.strategy, args.faces, own_only=True, **spacing,
+                                  **given), source)
+
+
+def _degrees(args, name: str) -> float:
+    """``--NAME`` in degrees, or InputError naming the option."""
     try:
-        angle, threshold = float(args.angle), float(args.threshold)
+        return float(getattr(args, name))
     except ValueError:
-        raise InputError(f"--angle, --threshold: expected degrees, got {args.angle!r}, "
-                         f"{args.threshold!r}") from None
-    return job_of(args, finishing(args.strategy, args.faces, angle=angle,
-                                  pattern=args.pattern, threshold=threshold, side=args.side,
-                                  overlap=parse_length(args.overlap, "overlap"), **spacing),
-                  source)
+        raise InputError(f"--{name}: expected degrees, got {getattr(args, name)!r}") from None
 
 
 BUILDERS = {"path": path_job, "pencil": pencil_job, "finish": finish_job}

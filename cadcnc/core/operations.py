@@ -314,11 +314,18 @@ OPERATIONS = (PairPath, Pencil, Raster, Waterline, SteepShallow)
 """Every operation record a Job may hold."""
 
 
-def finishing(strategy: str, faces, **given) -> Finishing:
+def _owners(name: str) -> str:
+    """The strategies whose record has the field ``name``, for a message."""
+    return " and ".join(s for s, kind in FINISHING.items()
+                        if name in {f.name for f in fields(kind)})
+
+
+def finishing(strategy: str, faces, *, own_only: bool = False, **given) -> Finishing:
     """The finishing record of ``strategy`` ("raster", "waterline", "steep-shallow") with
     ``given`` finishing fields (FINISH_FIELDS): a spacing the strategy has not (stepover,
-    scallop, stepdown) is refused, the other fields it has not are left out (the CLI and
-    an old program's JSON give every field)."""
+    scallop, stepdown) is refused; the other fields it has not are left out (an old
+    program's JSON gives every field), or, with ``own_only`` (what a user typed), refused
+    by name rather than dropped."""
     kind = FINISHING.get(strategy)
     if kind is None:
         raise InputError(f"strategy must be one of {', '.join(FINISHING)}, got "
@@ -327,6 +334,11 @@ def finishing(strategy: str, faces, **given) -> Finishing:
     if unknown:
         raise InputError(f"finishing has no field {', '.join(sorted(unknown))}")
     own = {f.name for f in fields(kind)}
+    foreign = sorted(k for k, v in given.items()
+                     if v is not None and k not in own and k not in SPACINGS)
+    if own_only and foreign:
+        raise InputError(f"{strategy} finishing takes no {', '.join(foreign)} (a setting "
+                         f"of {_owners(foreign[0])}); leave it out or change the strategy")
     if any(given.get(k) is not None for k in SPACINGS if k not in own):
         check_spacings(strategy, {k: given.get(k) for k in SPACINGS})
     return kind(faces, **{k: v for k, v in given.items() if k in own})

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import cadcnc
+from cadcnc.core.job import finishing
 from cadcnc.io.program_json import read_program
 from cadcnc.ops.finish import steep_shallow
 from cadcnc.testing.rs274 import move_points
@@ -68,6 +69,10 @@ def test_rs274_reads_the_waterline_program(boss_run, tmp_path):
     (["--strategy", "steep-shallow", "--scallop", "0.1", "--threshold", "95"], "threshold"),
     (["--strategy", "steep-shallow", "--scallop", "0.1", "--overlap", "-1"], "overlap"),
     (["--strategy", "waterline", "--stepdown", "1", "--stepover", "1"], "stepover"),
+    # a setting of another strategy is refused by name, not silently dropped
+    (["--strategy", "waterline", "--stepdown", "1", "--angle", "30"], "takes no angle"),
+    (["--stepover", "1", "--threshold", "50"], "takes no threshold"),
+    (["--stepover", "1", "--side", "conventional"], "takes no side"),
 ])
 def test_bad_levels_and_thresholds_write_nothing(tmp_path, args, words):
     out = tmp_path / "p.json"
@@ -102,3 +107,13 @@ def test_steep_shallow_is_one_program_with_one_uncut_report(monkeypatch):
     assert slope.min() > 45.0 - 15.0   # within the overlap of the steep region
     gate = cadcnc.gate_program(prog, part)
     assert gate.ok
+
+
+def test_an_old_program_file_with_every_field_still_reads():
+    """A program file written before the records split gives every finishing field: the
+    ones its strategy has not are left out, not refused."""
+    rec = finishing("waterline", (9,), stepdown=1.0, scallop=None, stepover=None, angle=0.0,
+                    pattern="zigzag", threshold=45.0, side="climb", overlap=0.0)
+    assert rec.strategy == "waterline" and rec.stepdown == 1.0
+    with pytest.raises(cadcnc.InputError, match="takes no angle"):
+        finishing("waterline", (9,), own_only=True, stepdown=1.0, angle=30.0)
