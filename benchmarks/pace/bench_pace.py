@@ -91,7 +91,7 @@ def run_case(name: str, path: str, job: Job) -> dict:
     part = cadcnc.load_step(path)
     seen, tick = stamps()
     program, out["compute_s"], out["compute_cpu_s"] = timed(
-        lambda: cadcnc.run(part, job, jobs=1, progress=tick))
+        lambda: cadcnc.run(part, job, processes=1, progress=tick))
     tasks = [b - a for a, b in zip(seen, seen[1:])]
     out["points"] = sum(len(c.points) for c in program.cuts)
     (_, ref, _, _), out["gate_ref_s"], out["gate_ref_cpu_s"] = timed(
@@ -109,7 +109,7 @@ def run_case(name: str, path: str, job: Job) -> dict:
     part2 = cadcnc.load_step(path)
     t0 = clock()
     with shared_gates(part2), kept_pools():
-        program2 = cadcnc.run(part2, job, jobs=2)
+        program2 = cadcnc.run(part2, job, processes=2)
         back2, _, gcode2, _ = gate(program2, part2, jobs=2, reference=False)
     out["jobs2_s"] = clock() - t0
     out["jobs1_s"] = out["compute_s"] + out["gate_s"]

@@ -53,7 +53,7 @@ def run_case(label: str, path: str, job, module, name: str, repeat: int,
     real = timed_stage(module, name, calls)
     try:
         part = cadcnc.load_step(path)
-        program = cadcnc.run(part, job, jobs=1)
+        program = cadcnc.run(part, job, processes=1)
     finally:
         setattr(module, name, real)
     text = render(program, "p.json", part, "")

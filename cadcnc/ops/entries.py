@@ -234,13 +234,13 @@ def _way(cut: CutSegment, v: Visit) -> str:
 
 def entered_program_segments(part, job: Job, cuts: list[CutSegment], z_safe: float,
                              join: float = 0.0, stay_down=None, order=None, tick=None,
-                             jobs: int | None = 1) -> tuple[list, list[Skipped], list[str]]:
+                             processes: int | None = 1) -> tuple[list, list[Skipped], list[str]]:
     """The segments of a program of ``cuts`` (each entered by the rule of the module doc,
     then ordered by ``order(items)`` when given, and linked), the cuts skipped, and the
-    note on entries (:func:`entered`, with ``tick``). ``jobs``: processes looking for
+    note on entries (:func:`entered`, with ``tick``). ``processes``: processes looking for
     the cuts' entries (None: every core); the answer does not depend on it."""
     access, plans = Access(part, job, z_safe), None
-    if check_jobs(jobs) > 1 and len(cuts) > 1:
+    if check_jobs(processes) > 1 and len(cuts) > 1:
         seen = [0]
 
         def told(_: int, _plan) -> None:
@@ -248,7 +248,7 @@ def entered_program_segments(part, job: Job, cuts: list[CutSegment], z_safe: flo
             if tick is not None:
                 tick(seen[0], len(cuts))
 
-        plans = on_workers(_plan_task, [(job, z_safe, cut) for cut in cuts], part, jobs,
+        plans = on_workers(_plan_task, [(job, z_safe, cut) for cut in cuts], part, processes,
                            told, "the entry of cut")
     items, skipped, notes = entered(cuts, access, tick, plans)
     if order is not None:

@@ -32,13 +32,13 @@ class RunOptions:
     the limits' refusals): ``progress`` (:data:`~cadcnc.core.progress.Progress`), ``times``
     (a dict given the seconds per stage, pencil), ``max_cycles`` (interpolation cycles a
     path or pencil program may need, refused up front over it), ``max_planes`` (finishing
-    planes or levels, likewise), ``jobs`` (processes; None: every core)."""
+    planes or levels, likewise), ``processes`` (worker processes; None: every core)."""
 
     progress: Progress | None = None
     times: dict | None = None
     max_cycles: int = MAX_CYCLES
     max_planes: int = MAX_PLANES
-    jobs: int | None = 1
+    processes: int | None = 1
 
 
 class Planner(Protocol):
@@ -77,24 +77,24 @@ def operation_of(job: Job) -> Operation:
 
 def run(part, job: Job, *, progress: Progress | None = None, times: dict | None = None,
         max_cycles: int = MAX_CYCLES, max_planes: int = MAX_PLANES,
-        jobs: int | None = 1) -> Program:
+        processes: int | None = 1) -> Program:
     """The :class:`~cadcnc.program.program.Program` of ``job`` on ``part`` (a
     :class:`~cadcnc.geometry.part.Part`, or a CadQuery Workplane or Shape), in the job's
     work coordinates: the pair's corner for a PairPath (every feasible stretch, cut and
     linked), every inner corner for a Pencil, the passes, levels or both for the finishing
-    records. The keywords are :class:`RunOptions`' (``jobs``: processes running pencil's
+    records. The keywords are :class:`RunOptions`' (``processes``: processes running pencil's
     corners and finishing's planes; the program is the same whatever it is). The program is
     not gated: see :func:`cadcnc.verification.gate_program`."""
     if not isinstance(job, Job):
         raise InputError(f"job must be a cadcnc.Job, got {type(job).__name__}")
     operation = operation_of(job)
-    start(jobs)   # the workers' server warms up while the part is read and planned
+    start(processes)   # the workers' server warms up while the part is read and planned
     if not isinstance(part, Part):
         part = Part.from_cadquery(part, job.tolerances)
     part = setup_part(part, job)   # the tool axis up: the program in work coordinates
     check_clearance(part, job)
     with kept_pools():   # one pool for the operation's stages (planes, corners, entries)
-        return operation.plan(part, job, RunOptions(progress, times, max_cycles, max_planes, jobs))
+        return operation.plan(part, job, RunOptions(progress, times, max_cycles, max_planes, processes))
 
 
 def cut_back_gap(job: Job) -> float | None:
@@ -122,7 +122,7 @@ def _pair(part: Part, job: Job, o: RunOptions) -> Program:
 
 def _pencil(part: Part, job: Job, o: RunOptions) -> Program:
     return pencil_program(part, job, progress=o.progress, times=o.times,
-                          max_cycles=o.max_cycles, jobs=o.jobs)
+                          max_cycles=o.max_cycles, processes=o.processes)
 
 
 # finishing's modules and scipy.optimize: about 0.5 s CPU a path or pencil doesn't pay,
@@ -131,7 +131,7 @@ def _raster(part: Part, job: Job, o: RunOptions) -> Program:
     from .finish.raster import raster_program  # noqa: PLC0415
 
     return raster_program(part, job, progress=o.progress, max_planes=o.max_planes,
-                          jobs=o.jobs)
+                          processes=o.processes)
 
 
 def _waterline(part: Part, job: Job, o: RunOptions) -> Program:

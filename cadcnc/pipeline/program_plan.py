@@ -15,4 +15,4 @@ def plan(part, job: Job, *, progress=None, times: dict | None = None,
     ``max_cycles``: the work limit; ``processes``: processes computing it (None: every
     core); the program does not depend on it."""
     return run(part, job, progress=progress, times=times, max_cycles=max_cycles,
-               jobs=processes)
+               processes=processes)

@@ -73,7 +73,7 @@ def run_setups(step, job: Job, setups, overlap: float, outputs, settings: Settin
         part.face(n)
     with kept_pools():   # each setup's part has its own workers
         result = pencil_setups(part, job, setups, overlap, progress=progress,
-                               max_cycles=settings.max_cycles, jobs=settings.processes)
+                               max_cycles=settings.max_cycles, processes=settings.processes)
     run = SetupsRun(result, seconds_computed=time.monotonic() - t0)
     codes = [] if asked == AUTO else _unreached(result, run.messages)
     contents = _judged(run, step, job, outputs, settings, codes, gate_progress)

@@ -60,5 +60,5 @@ def cut_back(program: Program, part, z_safe: float, join: float = 0.0, *,
     if not changed:
         return program
     segments, unreachable, _ = entered_program_segments(part, program.job, cuts, z_safe,
-                                                        join=join, jobs=jobs)
+                                                        join=join, processes=jobs)
     return Program(program.job, segments, skipped + unreachable, program.notes)

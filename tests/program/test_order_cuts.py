@@ -152,7 +152,7 @@ def test_the_same_order_on_a_real_pencil_program(monkeypatch):
     monkeypatch.setattr(pencil_program, "order_cuts", both)
     part = cadcnc.load_step(FIXTURES / "step_slot.step")
     program = cadcnc.run(part, Job(Tool(3.0, 0.0), 1500.0, 0.004, Pencil(None, "climb")),
-                         jobs=1)
+                         processes=1)
     assert program.cuts
     assert seen and all(ok for _, ok in seen), seen
     assert max(n for n, _ in seen) >= 2

@@ -1,5 +1,5 @@
 """Entries looked for on worker processes (issue 24): ``entered_program_segments`` with
-``jobs=2`` gives the very segments, skips and notes of ``jobs=1`` on the entry fixtures
+``processes=2`` gives the very segments, skips and notes of ``processes=1`` on the entry fixtures
 (fixtures/build_entry_fixtures.py): cuts entered at their start, at their end, between
 their ends, from the side, and one in a sealed void that no entry reaches."""
 
@@ -45,9 +45,9 @@ def test_entries_on_two_processes_are_those_of_one(name, monkeypatch):
     # the sealed corner's cut and the others twice: more cuts than workers
     cuts = cuts + cuts
     z = safe_height(part, job)
-    one = entered_program_segments(part, job, cuts, z, join=0.5, jobs=1)
+    one = entered_program_segments(part, job, cuts, z, join=0.5, processes=1)
     ticks: list = []
-    two = entered_program_segments(part, job, cuts, z, join=0.5, jobs=2,
+    two = entered_program_segments(part, job, cuts, z, join=0.5, processes=2,
                                    tick=lambda k, n: ticks.append((k, n)))
     assert len(one[0]) == len(two[0])
     assert len(one[1]) == (len(cuts) if name == "entry_sealed" else 0)

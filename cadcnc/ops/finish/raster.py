@@ -44,14 +44,14 @@ spacing of the scallop height)."""
 
 def raster_program(part: Part, job: Job, *, progress: Progress | None = None,
                    max_planes: int = MAX_PLANES, clock=time.monotonic,
-                   work: dict | None = None, jobs: int | None = 1) -> Program:
+                   work: dict | None = None, processes: int | None = 1) -> Program:
     """The program of a :class:`~cadcnc.core.job.Raster` ``job`` on ``part``:
     ``progress(done, total, what)`` after each plane, and inside a plane at least every
     HEARTBEAT_S seconds of ``clock`` (``done`` then counting the planes finished). The
     planes are estimated before any is placed and refused over ``max_planes``
     (:class:`~cadcnc.core.work_limits.WorkLimitError`, exit 2); the face samples are at most
     MAX_SAMPLES. ``work``: a dict given ``planes_estimate``, ``planes``,
-    ``samples_estimate``, ``samples`` and ``cycles`` (every stepper cycle run). ``jobs``:
+    ``samples_estimate``, ``samples`` and ``cycles`` (every stepper cycle run). ``processes``:
     processes running the planes (None: every core); the program does not depend on it
     (the heartbeat inside a plane is then only the planes' ends)."""
     op, pattern = job.operation, job.operation.pattern
@@ -73,16 +73,16 @@ def raster_program(part: Part, job: Job, *, progress: Progress | None = None,
         beat.beat(f"plane {done} at {plan.offsets[k]:.3f} mm", force=True)
 
     pass_setup(part, op.faces, job)  # the planes' guards, built before forked workers copy them
-    for res in on_workers(_plane, tasks, part, jobs, arrived, "plane", beat):
+    for res in on_workers(_plane, tasks, part, processes, arrived, "plane", beat):
         cuts += res.cuts
         skipped += res.skipped
         work["cycles"] += res.cycles
     stay_down = stay_down_links(part, job) if pattern == "zigzag" else None
     segments, unreachable, notes = entered_program_segments(
         part, job, cuts, safe_height(part, job), join=JOIN, stay_down=stay_down,
-        tick=lambda k, n: beat.beat(f"entries: {k} of {n} cuts"), jobs=jobs)
+        tick=lambda k, n: beat.beat(f"entries: {k} of {n} cuts"), processes=processes)
     program = Program(job, segments, skipped + unreachable, notes)
-    report = uncut_report(program, part, samples, plan, check_jobs(jobs))
+    report = uncut_report(program, part, samples, plan, check_jobs(processes))
     program.skipped += report.skipped()
     program.notes += report.notes()
     return program

@@ -107,10 +107,10 @@ def parse_setups(value) -> list[tuple[float, float, float]] | str:
 
 def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
                   progress=None, max_cycles: int | None = None,
-                  jobs: int | None = 1) -> SetupsResult:
+                  processes: int | None = 1) -> SetupsResult:
     """The fewest setups of ``job`` (a :class:`~cadcnc.core.job.Pencil` job) on ``part`` among
     ``setups`` (AUTO: the six principal axes; or a list of axes): module doc. ``overlap``:
-    mm of lap at a boundary with an earlier setup; ``jobs``: processes for each setup's
+    mm of lap at a boundary with an earlier setup; ``processes``: processes for each setup's
     corners (None: every core). Raises NothingToCutError when no candidate reaches
     anything."""
     if not isinstance(job.operation, Pencil):
@@ -123,7 +123,7 @@ def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
     samples = _positions(part, job)
     runs, keys = [], []
     extra = {} if max_cycles is None else {"max_cycles": max_cycles}
-    options = RunOptions(progress=progress, jobs=jobs, **extra)
+    options = RunOptions(progress=progress, processes=processes, **extra)
     for axis in axes:
         sub = replace(job, axis=axis, origin=None if axis != job.axis else job.origin)
         sp = setup_part(part, sub)

@@ -54,7 +54,7 @@ CHAIN_GAP = 1e-3
 def pencil_program(part: Part, job: Job, *, progress: Progress | None = None,
                    times: dict | None = None,
                    max_cycles: int = MAX_CYCLES, clock=time.monotonic,
-                   work: dict | None = None, jobs: int | None = 1) -> Program:
+                   work: dict | None = None, processes: int | None = 1) -> Program:
     """The pencil program of a :class:`~cadcnc.core.job.Pencil` ``job`` on ``part``.
 
     ``progress(done, total, what)`` after each corner, and within a corner at least every
@@ -67,7 +67,7 @@ def pencil_program(part: Part, job: Job, *, progress: Progress | None = None,
     (:func:`estimate_work`) and refused over ``max_cycles`` interpolation cycles or
     MAX_SAMPLES search samples (:class:`~cadcnc.core.work_limits.WorkLimitError`, exit 2); ``work``:
     a dict given the estimates and the counts (``cycles_estimate``, ``samples_estimate``,
-    ``cycles``: every stepper cycle run, re-runs included; ``samples``). ``jobs``:
+    ``cycles``: every stepper cycle run, re-runs included; ``samples``). ``processes``:
     processes cutting the corners, one pair's corners a task (None: every core); the
     program does not depend on it; ``times`` then adds the workers' seconds.
     """
@@ -101,12 +101,12 @@ def pencil_program(part: Part, job: Job, *, progress: Progress | None = None,
                 progress(done, len(todo), "faces {} {}".format(*todo[k].faces))
                 beat.last = beat.clock()
 
-    portable = (lambda c: c) if jobs == 1 else (lambda c: _rail_refs(part, c))
+    portable = (lambda c: c) if processes == 1 else (lambda c: _rail_refs(part, c))
     tasks = [(job, [(k, portable(todo[k])) for k in ks], max_cycles)
              for ks in groups.values()]
     sizes = [sum(todo[k].length + search_samples(todo[k].length, tool.offset, todo[k].closed)
                  for k in ks) for ks in groups.values()]   # the largest pairs first
-    for _, seconds, counts in on_workers(_pair_corners, tasks, part, jobs, arrived,
+    for _, seconds, counts in on_workers(_pair_corners, tasks, part, processes, arrived,
                                          "the corners of pair", beat, sizes):
         for name, t in seconds.items():
             stage.add(name, t)
@@ -119,7 +119,7 @@ def pencil_program(part: Part, job: Job, *, progress: Progress | None = None,
         segments, unreachable, notes = entered_program_segments(
             part, job, cuts, safe_height(part, job), join=CHAIN_GAP,
             order=lambda items: order_cuts(items, CHAIN_GAP),
-            tick=lambda k, n: beat.beat(f"linking: {k} of {n} cuts entered"), jobs=jobs)
+            tick=lambda k, n: beat.beat(f"linking: {k} of {n} cuts entered"), processes=processes)
     return Program(job, segments, skipped + unreachable, notes)
 
 
