@@ -111,15 +111,3 @@ def boss_cli_outputs(tmp_path_factory):
     run = cli.cadcnc_cli("path", fixtures.FIXTURES / "bspline_boss.step", *cli.BOSS_JOB,
                          "-o", d / "p.json", "-o", d / "p.csv", "-o", d / "p.ngc", check=0)
     return d, run
-
-
-def pencil_run(part, *, radius, faces=None, side="climb", feed=1500.0, axis="+Z", **options):
-    """The pencil program of ``part`` (a Part, Workplane or Shape) with a ball of
-    ``radius`` mm: ``cadcnc.run`` of a Pencil job (feed mm/min, period 4 ms)."""
-    import cadcnc
-
-    if not isinstance(part, cadcnc.Part):
-        part = cadcnc.Part.from_cadquery(part)
-    job = cadcnc.Job(cadcnc.Tool(radius), feed, 0.004, cadcnc.Pencil(faces, side),
-                     source=part.source, axis=axis)
-    return cadcnc.run(part, job, **options)
