@@ -248,7 +248,7 @@ class FeedPlan:
     @property
     def periods(self) -> int:
         """Periods to the end: the stream has periods + 1 positions (the start at t = 0)."""
-        return int(math.ceil(self.duration / self.machine.period - 1e-9))
+        return int(math.ceil(self.duration / self.machine.period - 1e-9))  # ceil's round-off
 
     def targets(self, max_periods: int = MAX_PERIODS) -> tuple[np.ndarray, np.ndarray]:
         """Per position n = 0..periods (time n Ts): the piece and the arc length in it."""

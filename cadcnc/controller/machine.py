@@ -29,6 +29,8 @@ DEFAULT_JERK_RAMP = 0.05
 MAX_VELOCITY = 1e6       # mm/s: 1 km/s
 MAX_ACCELERATION = 1e14  # mm/s^2
 MAX_JERK = 1e20          # mm/s^3
+MIN_PERIOD = 1e-6       # s: the shortest servo period accepted (1 us)
+MAX_PERIOD = 0.1        # s: the longest (100 ms)
 """The largest limits a Machine takes: far beyond any machine tool ("no limit" in a test
 is 1e6 mm/s, 1e14 mm/s², 1e20 mm/s³), and small enough that the planner's powers of them
 (v^3, A^2, J^2...) stay finite (1e308 overflowed)."""
@@ -69,7 +71,7 @@ class Machine:
     def __post_init__(self):
         p = self.period
         if (not isinstance(p, numbers.Real) or isinstance(p, bool) or not math.isfinite(p)
-                or not 1e-6 <= p <= 0.1):
+                or not MIN_PERIOD <= p <= MAX_PERIOD):
             raise InputError(f"machine period must be a number of seconds in [1e-6, 0.1] "
                              f"(1 us .. 100 ms), got {p!r}")
         object.__setattr__(self, "period", float(p))
@@ -186,7 +188,7 @@ def read_machine_ini(path, jerk: float | None = None, warn=None) -> Machine:
             raise InputError(f"{path}: [{section}] MAX_JERK is missing (LinuxCNC 2.9 has "
                              "none): give the jerk with --jerk MM/S3")
     try:
-        period = Machine(period_ns * 1e-9, (1.0,) * 3, (1.0,) * 3, (1.0,) * 3).period
+        period = Machine(period_ns * 1e-9, (1.0,) * 3, (1.0,) * 3, (1.0,) * 3).period  # ns -> s
     except InputError as e:
         raise InputError(f"{path}: [EMCMOT] SERVO_PERIOD = {period_ns:g} ns: {e}") from None
     try:

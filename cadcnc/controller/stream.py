@@ -21,6 +21,7 @@ import numpy as np
 
 from ..core.errors import GeometryError
 from ..core.progress import Progress
+from ..core.tolerances import STREAM_END
 from ..interp.cycle import CLOSED, END
 from ..interp.planned_follow import follow
 from ..program.program import Program
@@ -153,9 +154,10 @@ def _landed(stepper, piece: Piece, out: np.ndarray, what: str) -> np.ndarray:
     for _ in range(3):   # the rest of the cut lies between two periods: land on its end
         if stepper.stop_reason is not None:
             break
-        dp = stepper.step(float(np.linalg.norm(end - p)) * (1.0 + LANDING) * to_feed + 1e-9)
+        feed = float(np.linalg.norm(end - p)) * (1.0 + LANDING) * to_feed
+        dp = stepper.step(feed + 1e-9)   # mm/min: > 0 on the end itself
         p = p if dp is None else p + dp
-    if stepper.stop_reason not in (END, CLOSED) or np.linalg.norm(p - end) > 1e-9:
+    if stepper.stop_reason not in (END, CLOSED) or np.linalg.norm(p - end) > STREAM_END:
         raise GeometryError(f"{what}: the stepper did not land on the cut's last point "
                             f"(stopped: {stepper.stop_reason}; {np.linalg.norm(p - end):.3g} "
                             "mm from it)")
@@ -246,7 +248,7 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
         if shares.max() > NOISE:
             break
         # the path's derivatives between coarse points: plan again with less of the limit
-        derate = np.where(shares > 1.0, derate / (shares * (1.0 + 1e-2)), derate)
+        derate = np.where(shares > 1.0, derate / (shares * (1.0 + 1e-2)), derate)  # 1 % under
     raise _refusal(over, machine)
 
 

@@ -317,7 +317,7 @@ def _flatten_at(s, w, u, wl, p: int, q: int, window: float) -> bool:
                 lo = m
             else:
                 hi = m
-        if lo <= 1e-6 * w[j]:
+        if lo <= 1e-6 * w[j]:   # relative to w: no feed left (round-off of the bisection)
             return False
         a, b = _above(w, j, lo)
         for i in range(a, b + 1):
@@ -339,7 +339,7 @@ def flatten(s, t, w, u, wl, need, window: float) -> int:
     a valley) becomes a cruise of at least ``window`` s; the turns flattened."""
     n = len(s)
     done = 0
-    tiny = 1e-9 * np.max(np.abs(u)) if len(u) else 0.0
+    tiny = 1e-9 * np.max(np.abs(u)) if len(u) else 0.0   # relative: round-off of u
     k = 0
     while k < n - 1:
         if need[k] > window:

@@ -16,6 +16,12 @@ exceed the machine's limit by this share (round-off), not more
 STREAM_END = 1e-9
 """mm: a stream's first and last positions lie this close to the program's first and last
 points (the .txt's 9 decimals)."""
+CONFUSION = 1e-7
+"""mm: OCCT's ``Precision::Confusion()``, the precision given to OCCT where it asks for one
+(building a face, projecting a point to (u, w)): points this close are one point to OCCT."""
+VERTICAL = 1e-12
+"""|1 - |d_z|| of a unit direction below this: the direction is vertical (round-off of a
+unit vector's z; the guard's walls and shank rule, waterline's horizontal planes)."""
 
 
 @dataclass(frozen=True)

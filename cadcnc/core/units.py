@@ -17,7 +17,7 @@ from .errors import InputError
 _NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _QUANTITY = re.compile(rf"^\s*({_NUMBER})\s*([A-Za-zµ/]*)\s*$")
 _NON_FINITE = re.compile(r"^\s*[+-]?(?:inf(?:inity)?|nan)\b", re.IGNORECASE)
-DURATION_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
+DURATION_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}  # seconds per unit
 
 
 def _split(text: str, name: str, expected: str) -> tuple[float, str]:
@@ -81,7 +81,7 @@ def parse_point(text: str, name: str) -> tuple[float, float, float]:
 
 def format_duration(seconds: float) -> str:
     """``4 ms``, ``250 us``, ``1.5 s``: the largest unit that keeps the number >= 1."""
-    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6)):
+    for unit, scale in ((u, DURATION_UNITS[u]) for u in ("s", "ms", "us")):
         if abs(seconds) >= scale:
             return f"{seconds / scale:g} {unit}"
     return f"{seconds:g} s"

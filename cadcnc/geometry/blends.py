@@ -104,7 +104,7 @@ def find_blend(part: Part, n: int, kmax: np.ndarray, kmin: np.ndarray) -> Blend 
                 continue
             k = len(e.points) // 2
             tangent = e.points[min(k + 1, len(e.points) - 1)] - e.points[max(k - 1, 0)]
-            tangent /= np.linalg.norm(tangent) + 1e-300
+            tangent /= np.linalg.norm(tangent) + 1e-300   # no 0 / 0 (a zero chord)
             try:
                 cross = _cross_direction(part, n, e.points[k], blend.concave)
             except GeometryError:

@@ -22,6 +22,8 @@ from OCP.BRep import BRep_Builder
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge2d
 from OCP.TopoDS import TopoDS_Face
 
+from ..core.tolerances import CONFUSION
+
 _CURVE_2D, _SURFACE = 7, 9   # BinTools' record tags of Geom2d_BSplineCurve, Geom_BSplineSurface
 _KNOT = np.dtype([("t", "<f8"), ("m", "<i4")])
 
@@ -83,7 +85,7 @@ def surface(bs) -> tuple[np.ndarray, np.ndarray, tuple, tuple] | None:
               + bs.VDegree().to_bytes(2, "little")
               + b"".join(x.to_bytes(4, "little") for x in (nu, nv, ku, kv)))
     face = TopoDS_Face()
-    BRep_Builder().MakeFace(face, bs, 1e-7)
+    BRep_Builder().MakeFace(face, bs, CONFUSION)
     blob = _blob(face)
     at = _record(blob, b"Surfaces", header)
     if at is None:

@@ -81,14 +81,14 @@ def principal_curvatures(ff: FundamentalForms, ru, rw) -> PrincipalCurvatures:
         r2 = (ff.M - k * ff.F, ff.N - k * ff.G)
         row = r1 if math.hypot(*r1) >= math.hypot(*r2) else r2
         scale = math.hypot(*row)
-        if scale < 1e-12 * (abs(ff.L) + abs(ff.M) + abs(ff.N) + 1e-300):
+        if scale < 1e-12 * (abs(ff.L) + abs(ff.M) + abs(ff.N) + 1e-300):  # relative 0 row
             d = np.array(ru, dtype=float)
         else:
             a, b = -row[1], row[0]
             d = a * ru + b * rw
         directions.append(d / np.linalg.norm(d))
     d_max, d_min = directions
-    if abs(k_max - k_min) < 1e-12 * max(1.0, abs(k_max)):
+    if abs(k_max - k_min) < 1e-12 * max(1.0, abs(k_max)):   # umbilic to round-off
         # umbilic: any orthonormal pair will do
         d_min = np.cross(np.cross(ru, rw), d_max)
         d_min /= np.linalg.norm(d_min)

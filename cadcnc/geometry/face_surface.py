@@ -29,7 +29,7 @@ from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_REVERSED
 from OCP.TopoDS import TopoDS_Face
 
 from ..core.errors import GeometryError, InputError, SingularPointError
-from ..core.tolerances import DEFAULT, Tolerances
+from ..core.tolerances import CONFUSION, DEFAULT, Tolerances
 from . import differential as dg
 from .boxes import optimal_box
 from .surface_data import SURFACE_KINDS, SurfaceData, as_topods_face, surface_data
@@ -188,7 +188,7 @@ class FaceSurface:
                 d = self.derivatives_array(u, w, out)
                 lu = max(lu, float(np.linalg.norm(d[1])) * (u1 - u0))
                 lw = max(lw, float(np.linalg.norm(d[2])) * (w1 - w0))
-        return max(lu, 1e-6), max(lw, 1e-6)
+        return max(lu, 1e-6), max(lw, 1e-6)   # mm: no zero length (a collapsed edge)
 
     @property
     def normal_sign(self) -> float:
@@ -237,7 +237,7 @@ class FaceSurface:
     def singularity(self, ru: np.ndarray, rw: np.ndarray) -> float:
         """|r_u x r_w| / (|r_u|^2 + |r_w|^2): 0 at a singular point, 1/2 for a square grid."""
         c = dg.cross(ru, rw)
-        return float(math.sqrt(c @ c) / (ru @ ru + rw @ rw + 1e-300))
+        return float(math.sqrt(c @ c) / (ru @ ru + rw @ rw + 1e-300))   # 0 / 0 -> 0
 
     def normal(self, u: float, w: float) -> np.ndarray:
         """Unit normal out of the material, (3,). Raises SingularPointError where undefined
@@ -302,5 +302,5 @@ def nearest_on_face(face: TopoDS_Face, surface, pnt: gp_Pnt):
     if not dss.IsDone() or dss.NbSolution() == 0:
         return None
     near = dss.PointOnShape2(1)
-    uv = ShapeAnalysis_Surface(surface).ValueOfUV(near, 1e-7)
+    uv = ShapeAnalysis_Surface(surface).ValueOfUV(near, CONFUSION)
     return uv.X(), uv.Y(), float(dss.Value())

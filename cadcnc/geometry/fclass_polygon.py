@@ -23,9 +23,10 @@ from OCP.TopAbs import TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
+from ..core.tolerances import CONFUSION
 from .polygon_points import pcurve_points, surface_points
 
-_CONFUSION = 1e-7  # OCCT Precision::Confusion(), mm
+_CONFUSION = CONFUSION  # OCCT Precision::Confusion(), mm
 _FAST_FROM = 32  # samples of an edge from which numpy evaluates them (fewer: OCCT's calls)
 
 
@@ -72,7 +73,7 @@ def _keep_distinct(kept: int, uv: np.ndarray, us, du: float, c3, last, p3=None):
     a = np.array(p3 if last3d is None else [last3d] + p3)
     d = a[1:] - a[:-1]
     if len(d) == 0 or (d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2]).min() >= \
-            _CONFUSION * _CONFUSION * (1.0 + 1e-9):
+            _CONFUSION * _CONFUSION * (1.0 + 1e-9):   # relative round-off
         return uv, (p3[-1], c3, us[-1])
     out = []
     for (x, y), t, q in zip(uv.tolist(), us, p3):
@@ -111,7 +112,7 @@ def _min_gap2(first: np.ndarray, p3: np.ndarray) -> float:
 
 def _close(fast: np.ndarray, exact: tuple) -> bool:
     """Whether a numpy point agrees with OCCT's to round-off (1e-12 of its size)."""
-    return bool(np.abs(fast - exact).max() <= 1e-12 * (1.0 + np.abs(exact).max()))
+    return bool(np.abs(fast - exact).max() <= 1e-12 * (1.0 + np.abs(exact).max()))  # round-off
 
 
 def _fast_points(c2, c3, surface, us: np.ndarray, data=None):
@@ -191,7 +192,7 @@ def _sample(wire, face, box: list, defl: float = 0.0, surface=None,
             return None
         walked += 1
         edge, orient, pf, pl = item
-        if abs(pl - pf) < 1e-9:
+        if abs(pl - pf) < 1e-9:   # an edge of no parameter range: skipped
             continue
         c2, c3 = BRepAdaptor_Curve2d(edge, face), BRepAdaptor_Curve(edge, face)
         if defl:
@@ -241,7 +242,7 @@ def _thickness(seq: list) -> float:
     b = np.roll(a := np.asarray(seq)[:-1], 1, axis=0)
     square = float(np.sum((a[:, 0] - b[:, 0]) * (a[:, 1] + b[:, 1]) * 0.5))
     per = float(np.sum(np.hypot(*(a - b).T)))
-    return max(2.0 * abs(square) / per, 1e-7) if per > 0.0 else math.nan
+    return max(2.0 * abs(square) / per, 1e-7) if per > 0.0 else math.nan  # FClass2d's floor
 
 
 def polygon_bands(face_surface, tol_uv: float, data=None) -> tuple[np.ndarray, ...] | None:
@@ -272,7 +273,7 @@ def polygon_bands(face_surface, tol_uv: float, data=None) -> tuple[np.ndarray, .
             seq, fu, fv, _ = _sample(wire, face, box)
             thick, defl = _thickness(seq), max(fu, fv)
         discr = min(defl * 0.1, thick * 10.0)
-        while defl > thick and discr > 1e-7:
+        while defl > thick and discr > 1e-7:   # OCCT FClass2d's loop, its 1e-7
             seq, fu, fv, _ = _sample(wire, face, box, discr)
             thick, defl = _thickness(seq), max(fu, fv)
             discr = min(discr * 0.1, thick * 10.0)

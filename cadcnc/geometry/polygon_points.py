@@ -156,7 +156,7 @@ def surface_points(adaptor, uv: np.ndarray, data=None) -> np.ndarray | None:
     before the face's (rigid) location; None if not supported. ``data``: the face's
     SurfaceData (geometry/surface_data.py), whose B-spline poles are then not read again."""
     trsf: gp_Trsf = adaptor.Trsf()
-    if abs(abs(trsf.ScaleFactor()) - 1.0) > 1e-15:
+    if abs(abs(trsf.ScaleFactor()) - 1.0) > 1e-15:   # a scale, not round-off of 1
         return None
     s, kind = adaptor.Surface(), adaptor.GetType()
     if data is not None and kind == GeomAbs_BSplineSurface and \

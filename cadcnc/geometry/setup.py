@@ -30,6 +30,9 @@ from ..core.job import PRINCIPAL_AXES, Job, axis_name
 from .boxes import optimal_box
 from .part import Part
 
+SAME_ROTATION = 1e-12  # per entry: two rotations this close are one (round-off of cos, sin)
+SAME_ORIGIN = 1e-9     # mm: two setup origins this close are one
+
 
 def rotation_for(axis) -> np.ndarray:
     """(3, 3) R = Ry(B) Rx(A) with R @ axis = +Z (see :func:`table_angles`)."""
@@ -180,5 +183,5 @@ def original_part(part):
 
 
 def _same(a: Setup, b: Setup) -> bool:
-    return bool(np.allclose(a.rotation, b.rotation, atol=1e-12)
-                and np.allclose(a.origin, b.origin, atol=1e-9))
+    return bool(np.allclose(a.rotation, b.rotation, atol=SAME_ROTATION)
+                and np.allclose(a.origin, b.origin, atol=SAME_ORIGIN))

@@ -41,7 +41,8 @@ def layout(lo, hi, p, q, face_surface, max_cells: int, target: float) -> tuple[l
     full = [w[1] if w[1] and w[2] is None else 0.0 for w in windows]
     span = [hi[k] - lo[k] for k in range(2)]
     domain = [full[k] or span[k] for k in range(2)]
-    var = [max(float(np.abs(q[:, k] - p[:, k]).sum()), 1e-9 * span[k]) for k in range(2)]
+    var = [max(float(np.abs(q[:, k] - p[:, k]).sum()), 1e-9 * span[k])  # > 0: no / 0 below
+           for k in range(2)]
     n = 4.0 * var[0] * var[1] * domain[0] * domain[1] / (target * span[0] * span[1]) ** 2
     c = domain[0] * domain[1] / min(max(n, 256.0), float(max_cells))
     # the best cell shape, but no direction finer than max_cells / 16 cells

@@ -65,7 +65,7 @@ def _free_cells(bands, face_surface, max_cells: int, target: float) -> tuple:
     axes, windows = layout(lo, hi, p, q, face_surface, max_cells, target)
     origin, size = np.array([a[0] for a in axes]), np.array([a[1] for a in axes])
     shape = np.array([axes[0][2], axes[1][2]])
-    eps = 1e-12 * (np.abs(origin) + shape * size) + 1e-300
+    eps = 1e-12 * (np.abs(origin) + shape * size) + 1e-300   # round-off of a cell edge, > 0
     shifts = [[k * t for k in range(math.ceil((o - b) / t) - 1,
                                     math.floor((o + n * s - a) / t) + 2)] if t else [0.0]
               for a, b, o, s, n, (_, t, _) in zip(lo, hi, origin, size, shape, windows)]

@@ -174,7 +174,7 @@ class AnalyticFace:
         e = _axpy(-self.z[2], self.z, (0.0, 0.0, 1.0))       # radial part of +z
         qa, qb, qc = _dot(e, e), _dot(w0, e), _dot(w0, w0)   # rho^2 = qa s^2 + 2 qb s + qc
         s_v = min(max(-qb / qa, 0.0), length) if qa > EPS else 0.0
-        if qa * s_v * s_v + 2.0 * qb * s_v + qc < (EPS * self.r_major) ** 2 + 1e-18:
+        if qa * s_v * s_v + 2.0 * qb * s_v + qc < (EPS * self.r_major) ** 2 + 1e-18:  # mm^2
             return None                                     # the segment meets the axis
         b = p[2] - self.o[2]                                 # q' / 2 = s + b
         quartic = np.convolve([1.0, 2.0 * b, b * b], [qa, 2.0 * qb, qc])   # 5 coefficients

@@ -157,9 +157,11 @@ class HeightCells:
         """xy buckets about a cell's size: each box listed in every bucket it overlaps."""
         b = self.boxes
         self.x0, self.y0 = float(b[:, 0].min()), float(b[:, 1].min())
-        span = max(float(b[:, 3].max()) - self.x0, float(b[:, 4].max()) - self.y0, 1e-9)
+        span = max(float(b[:, 3].max()) - self.x0, float(b[:, 4].max()) - self.y0,
+                   1e-9)   # mm: boxes of one point still get a span (no / 0 below)
         width = np.maximum(b[:, 3] - b[:, 0], b[:, 4] - b[:, 1])
-        self.size = max(float(np.median(width)), span / math.sqrt(MAX_BUCKETS), 1e-6)
+        self.size = max(float(np.median(width)), span / math.sqrt(MAX_BUCKETS),
+                        1e-6)   # mm: a bucket of some size, far below any tool
         self.nx = int(math.floor((float(b[:, 3].max()) - self.x0) / self.size)) + 1
         self.ny = int(math.floor((float(b[:, 4].max()) - self.y0) / self.size)) + 1
         i0 = np.floor((b[:, 0] - self.x0) / self.size).astype(int).clip(0, self.nx - 1)

@@ -43,7 +43,7 @@ from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS_Compound
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
-from ..core.tolerances import DEFAULT
+from ..core.tolerances import DEFAULT, VERTICAL
 from .analytic_faces import AnalyticFace
 from .face_distance import FaceDistance
 
@@ -343,12 +343,12 @@ def _needs_own_rule(face) -> bool:
     surf = face._adaptor
     if face.kind == "plane":
         u, w = np.mean(face.u_range), np.mean(face.w_range)
-        return face.normal(u, w)[2] < -1e-12
+        return face.normal(u, w)[2] < -1e-12   # faces down beyond a unit normal's round-off
     if face.kind == "cylinder":
         axis = surf.Cylinder().Axis().Direction()
-        return abs(abs(axis.Z()) - 1.0) > 1e-12
+        return abs(abs(axis.Z()) - 1.0) > VERTICAL
     if face.kind == "extrusion":
-        return abs(abs(surf.Direction().Z()) - 1.0) > 1e-12
+        return abs(abs(surf.Direction().Z()) - 1.0) > VERTICAL
     return True
 
 

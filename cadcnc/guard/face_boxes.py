@@ -119,7 +119,7 @@ class FaceBoxes:
             for w in np.linspace(w0, w1, 3):
                 got = self._point(u, w) if self.surface is not None \
                     else np.array(self.curve.Value(u).Coord()) + w * self.axis
-                if np.linalg.norm(got - self.face.point(u, w)) > 1e-9:
+                if np.linalg.norm(got - self.face.point(u, w)) > 1e-9:   # mm: OCCT's to round-off
                     return False
         return True
 

@@ -38,10 +38,10 @@ from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedMapOfShape
 
+from ..core.tolerances import VERTICAL
 from ..core.trim_labels import INSIDE, OUTSIDE
 from .cells import DROPS, REUSE, HeightCells, shared
 
-VERTICAL = 1e-12   # |1 - |d_z|| below this: a direction is vertical
 PROBE = 1e-4       # the classification's step off an edge, as a fraction of the v range
 
 

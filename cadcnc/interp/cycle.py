@@ -75,7 +75,7 @@ class Contact:
         cn = norm(c)
         E, F, G = dot(ru, ru), dot(ru, rw), dot(rw, rw)
         # the singularity ratio |r_u x r_w| / (|r_u|^2 + |r_w|^2): 0 at a singular point
-        self.singularity = cn / (E + G + 1e-300)
+        self.singularity = cn / (E + G + 1e-300)   # 0 / 0 -> 0
         n = scale(c, self.surface.normal_sign / cn) if cn > 0.0 else (0.0, 0.0, 0.0)
         self.u, self.w, self.r, self.ru, self.rw, self.n = u, w, r, ru, rw, n
         self.E, self.F, self.G = E, F, G
@@ -288,7 +288,7 @@ def centre_curvature(c1: Contact, c2: Contact, k1: float, k2: float) -> float:
     a = k1 / (1.0 - c1.offset * k1)
     b = k2 / (1.0 - c2.offset * k2)
     c = dot(c1.n, c2.n)
-    return math.sqrt(max(a * a + b * b - 2.0 * c * a * b, 0.0) / max(1.0 - c * c, 1e-300))
+    return math.sqrt(max(a * a + b * b - 2.0 * c * a * b, 0.0) / max(1.0 - c * c, 1e-300))  # no / 0
 
 
 def model_step(c: Contact, k: float, t: Vec, carried: Vec, slope: float,

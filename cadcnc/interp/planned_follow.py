@@ -47,7 +47,7 @@ def follow(stepper, plan: np.ndarray, end, curvature: float, landing: float) -> 
                 f = (1.0 - w) * f + w * (d * (1.0 + curvature * curvature * d * d / 24.0)
                                          - left)
                 if left <= 0.0:
-                    f = max(f, d * (1.0 + landing) + 1e-12)
+                    f = max(f, d * (1.0 + landing) + KF.LANDING_PAST)
             if f > 0.0:
                 stepper.step(f * to_feed)
         out[n] = stepper.p

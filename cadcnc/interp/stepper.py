@@ -286,7 +286,7 @@ class Stepper:
         self._watch = None
         self.landing_trials = used + 1
         reason, detail = state["failure"]
-        if lo * f < 1e-12 or not state["kept"]:
+        if lo * f < LANDING_TOL or not state["kept"]:
             self._stop(reason, detail + " (no step possible from the current point)")
             return None
         dp = self._commit_kept(lo * f)

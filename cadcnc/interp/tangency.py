@@ -43,7 +43,7 @@ def _solve4(a: list[list[float]], b: list[float]) -> list[float]:
     size = max(abs(x) for row in a for x in row)
     for k in range(4):
         piv = max(range(k, 4), key=lambda i: abs(m[i][k]))
-        if abs(m[piv][k]) <= 1e-13 * size:
+        if abs(m[piv][k]) <= 1e-13 * size:   # relative: a zero pivot to round-off
             return np.linalg.lstsq(np.array(a), np.array(b), rcond=None)[0].tolist()
         m[k], m[piv] = m[piv], m[k]
         for i in range(k + 1, 4):
@@ -109,7 +109,8 @@ def solve_tangency(s1, s2, offsets: tuple[float, float], seed_uv1, seed_uv2, anc
             except StartPointError:
                 lam *= 0.5
                 continue
-            if max(abs(v) for v in equations(trial[0], trial[1])) < err or lam < 1e-6:
+            if (max(abs(v) for v in equations(trial[0], trial[1])) < err
+                    or lam < 1e-6):   # damping floor: the step halved 20 times
                 break
             lam *= 0.5
         x = [a + lam * d for a, d in zip(x, dx)]

@@ -36,6 +36,11 @@ def cross(a: Vec, b: Vec) -> Vec:
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
+SINGULAR_DET = 1e-14
+"""Relative: a 3x3 determinant below this times the rows' norms' product is singular
+(round-off of unit-scale rows); the kernel mirrors it (kernel/cycle_math.py)."""
+
+
 def norm(a: Vec) -> float:
     return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
@@ -45,7 +50,7 @@ def solve3(r0: Vec, r1: Vec, r2: Vec, b: Vec) -> Vec | None:
     c12 = cross(r1, r2)
     det = dot(r0, c12)
     scale_ = norm(r0) * norm(r1) * norm(r2)
-    if abs(det) <= 1e-14 * scale_:
+    if abs(det) <= SINGULAR_DET * scale_:
         return None
     c20 = cross(r2, r0)
     c01 = cross(r0, r1)

@@ -53,7 +53,7 @@ def digits_for(tolerance: float) -> int:
     """Fewest decimals d with sqrt(3)/2 * 10**-d <= tolerance / 10 (3-D rounding error)."""
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise InputError(f"G-code tolerance must be > 0 mm, got {tolerance!r}")
-    d = math.ceil(-math.log10(tolerance / 10 / (math.sqrt(3) / 2)) - 1e-12)
+    d = math.ceil(-math.log10(tolerance / 10 / (math.sqrt(3) / 2)) - 1e-12)  # log10's round-off
     return max(d, 0)
 
 

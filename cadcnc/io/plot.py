@@ -38,7 +38,7 @@ def figure(path, part, title: str = ""):
     fig = plt.figure(figsize=(12, 5.5))
     ax = fig.add_subplot(1, 2, 1, projection="3d")
     pts = path.points
-    span = max(float(np.ptp(pts, axis=0).max()), 1e-6)
+    span = max(float(np.ptp(pts, axis=0).max()), 1e-6)   # mm: a point still has a scale
     margin = max(0.25 * span, 4 * max(path.offsets))
     lo, hi = pts.min(axis=0) - margin, pts.max(axis=0) + margin
     for k, number in enumerate(path.faces):

@@ -120,7 +120,7 @@ def setup_of_dict(d) -> Setup | None:
         setup = Setup.from_dict(d)
         ok = setup.axis.shape == (3,) and setup.rotation.shape == (3, 3) and \
             setup.origin.shape == (3,) and np.allclose(setup.rotation @ setup.rotation.T,
-                                                       np.eye(3), atol=1e-9)
+                                                       np.eye(3), atol=1e-9)  # orthonormal
     except (KeyError, TypeError, ValueError):
         ok = False
     if not ok:

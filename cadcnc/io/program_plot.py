@@ -70,7 +70,7 @@ def program_figure(program: Program, part, title: str = "", axis=None):
             k += 1
         else:
             ax.plot(*seg.points.T, color=LINK_COLOUR, lw=0.8, ls="--")
-    centre, half = (lo + hi) / 2, max(float((hi - lo).max()) / 2, 1e-3)
+    centre, half = (lo + hi) / 2, max(float((hi - lo).max()) / 2, 1e-3)  # mm: not 0 for a point
     if axis is not None:   # from the centre of the box out along the axis, named
         tip = centre + np.asarray(axis) * half * 0.95
         ax.quiver(*centre, *(tip - centre), color="crimson", lw=2.0, arrow_length_ratio=0.15)

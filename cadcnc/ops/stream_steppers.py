@@ -36,7 +36,7 @@ def guide_plane_of(path) -> GuidePlane | None:
     chord = path.points[-1] - path.points[0]
     du = float(path.uv[-1, 1, 0] - path.uv[0, 1, 0])
     flat = np.hypot(chord[0], chord[1])
-    if flat < 1e-9 or abs(du) < 1e-9:
+    if flat < 1e-9 or abs(du) < 1e-9:   # mm, rad: no horizontal travel, no turn
         return None
     direction = chord[:2] / flat * math.copysign(1.0, du)
     angle = math.degrees(math.atan2(direction[1], direction[0]))

@@ -231,7 +231,7 @@ def _first_gain(d: np.ndarray, o: np.ndarray, i: int, j0: int) -> int:
     tail_after[:-1] = d[o[i], o[js[:-1] + 1]]
     before = d[o[i - 1], o[i]] + tail_before
     after = d[o[i - 1], o[js]] + tail_after
-    better = after + rev[js - i - 1] < before + fwd[js - i - 1] - 1e-9
+    better = after + rev[js - i - 1] < before + fwd[js - i - 1] - 1e-9  # mm: no swap on ties
     hit = np.flatnonzero(better)
     return int(js[hit[0]]) if hit.size else -1
 

@@ -31,7 +31,7 @@ NEAR = 0.01         # mm: pieces whose polyline is this close to the nearest are
 def _segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(K,) distance of points p (K, 3) to the segment a-b (mm)."""
     ab = b - a
-    t = np.clip(((p - a) @ ab) / max(float(ab @ ab), 1e-300), 0.0, 1.0)
+    t = np.clip(((p - a) @ ab) / max(float(ab @ ab), 1e-300), 0.0, 1.0)  # no / 0
     return np.linalg.norm(p - (a + t[:, None] * ab), axis=1)
 
 
@@ -106,7 +106,7 @@ def fit_arc(pts: np.ndarray) -> Arc | None:
         n = -n
     arc = Arc(c, n, r, e1, 0.0, (pts[0], pts[-1]))
     ang = np.unwrap(np.arctan2((pts - c) @ arc.e2, (pts - c) @ arc.e1))
-    if np.any(np.diff(ang) < -1e-12) or ang[-1] >= 2 * np.pi:
+    if np.any(np.diff(ang) < -1e-12) or ang[-1] >= 2 * np.pi:   # rad: round-off
         return None
     arc.span = float(ang[-1])
     d = np.hypot((pts - c) @ n, np.linalg.norm(np.cross(pts - c, n), axis=1) - r)
@@ -154,7 +154,7 @@ class Offsets:
                          for pr, r in zip(self.probes, self.radii))
         # past an end (its foot on the polyline would lie beyond it): that end's distance;
         # a closed corner path (a loop: first point = last) has no end to pass
-        closed = np.linalg.norm(self.pts[0] - self.pts[-1]) <= 1e-6
+        closed = np.linalg.norm(self.pts[0] - self.pts[-1]) <= 1e-6   # mm: Tolerances.closed
         ends = () if closed else ((self.pts[0], self.pts[1]), (self.pts[-1], self.pts[-2]))
         for end, nxt in ends:
             past = (p - end) @ (end - nxt) > 0

@@ -60,6 +60,8 @@ MIN_SAMPLES = 9      # per edge (the spec)
 TOL = 1e-3           # mm: the spec's 1 um
 TANGENT_DEG = 1.0    # a material angle within this of 180 deg is a tangent edge sample
 CLASSIFY_TOL = 1e-7  # FClass2d tolerance for "on the boundary"
+UV_PRECISION = 1e-9  # mm: OCCT's point-to-(u, v) and normal resolution, far below TOL
+WRAP = 1e-9          # parameter units: a value this near a period's end wraps to its start
 
 
 def read_shape(path: str):
@@ -89,7 +91,7 @@ class Face:
 
     def normal(self, u: float, v: float) -> np.ndarray | None:
         """Unit outward normal (out of the material) at (u, v), None where undefined."""
-        props = GeomLProp_SLProps(self.surface, u, v, 1, 1e-9)
+        props = GeomLProp_SLProps(self.surface, u, v, 1, UV_PRECISION)
         if not props.IsNormalDefined():
             return None
         n = np.array(props.Normal().Coord())
@@ -102,9 +104,9 @@ class Face:
         """(u, v) of the foot of p on the untrimmed surface (local search from ``near``)."""
         g = gp_Pnt(*map(float, p))
         if near is None:
-            uv = self.analysis.ValueOfUV(g, 1e-9)
+            uv = self.analysis.ValueOfUV(g, UV_PRECISION)
         else:
-            uv = self.analysis.NextValueOfUV(gp_Pnt2d(*near), g, 1e-9, -1.0)
+            uv = self.analysis.NextValueOfUV(gp_Pnt2d(*near), g, UV_PRECISION, -1.0)
         return uv.X(), uv.Y()
 
     def on_face(self, u: float, v: float) -> bool:
@@ -113,8 +115,8 @@ class Face:
             if period:
                 lo = self.uv_box[2 * k]
                 val = (u, v)[k]
-                val = lo + math.fmod(val - lo + 1e-9, period) - 1e-9
-                if val < lo - 1e-9:
+                val = lo + math.fmod(val - lo + WRAP, period) - WRAP
+                if val < lo - WRAP:
                     val += period
                 u, v = (val, v) if k == 0 else (u, val)
         state = self.classifier.Perform(gp_Pnt2d(u, v))
@@ -216,8 +218,8 @@ class Oracle:
         if size == 0.0:
             return None
         perp = np.array([-dv, du]) / size
-        span = max(f.uv_box[1] - f.uv_box[0], f.uv_box[3] - f.uv_box[2], 1e-9)
-        step = 1e-5 * span
+        span = max(f.uv_box[1] - f.uv_box[0], f.uv_box[3] - f.uv_box[2], 1e-9)  # no 0 step
+        step = 1e-5 * span   # finite-difference step, relative to the box
         if not f.on_face(u + step * perp[0], v + step * perp[1]):
             perp = -perp
         sa = BRepAdaptor_Surface(f.face)
@@ -226,7 +228,7 @@ class Oracle:
         su, sv = np.array(su.Coord()), np.array(sv.Coord())
         d = perp[0] * su + perp[1] * sv
         along = du * su + dv * sv  # the edge's tangent: (u, v) axes need not be orthogonal
-        along /= max(np.linalg.norm(along), 1e-300)
+        along /= max(np.linalg.norm(along), 1e-300)   # no / 0
         d -= (d @ n) * n + (d @ along) * along
         norm = np.linalg.norm(d)
         if norm == 0.0:
@@ -250,7 +252,7 @@ class Oracle:
         if cap is not None:
             n = min(n, max(cap, MIN_SAMPLES))
         t0, t1 = curve.FirstParameter(), curve.LastParameter()
-        ua = GCPnts_UniformAbscissa(curve, n, t0, t1, 1e-9)
+        ua = GCPnts_UniformAbscissa(curve, n, t0, t1, 1e-9)  # mm: abscissa precision
         if ua.IsDone() and ua.NbPoints() == n:
             return [ua.Parameter(i) for i in range(1, n + 1)]
         return list(np.linspace(t0, t1, n))
@@ -278,7 +280,7 @@ class Oracle:
             rows = np.array([feet[0][3], feet[1][3], tangent])
             rhs = np.array([feet[0][3] @ feet[0][2] + offset, feet[1][3] @ feet[1][2] + offset,
                             tangent @ s])
-            if abs(np.linalg.det(rows)) < 1e-12:
+            if abs(np.linalg.det(rows)) < 1e-12:   # singular: no Newton step
                 return s, None
             q = np.linalg.solve(rows, rhs)
             if not np.all(np.isfinite(q)) or np.linalg.norm(q - s) > 10.0 * offset + 1.0:
@@ -294,7 +296,7 @@ class Oracle:
                     return p, None
                 new.append((n, (u, v), f.point(u, v), normal))
             feet = new
-            if moved < 1e-9:
+            if moved < 1e-9:   # mm: converged
                 return p, feet
         return p, None
 
@@ -377,7 +379,7 @@ class Oracle:
         f = self.faces[number]
         u, v = f.project(p, None)
         foot = float(np.linalg.norm(np.asarray(p, float) - f.point(u, v)))
-        if foot < dist - 1e-9 and f.on_face(u, v):
+        if foot < dist - 1e-9 and f.on_face(u, v):   # mm: nearer beyond round-off
             self.corrections.append({"face": number, "p": [float(x) for x in p],
                                      "brepextrema": dist, "foot": foot})
             return foot

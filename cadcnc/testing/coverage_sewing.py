@@ -113,7 +113,7 @@ def _area_facing_z(shell, n: int = 5) -> float:
         face = TopoDS.Face_s(explorer.Current())
         surface = BRep_Tool.Surface_s(face)
         umin, umax, vmin, vmax = BRepTools.UVBounds_s(face)
-        classifier = BRepTopAdaptor_FClass2d(face, 1e-7)
+        classifier = BRepTopAdaptor_FClass2d(face, 1e-7)  # Precision::Confusion()
         props = GProp_GProps()
         BRepGProp.SurfaceProperties_s(face, props)
         signs = []
@@ -121,7 +121,7 @@ def _area_facing_z(shell, n: int = 5) -> float:
             for v in vmin + (vmax - vmin) * (np.arange(n) + 0.5) / n:
                 if classifier.Perform(gp_Pnt2d(u, v)) != TopAbs_IN:
                     continue
-                lp = GeomLProp_SLProps(surface, u, v, 1, 1e-9)
+                lp = GeomLProp_SLProps(surface, u, v, 1, 1e-9)  # normal's resolution
                 if lp.IsNormalDefined():
                     z = lp.Normal().Z() * (-1.0 if face.Orientation() == TopAbs_REVERSED
                                            else 1.0)

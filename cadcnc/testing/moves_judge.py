@@ -49,7 +49,7 @@ def polyline_depths(part, points: np.ndarray, ball: float) -> np.ndarray:
         if k and d[k - 1] + d[k] >= np.linalg.norm(p - points[k - 1]):
             inside[k] = inside[k - 1]
             continue
-        classifier.Perform(gp_Pnt(*map(float, p)), 1e-9)
+        classifier.Perform(gp_Pnt(*map(float, p)), 1e-9)   # mm: on the boundary
         inside[k] = classifier.State() == TopAbs_IN
     return np.where(inside, ball + d, ball - d)
 

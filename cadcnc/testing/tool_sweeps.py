@@ -35,11 +35,11 @@ def swept_axis(a, b, shank: float):
     """The shape the tool's axis sweeps moving its ball centre from a to b (see module)."""
     a, b = np.asarray(a, float), np.asarray(b, float)
     up = np.array([0.0, 0.0, shank])
-    if math.hypot(*(b[:2] - a[:2])) < 1e-9:
+    if math.hypot(*(b[:2] - a[:2])) < 1e-9:   # mm: a vertical move
         lo, hi = (a, b) if a[2] <= b[2] else (b, a)
         hi = hi + up
-        if np.linalg.norm(hi - lo) < 1e-9:
-            hi = lo + np.array([0.0, 0.0, 1e-6])
+        if np.linalg.norm(hi - lo) < 1e-9:   # mm: no segment
+            hi = lo + np.array([0.0, 0.0, 1e-6])   # mm: a segment OCCT can build
         return BRepBuilderAPI_MakeEdge(_pnt(lo), _pnt(hi)).Edge()
     if shank <= 0.0:
         return BRepBuilderAPI_MakeEdge(_pnt(a), _pnt(b)).Edge()

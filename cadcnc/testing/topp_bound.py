@@ -40,11 +40,11 @@ def moves(program, feed_mm_min: float) -> list[tuple[np.ndarray, float]]:
     for seg in program.segments:
         pts = np.asarray(seg.points, dtype=float)
         if seg.kind == "cut":
-            keep = np.r_[True, np.linalg.norm(np.diff(pts, axis=0), axis=1) > 1e-12]
+            keep = np.r_[True, np.linalg.norm(np.diff(pts, axis=0), axis=1) > 1e-12]  # mm: repeats
             out.append((pts[keep], f))
             continue
         for m, rapid in enumerate(seg.rapid):
-            if np.linalg.norm(pts[m + 1] - pts[m]) > 1e-12:
+            if np.linalg.norm(pts[m + 1] - pts[m]) > 1e-12:   # mm: not a repeat
                 out.append((pts[m:m + 2], math.inf if rapid else f))
     return out
 
@@ -98,8 +98,8 @@ def _instance(group, machine):
     def limits(si: float) -> np.ndarray:
         """(4, 2): the axes' velocity and the feed, as |d s / d t| (the fourth coordinate)."""
         k = min(max(int(np.searchsorted(ends, si, side="right")) - 1, 0), len(caps) - 1)
-        cap = caps[k] if not (k > 0 and abs(si - ends[k]) < 1e-9) else min(caps[k],
-                                                                            caps[k - 1])
+        at_joint = k > 0 and abs(si - ends[k]) < 1e-9   # mm: on the joint of two pieces
+        cap = caps[k] if not at_joint else min(caps[k], caps[k - 1])
         cap = min(cap, RAPID)
         return np.vstack([np.c_[-V, V], [[-cap, cap]]])
 

@@ -20,6 +20,7 @@ _jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 
 PAPER_INVERSE_LIMIT = 1.0 + 1e-9   # cycle.PAPER_INVERSE_LIMIT
 MAX_TURN = 0.1                     # cycle.MAX_TURN
+SINGULAR_DET = 1e-14               # vec3.SINGULAR_DET
 
 
 @_jit
@@ -81,7 +82,7 @@ def set_geometry(S: np.ndarray, o: int, sign: float, u: float, w: float,
     E = dot(ru, ru)
     F = dot(ru, rw)
     G = dot(rw, rw)
-    S[o + C_SING] = cn / (E + G + 1e-300)
+    S[o + C_SING] = cn / (E + G + 1e-300)   # 0 / 0 -> 0
     n = scale(c, sign / cn) if cn > 0.0 else (0.0, 0.0, 0.0)
     S[o + C_U] = u
     S[o + C_W] = w
@@ -156,7 +157,7 @@ def solve3(r0: tuple, r1: tuple, r2: tuple, b: tuple) -> tuple:
     c12 = cross(r1, r2)
     det = dot(r0, c12)
     scale_ = norm(r0) * norm(r1) * norm(r2)
-    if abs(det) <= 1e-14 * scale_:
+    if abs(det) <= SINGULAR_DET * scale_:
         return False, (0.0, 0.0, 0.0)
     c20 = cross(r2, r0)
     c01 = cross(r0, r1)
@@ -210,7 +211,7 @@ def centre_curvature(S: np.ndarray, o1: int, o2: int, k1: float, k2: float) -> f
     a = k1 / (1.0 - S[o1 + C_OFF] * k1)
     b = k2 / (1.0 - S[o2 + C_OFF] * k2)
     c = dot(vec(S, o1 + C_NRM), vec(S, o2 + C_NRM))
-    return math.sqrt(max(a * a + b * b - 2.0 * c * a * b, 0.0) / max(1.0 - c * c, 1e-300))
+    return math.sqrt(max(a * a + b * b - 2.0 * c * a * b, 0.0) / max(1.0 - c * c, 1e-300))  # no / 0
 
 
 @_jit

@@ -31,6 +31,8 @@ from .step import DONE, MAX_CYCLES, RECORD_FULL, step
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 
+LANDING_PAST = 1e-12   # mm: the last step asks this much past the end, so that it lands
+
 A_END, A_K, A_LANDING, A_TO_FEED, A_PERIOD = 0, 3, 4, 5, 6   # offsets in ``args``
 ARGS = 7
 
@@ -47,7 +49,7 @@ def command(plan: np.ndarray, n: int, args: np.ndarray, S: np.ndarray) -> float:
         k = args[A_K]
         f = (1.0 - w) * f + w * (d * (1.0 + k * k * d * d / 24.0) - left)
         if left <= 0.0:
-            f = max(f, d * (1.0 + args[A_LANDING]) + 1e-12)
+            f = max(f, d * (1.0 + args[A_LANDING]) + LANDING_PAST)
     return f
 
 

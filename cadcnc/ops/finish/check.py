@@ -27,9 +27,9 @@ from __future__ import annotations
 
 import numpy as np
 
-BACK_MM = 1e-6
-GAP_MM = 1e-3
-OVERLAP_MM = 1e-6
+BACK_MM = 1e-6      # mm: a cut may go back this much where the normal points up (module doc)
+GAP_MM = 1e-3       # mm: the gap a pass may leave where a cut landed on its boundary
+OVERLAP_MM = 1e-6   # mm: two cuts may share this much of the s range (round-off)
 SAME_S = 1e-6
 """mm: crossings this near in s lie on one vertical stretch of the centre's curve (a wall
 climbed or descended): their order along the pass is by height, not by s."""

@@ -48,7 +48,7 @@ that g' changes sign at most once between them (one hidden extremum, solved)."""
 GRAZE_MM = 1e-9
 """mm: an extremum of g this near zero is a tangency of the plane and the edge's centre
 path (a graze): the section touches the face's boundary there without crossing it."""
-ROOT_XTOL = 1e-13
+ROOT_XTOL = 1e-13   # brentq's absolute tolerance on an edge parameter: round-off
 Z = np.array([0.0, 0.0, 1.0])
 
 
@@ -59,7 +59,7 @@ def pass_tangent(n: np.ndarray, travel: np.ndarray) -> np.ndarray:
     ValueError where n is normal to that plane (a wall parallel to the guide plane)."""
     t = n[2] * travel - float(n @ travel) * Z
     length = float(np.linalg.norm(t))
-    if length < 1e-12:
+    if length < 1e-12:   # no direction (n parallel to Z x travel)
         raise ValueError("the face is parallel to the guide plane here")
     return t / length
 
@@ -111,7 +111,7 @@ class FaceEdges:
     def velocity(self, curve: BoundaryEdge, t: float) -> np.ndarray:
         """(3,) d(centre)/dt at edge parameter t (central difference inside the edge)."""
         t0, t1 = curve.t0, curve.t1
-        h = 1e-6 * (t1 - t0)
+        h = 1e-6 * (t1 - t0)   # finite-difference step, relative to the edge's range
         a, b = max(t0, t - h), min(t1, t + h)
         return (self.centre(curve, b)[0] - self.centre(curve, a)[0]) / (b - a)
 
@@ -124,7 +124,7 @@ class FaceEdges:
             ts = np.linspace(t0, t1, count)
             centres = np.array([self.centre(curve, t)[0] for t in ts])
             vel = np.array([self.velocity(curve, t) for t in ts])
-            unit = vel / np.maximum(np.linalg.norm(vel, axis=1), 1e-300)[:, None]
+            unit = vel / np.maximum(np.linalg.norm(vel, axis=1), 1e-300)[:, None]  # no / 0
             cos = np.clip(np.einsum("ij,ij->i", unit[:-1], unit[1:]), -1.0, 1.0)
             turn = math.degrees(float(np.arccos(cos).max()))
             if turn <= TURN_DEG:
@@ -147,7 +147,9 @@ class FaceEdges:
                     entry = self._enters(k, t, uv, n, nrm, travel, tangent)
                 except ValueError:
                     continue   # parallel to the plane there: no pass crosses it
-                if any(o.entry == entry and np.linalg.norm(o.point - c) <= 1e-9 for o in out):
+                if any(o.entry == entry
+                       and np.linalg.norm(o.point - c) <= 1e-9   # mm: already found
+                       for o in out):
                     continue   # one point found twice (a closed edge's vertex)
                 out.append(Crossing(self.face.number, k, t, uv, c, n, float(c @ travel),
                                     entry, self.neighbours[k]))

@@ -33,14 +33,19 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...core.errors import InputError
+from ...core.tolerances import VERTICAL
 from ...core.work_limits import MAX_PLANES, refuse_over
-from .plan import FaceSamples, across, adaptive_offsets, centre_chord, planes_estimate
+from .plan import DOWN_NZ, FaceSamples, across, adaptive_offsets, centre_chord, planes_estimate
 from .polish import face_derivatives
 from .slope import strip_pairs
 
 FLAT_DEG = 5.0
 """deg: a sample whose normal is within this of +Z is flat: left to raster."""
 CRITICAL_MM = 1e-9
+"""mm: a level this near a critical height is moved onto it (module doc)."""
+TOP_MM = 1e-3
+"""mm per mm of R' (at least 1): a critical height this near the highest reachable
+centre height is the top the levels start from."""
 TANGENCY_DEG = 10.0
 """deg: samples this near flat start the search for horizontal tangencies."""
 MAX_STARTS = 200   # per face: tangency searches
@@ -69,7 +74,7 @@ def sample_reasons(samples: FaceSamples, k, g, offset: float) -> np.ndarray:
     reason = np.full(len(samples), "", dtype=object)
     reason[g < math.sin(math.radians(FLAT_DEG))] = "flat"
     reason[k * offset >= 1.0] = "too tight"
-    reason[samples.normals[:, 2] < -1e-9] = "unreachable"
+    reason[samples.normals[:, 2] < DOWN_NZ] = "unreachable"
     return reason
 
 
@@ -93,9 +98,9 @@ def _tangencies(surface, uv: np.ndarray, iterations: int = 12) -> list[tuple[flo
         mh = m / mn
         nxy = surface.normal_sign * mh[:, :2]
         small = np.hypot(nxy[:, 0], nxy[:, 1])
-        done[act[small < 1e-13]] = True
+        done[act[small < 1e-13]] = True   # |n_xy|: horizontal to round-off
         if it == iterations:
-            done[act[small < 1e-10]] = True
+            done[act[small < 1e-10]] = True   # last iteration: as close as Newton gets
             break
         cols = []
         for dm in (np.cross(ruu, rw) + np.cross(ru, ruw), np.cross(ruw, rw) + np.cross(ru, rww)):
@@ -103,7 +108,7 @@ def _tangencies(surface, uv: np.ndarray, iterations: int = 12) -> list[tuple[flo
                         / mn)
         a, b, c, e = cols[0][:, 0], cols[1][:, 0], cols[0][:, 1], cols[1][:, 1]
         det = a * e - b * c
-        ok = np.abs(det) > 1e-300
+        ok = np.abs(det) > 1e-300   # no / 0
         det = np.where(ok, det, 1.0)
         du = -(e * nxy[:, 0] - b * nxy[:, 1]) / det
         dw = -(a * nxy[:, 1] - c * nxy[:, 0]) / det
@@ -126,7 +131,7 @@ def critical_heights(part, faces, samples: FaceSamples, offset: float) -> list[t
         mine = np.nonzero(samples.faces == n)[0]
         if s.kind == "plane":
             nz = samples.normals[mine, 2]
-            if len(mine) and np.all(np.abs(nz) > 1.0 - 1e-12):
+            if len(mine) and np.all(np.abs(nz) > 1.0 - VERTICAL):
                 z = float(np.mean(samples.points[mine, 2]) + offset * np.sign(nz[0]))
                 out.append((z, f"face {n}, horizontal, offset"))
             continue
@@ -162,7 +167,7 @@ def plan_levels(samples: FaceSamples, radius: float, allowance: float, *,
     if not reach.any():
         return LevelPlan(np.zeros(0), Z.copy(), f, reason)
     lo, hi = float(f[reach].min()), float(f[reach].max())
-    tops = [z for z, _ in critical if abs(z - hi) < 1e-3 * max(1.0, r1)]
+    tops = [z for z, _ in critical if abs(z - hi) < TOP_MM * max(1.0, r1)]
     hi = max(tops) if tops else hi
     spacing = np.zeros(0)
     if stepdown is not None:
@@ -170,7 +175,8 @@ def plan_levels(samples: FaceSamples, radius: float, allowance: float, *,
         refuse_over(f"waterline levels over {hi - lo:.4g} mm (R' {r1:g} mm) at a stepdown "
                     f"of {stepdown:g} mm", count, max_levels, "levels",
                     "give a larger --stepdown")
-        levels = hi - stepdown * np.arange(int(math.floor((hi - lo) / stepdown + 1e-12)) + 1)
+        steps = int(math.floor((hi - lo) / stepdown + 1e-12))   # floor's round-off
+        levels = hi - stepdown * np.arange(steps + 1)
         half = np.full(len(levels), 0.5 * stepdown)
     else:
         c, serve = centre_chord(scallop, k, radius, allowance), reason == ""

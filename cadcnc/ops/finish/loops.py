@@ -58,7 +58,7 @@ def loop_tangent(side: str):
     def tangent(n: np.ndarray) -> np.ndarray:
         t = sign * np.array([-n[1], n[0], 0.0])
         length = float(np.linalg.norm(t))
-        if length < 1e-12:
+        if length < 1e-12:   # no direction (a horizontal normal's xy is 0)
             raise ValueError("the face is horizontal here")
         return t / length
     return tangent
@@ -267,7 +267,7 @@ class _Level:
         """The self-check (module doc): sentences of what failed, [] when none."""
         pts = [c.points for c in self.result.cuts]
         tree = cKDTree(np.vstack(pts)) if pts else None
-        reach = max(self.job.step, 1e-3) * 1.01 + 1e-6
+        reach = max(self.job.step, 1e-3) * 1.01 + 1e-6   # mm: a step, 1 % and round-off
         problems = []
         for face, wires in self.result.wires.items():
             guard = self.setup.guard(face)

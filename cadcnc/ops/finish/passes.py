@@ -193,7 +193,7 @@ class _Pass:
         least s not behind p's, the nearest to p among equal s (a wall climbed)."""
         s = float(np.dot(p, self.travel))
         ahead = [c for c in self.crossings[face] if not c.entry and not c.used
-                 and c.s >= s - 1e-9]
+                 and c.s >= s - 1e-9]   # mm: round-off of s
         return min(ahead, key=lambda c: (round(c.s, 9), float(np.linalg.norm(c.point - p))),
                    default=None)
 

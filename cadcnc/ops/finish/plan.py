@@ -102,7 +102,7 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
         inside = np.array([[s.classify(u, w) != OUTSIDE for w in ws] for u in us])
         numbers.extend([s.number] * int(inside.sum()))
         weights.extend((wu[:, None] * ww[None, :])[inside].tolist())
-        wrap = [per is not None and abs(hi - lo - per) <= 1e-9 * max(1.0, per)
+        wrap = [per is not None and abs(hi - lo - per) <= 1e-9 * max(1.0, per)  # whole period
                 for per, (lo, hi) in ((s.u_period, s.u_range), (s.w_period, s.w_range))]
         edge.extend(_edge_nodes(inside, *wrap)[inside].tolist())
         uv = np.stack(np.meshgrid(us, ws, indexing="ij"), axis=-1).reshape(-1, 2)
@@ -114,7 +114,7 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
     d = np.array(derivs)                                   # (N, 6, 3)
     c = np.cross(d[:, 1], d[:, 2])
     area = np.linalg.norm(c, axis=1)
-    scale = (d[:, 1] ** 2).sum(1) + (d[:, 2] ** 2).sum(1) + 1e-300
+    scale = (d[:, 1] ** 2).sum(1) + (d[:, 2] ** 2).sum(1) + 1e-300   # no / 0
     tol = {s.number: s.tol.singular for s in surfs}
     sign = {s.number: s.normal_sign for s in surfs}
     numbers = np.array(numbers)
@@ -283,7 +283,7 @@ def along_edges(samples: FaceSamples, f: np.ndarray, g: np.ndarray
         p = samples.points[idx]
         dist, near = cKDTree(p).query(p, k=3)
         s = (np.abs(f[idx][near[:, 1:]] - f[idx][:, None])
-             / np.maximum(dist[:, 1:], 1e-12)).max(axis=1) / np.maximum(g[idx], 1e-12)
+             / np.maximum(dist[:, 1:], 1e-12)).max(axis=1) / np.maximum(g[idx], 1e-12)  # no / 0
         # on a steep edge (over EDGE_STEEP_DEG) the planes are close already (g small);
         # in steep-shallow it is waterline's
         steep = samples.normals[idx, 2] < math.cos(math.radians(EDGE_STEEP_DEG))
@@ -319,7 +319,7 @@ def planes_estimate(lo: float, hi: float, *, stepover: float | None = None, f=No
     samples from it to one widest spacing ahead (what a step from the bin can take), at
     least 1. NaN (refused) when a spacing is 0 or not a number."""
     if stepover is not None:
-        return float(max(1, math.ceil((hi - lo) / stepover - 1e-9)))
+        return float(max(1, math.ceil((hi - lo) / stepover - 1e-9)))  # ceil's round-off
     sp = np.asarray(spacing, float)
     fin = np.isfinite(sp)
     if np.isnan(sp).any() or (sp[fin] <= 0).any():

@@ -41,7 +41,7 @@ def cross_pairs(q: np.ndarray, normals: np.ndarray, normal: np.ndarray, chord: n
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
     tree = cKDTree(q[idx])
     t = np.cross(normals[idx], normal)
-    t /= np.maximum(np.linalg.norm(t, axis=1), 1e-300)[:, None]
+    t /= np.maximum(np.linalg.norm(t, axis=1), 1e-300)[:, None]   # no / 0
     out_i, out_j = [], []
     for a in range(0, len(idx), CHUNK):
         mine = np.arange(a, min(a + CHUNK, len(idx)))

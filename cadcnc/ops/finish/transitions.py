@@ -113,7 +113,7 @@ def _entry_before(crossings, p: np.ndarray, travel: np.ndarray) -> Crossing | No
 def _slerp(a: np.ndarray, b: np.ndarray, alpha: float) -> np.ndarray:
     """The unit vector at fraction ``alpha`` of the great arc from a to b."""
     theta = math.acos(max(-1.0, min(1.0, float(a @ b))))
-    if theta < 1e-12:
+    if theta < 1e-12:   # rad: a == b to round-off (sin theta -> 0)
         return a
     return (math.sin((1.0 - alpha) * theta) * a + math.sin(alpha * theta) * b) / math.sin(theta)
 
@@ -139,7 +139,7 @@ def roll_arc(ps, face: int, exit_: Crossing, kg: int, entry: Crossing, first) ->
     for _ in range(4):   # an edge crossing the plane obliquely makes the arc longer
         points, contacts, uvs, normals = _arc_points(at, n, exit_.t, entry.t, nrm, off, span)
         longest = float(np.linalg.norm(np.diff(points, axis=0), axis=1).max())
-        if longest <= ps.job.step * (1.0 + 1e-6):
+        if longest <= ps.job.step * (1.0 + 1e-6):   # relative round-off
             break
         n = int(math.ceil(n * longest / ps.job.step))
     points[0] = np.asarray(first, float)
@@ -190,7 +190,7 @@ def _root(h, t0: float, t1: float, step: float, span: float) -> float:
     if h0 == 0.0:
         return t0
     toward = 1.0 if t1 >= t0 else -1.0
-    pad = max(step, 1e-9 * max(span, 1.0))
+    pad = max(step, 1e-9 * max(span, 1.0))   # > 0: the bracket grows
     for _ in range(60):
         for b in (t0 + toward * pad, t0 - toward * pad):
             hb = h(b)

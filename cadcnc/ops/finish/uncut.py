@@ -40,6 +40,7 @@ UNMACHINED = 4.0
 """A sample whose leftover exceeds this many scallop limits is left unmachined."""
 STEEP_DEG = 10.0
 """deg: a face this near vertical, not parallel to the planes, is too steep to climb."""
+CUSP_SLACK = 1e-6  # mm: a cusp over the limit by no more than this is within it (round-off)
 NEIGHBOURS = 64  # cut points looked at around each sample's ideal centre
 CHUNK = 2048     # samples measured at a time
 GUARD_SAMPLES = 200  # per face and reason: samples whose tool is checked against the part
@@ -140,7 +141,7 @@ def uncut_report(program, part, samples, plan, jobs: int = 1) -> UncutReport:
     cusp = np.where(machined & np.isfinite(scallop), scallop, 0.0)
     report = UncutReport(limit, threshold, float(cusp.max(initial=0.0)),
                          float(leftover[machined].max(initial=0.0)), float(area.sum()),
-                         float(area[machined & (cusp > limit + 1e-6)].sum()),
+                         float(area[machined & (cusp > limit + CUSP_SLACK)].sum()),
                          n_samples=len(samples), spacing=samples.spacing)
     left = ~machined
     why = _reasons(reason, left, samples, q, part, job, n)
@@ -175,8 +176,8 @@ def _chords(c, dist, q, nrm, n) -> tuple[np.ndarray, np.ndarray]:
     v = c[rows, hi] - c[rows, lo]
     t = np.cross(nrm, n)
     tn = np.linalg.norm(t, axis=1)
-    ok &= tn > 1e-9
-    t = t / np.maximum(tn, 1e-300)[:, None]
+    ok &= tn > 1e-9   # the normals not parallel (a direction exists)
+    t = t / np.maximum(tn, 1e-300)[:, None]   # no / 0 (rows dropped above)
     v = v - np.einsum("nj,nj->n", v, t)[:, None] * t
     return np.linalg.norm(v, axis=1), ok
 
@@ -200,7 +201,7 @@ def _reasons(reason, left, samples, q, part, job, n) -> np.ndarray:
         guard = ClearanceGuard(part, (int(face), int(face)), job.tool.offset,
                                job.tool.shank, job.tolerances.hit)
         # one probe per cell of side R' (the tool's scale), at most GUARD_SAMPLES
-        cells = np.floor(q[idx] / max(job.tool.offset, 1e-3)).astype(np.int64)
+        cells = np.floor(q[idx] / max(job.tool.offset, 1e-3)).astype(np.int64)  # mm: no / 0
         probe = idx[np.sort(np.unique(cells, axis=0, return_index=True)[1])]
         probe = probe[np.linspace(0, len(probe) - 1, min(len(probe), GUARD_SAMPLES)).astype(int)]
         hit = np.array([guard.margin(q[i])[0] < 0.0 for i in probe])
