@@ -1,0 +1,184 @@
+"""One dexel grid: rays along axis k, each holding sorted, disjoint intervals of material.
+
+Ray (iu, iv) of the grid along axis ``k`` runs along e_k through ``u = lo[u] + (iu + 1/2)
+res``, ``v = lo[v] + (iv + 1/2) res`` with ``(u, v) = ((k + 1) % 3, (k + 2) % 3)``; its
+index is ``iu * nv + iv``. Intervals are stored as float32 offsets from ``lo[k]`` (mm):
+``iv[ray, i] = (start, end)`` for ``i < cnt[ray]``, at most ``K`` of them. Rays are cut
+tile by tile (``TILE`` x ``TILE`` rays) on every numba thread; a tile applies the moves that
+reach it in program order, so a rapid meets the stock exactly as the earlier moves left it.
+A tile whose ray would need more than K intervals stops and is flagged: the caller grows K
+and cuts that tile again from the initial stock (cutting is idempotent).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .sweep import swept_tool
+
+TILE = 32
+SLIVER = 1e-6        # mm: a piece of material shorter than this along a ray is dropped
+COLLISION_OVERLAP = 1e-3   # mm: a rapid's tool overlapping material longer than this on a ray
+MAX_COLLISIONS = 16  # collisions recorded per tile (distinct moves, first point of each)
+
+
+@njit(cache=True)
+def subtract(row, n, a, b, kmax):
+    """Remove [a, b] from the ``n`` sorted intervals of ``row`` (K, 2) in place: (new n, or
+    -1 when more than ``kmax`` would be needed; overlap length; t of the first overlap)."""
+    i0 = 0
+    while i0 < n and row[i0, 1] <= a:
+        i0 += 1
+    i1 = n - 1
+    while i1 >= i0 and row[i1, 0] >= b:
+        i1 -= 1
+    if i0 > i1:
+        return n, 0.0, 0.0
+    overlap = 0.0
+    for i in range(i0, i1 + 1):
+        overlap += min(float(row[i, 1]), b) - max(float(row[i, 0]), a)
+    first = max(float(row[i0, 0]), a)
+    s0, e1 = float(row[i0, 0]), float(row[i1, 1])
+    left = s0 < a - SLIVER
+    right = e1 > b + SLIVER
+    p = int(left) + int(right)
+    m = i1 - i0 + 1
+    new_n = n - m + p
+    if new_n > kmax:
+        return -1, overlap, first
+    shift = p - m
+    if shift < 0:
+        for i in range(i1 + 1, n):
+            row[i + shift, 0] = row[i, 0]
+            row[i + shift, 1] = row[i, 1]
+    elif shift > 0:
+        for i in range(n - 1, i1, -1):
+            row[i + shift, 0] = row[i, 0]
+            row[i + shift, 1] = row[i, 1]
+    j = i0
+    if left:
+        row[j, 0] = s0
+        row[j, 1] = a
+        j += 1
+    if right:
+        row[j, 0] = b
+        row[j, 1] = e1
+    return new_n, overlap, first
+
+
+@njit(cache=True)
+def _ahead(kept, o, k, tk, p0, p1):
+    """Whether the ``kept`` point (3,) comes before the point o with o[k] = tk along the
+    move p0 -> p1."""
+    s_kept, s_new = 0.0, 0.0
+    for i in range(3):
+        d = p1[i] - p0[i]
+        s_kept += kept[i] * d
+        s_new += (tk if i == k else o[i]) * d
+    return s_kept <= s_new
+
+
+@njit(cache=True)
+def bin_moves(k, lo, res, nu, nv, bb_lo, bb_hi):
+    """Moves per tile (CSR: ``start`` (tiles + 1,), ``moves`` in program order) from the
+    moves' boxes ``bb_lo``, ``bb_hi`` (N, 3)."""
+    u, v = (k + 1) % 3, (k + 2) % 3
+    ntu, ntv = (nu + TILE - 1) // TILE, (nv + TILE - 1) // TILE
+    counts = np.zeros(ntu * ntv + 1, np.int64)
+    n = bb_lo.shape[0]
+    rng = np.empty((n, 4), np.int64)
+    for m in range(n):
+        a0 = max(0, int(math.floor((bb_lo[m, u] - lo[u]) / res - 0.5)))
+        a1 = min(nu - 1, int(math.ceil((bb_hi[m, u] - lo[u]) / res - 0.5)))
+        b0 = max(0, int(math.floor((bb_lo[m, v] - lo[v]) / res - 0.5)))
+        b1 = min(nv - 1, int(math.ceil((bb_hi[m, v] - lo[v]) / res - 0.5)))
+        rng[m, 0], rng[m, 1], rng[m, 2], rng[m, 3] = a0, a1, b0, b1
+        if a0 > a1 or b0 > b1:
+            continue
+        for tu in range(a0 // TILE, a1 // TILE + 1):
+            for tv in range(b0 // TILE, b1 // TILE + 1):
+                counts[tu * ntv + tv + 1] += 1
+    start = np.cumsum(counts)
+    fill = start[:-1].copy()
+    moves = np.empty(start[-1], np.int64)
+    for m in range(n):
+        a0, a1, b0, b1 = rng[m, 0], rng[m, 1], rng[m, 2], rng[m, 3]
+        if a0 > a1 or b0 > b1:
+            continue
+        for tu in range(a0 // TILE, a1 // TILE + 1):
+            for tv in range(b0 // TILE, b1 // TILE + 1):
+                t = tu * ntv + tv
+                moves[fill[t]] = m
+                fill[t] += 1
+    return start, moves, rng
+
+
+@njit(cache=True, parallel=True)
+def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, axis, radius, length,
+              rapid, bb_lo, bb_hi, init_iv, init_cnt, iv, cnt, overflow, col_move, col_at,
+              col_n):
+    """Cut the grid's ``tiles`` (indices) by their moves: each ray starts from ``init_iv``,
+    ``init_cnt`` and loses every move's swept tool (:func:`swept_tool`); p0, p1, axis
+    (N, 3), radius, length (N,), rapid (N,) bool. Writes ``iv``, ``cnt``; ``overflow[t]``
+    for a tile that needs more intervals; rapids through material into ``col_*`` (per
+    tile: moves (T, C), points (T, C, 3), counts (T,))."""
+    u, v = (k + 1) % 3, (k + 2) % 3
+    ntv = (nv + TILE - 1) // TILE
+    kmax = iv.shape[1]
+    for ti in prange(tiles.shape[0]):
+        t = tiles[ti]
+        tu, tv = t // ntv, t % ntv
+        u0, u1 = tu * TILE, min(nu, tu * TILE + TILE) - 1
+        v0, v1 = tv * TILE, min(nv, tv * TILE + TILE) - 1
+        for a in range(u0, u1 + 1):
+            for b in range(v0, v1 + 1):
+                r = a * nv + b
+                c = init_cnt[r]
+                for i in range(c):
+                    iv[r, i, 0] = init_iv[r, i, 0]
+                    iv[r, i, 1] = init_iv[r, i, 1]
+                cnt[r] = c
+        overflow[t] = False
+        col_n[t] = 0
+        o = np.empty(3)
+        for q in range(start[t], start[t + 1]):
+            m = moves[q]
+            tlo, thi = bb_lo[m, k] - lo[k], bb_hi[m, k] - lo[k]
+            for a in range(max(u0, rng[m, 0]), min(u1, rng[m, 1]) + 1):
+                o[u] = lo[u] + (a + 0.5) * res
+                for b in range(max(v0, rng[m, 2]), min(v1, rng[m, 3]) + 1):
+                    r = a * nv + b
+                    n = cnt[r]
+                    if n == 0 or iv[r, n - 1, 1] <= tlo or iv[r, 0, 0] >= thi:
+                        continue
+                    o[v] = lo[v] + (b + 0.5) * res
+                    o[k] = lo[k]
+                    ta, tb = swept_tool(o[0], o[1], o[2], k, p0[m], p1[m], axis[m],
+                                        radius[m], length[m])
+                    if ta >= tb:
+                        continue
+                    n2, overlap, first = subtract(iv[r], n, ta, tb, kmax)
+                    if n2 < 0:
+                        overflow[t] = True
+                        break
+                    cnt[r] = n2
+                    if rapid[m] and overlap > COLLISION_OVERLAP:
+                        c = col_n[t]
+                        if c > 0 and col_move[t, c - 1] == m:
+                            c -= 1      # the same move: keep the point met first
+                            if _ahead(col_at[t, c], o, k, lo[k] + first, p0[m], p1[m]):
+                                continue
+                        elif c == MAX_COLLISIONS:
+                            continue
+                        col_move[t, c] = m
+                        col_at[t, c, u] = o[u]
+                        col_at[t, c, v] = o[v]
+                        col_at[t, c, k] = lo[k] + first
+                        col_n[t] = c + 1
+                if overflow[t]:
+                    break
+            if overflow[t]:
+                break
