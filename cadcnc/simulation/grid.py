@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.work import refuse_over
+from ..core.work_limits import refuse_over
 from .dexels import MAX_COLLISIONS, TILE, bin_moves, cut_tiles
 
 K0 = 4                    # intervals a ray holds at first (grown on demand)
