@@ -34,6 +34,7 @@ class Run:
     shank_top: float
     shank: float | None = None
     name: str = ""
+    scallop: float | None = None   # mm: the finish job's scallop target, if any
 
 
 def run_of_program(program: Program, setup=None, shank: float | None = None,
@@ -62,7 +63,8 @@ def run_of_program(program: Program, setup=None, shank: float | None = None,
     heights = (points - origin) @ axis
     clearance = job.clearance if job.clearance is not None else float(heights.max())
     return Run(points, np.concatenate(rapid), job.tool.radius, axis,
-               float(clearance + origin @ axis), shank, name)
+               float(clearance + origin @ axis), shank, name,
+               getattr(job.operation, "scallop", None))
 
 
 def run_of_gcode(points: np.ndarray, rapid: np.ndarray, radius: float,
