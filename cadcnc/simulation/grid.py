@@ -88,7 +88,7 @@ def check_limits(lo, hi, res: float, bb_lo, bb_hi, threads: int,
     nice = nice if nice >= fit else float(f"{fit * 1.1:.2g}")
     refuse_over(f"the stock at --resolution {res:g} mm ({rays(lo, hi, res):.3g} rays)",
                 memory / 1e9, max_memory / 1e9, "GB",
-                f"give --resolution {nice:g} or coarser")
+                f"give --resolution {nice:g} or coarser (limit {max_memory / 1e9:g} GB)")
     refuse_over(f"the simulation at --resolution {res:g} mm", seconds, max_seconds,
                 "s of cutting", f"give --resolution {nice:g} or coarser, or more --jobs")
 

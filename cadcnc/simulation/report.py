@@ -81,27 +81,34 @@ def refine(samples: Samples, distance, limit: float, deflection: float):
     return pts[deep], depth[deep], face[deep]
 
 
-def clusters(points, depths, faces, radius: float) -> list[dict]:
-    """One entry per face and neighbourhood (``radius`` mm), at its deepest point."""
+def clusters(points, depths, faces, reach: float) -> list[dict]:
+    """One entry per face and connected region (points chained within ``reach`` mm), at
+    its deepest point, deepest first."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    if not len(points):
+        return []
+    pairs = cKDTree(points).query_pairs(reach, output_type="ndarray")
+    pairs = pairs[faces[pairs[:, 0]] == faces[pairs[:, 1]]]
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])),
+                       shape=(len(points), len(points)))
+    _, label = connected_components(graph, directed=False)
     out = []
-    taken = np.zeros(len(points), bool)
-    for i in np.argsort(-depths):
-        if taken[i]:
-            continue
-        near = (~taken) & (faces == faces[i]) & \
-            (np.linalg.norm(points - points[i], axis=1) <= radius)
-        taken |= near
+    for c in np.unique(label):
+        members = np.flatnonzero(label == c)
+        i = members[np.argmax(depths[members])]
         out.append({"face": int(faces[i]), "depth_mm": float(depths[i]),
-                    "at": [float(c) for c in points[i]], "count": int(near.sum())})
-    return out
+                    "at": [float(v) for v in points[i]], "count": int(len(members))})
+    return sorted(out, key=lambda g: -g["depth_mm"])
 
 
 def build_report(part, runs, stock: Stock, samples: Samples, stock_desc: dict, distance,
                  limit: float, deflection: float, threshold: float) -> SimulationReport:
     """The :class:`SimulationReport` of a simulation (module doc)."""
     points, depths, gface = refine(samples, distance, limit, deflection)
-    radius = 2.0 * max(r.radius for r in runs)
-    gouges = clusters(points, depths, gface, radius)
+    gouges = clusters(points, depths, gface, 2.0 * stock.res * np.sqrt(3.0))
     faces = []
     for n in range(1, len(part) + 1):
         on = samples.face == n
