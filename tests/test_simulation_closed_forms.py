@@ -45,7 +45,7 @@ def test_swept_tool_is_the_set_within_r_of_the_parallelogram():
         length, r, k = rng.uniform(0.5, 5), rng.uniform(0.5, 2), int(rng.integers(3))
         o = rng.uniform(-2, 2, 3)
         o[k] = -20.0
-        ta, tb = swept_tool(o[0], o[1], o[2], k, p0, p1, ax, r, length)
+        ta, tb = swept_tool(o[0], o[1], o[2], k, *p0, *p1, *ax, r, length)
         e = np.eye(3)[k]
         for t in (ta, tb):
             if ta < tb:   # the interval's ends lie on the boundary, within 1e-9 mm
@@ -56,13 +56,13 @@ def test_swept_tool_is_the_set_within_r_of_the_parallelogram():
 
 
 def test_subtract_splits_and_overflows():
-    row = np.zeros((2, 2), np.float32)
-    row[0] = (0.0, 10.0)
-    n, overlap, first = subtract(row, 1, 2.0, 3.0, 2)
+    iv = np.zeros((1, 2, 2), np.float32)
+    iv[0, 0] = (0.0, 10.0)
+    n, overlap, first = subtract(iv, 0, 1, 2.0, 3.0, 2)
     assert n == 2 and overlap == pytest.approx(1.0) and first == pytest.approx(2.0)
-    assert row.tolist() == [[0.0, 2.0], [3.0, 10.0]]
-    assert subtract(row, 2, 5.0, 6.0, 2)[0] == -1          # a third piece needs K = 3
-    assert subtract(row, 2, -1.0, 11.0, 2)[0] == 0         # all removed
+    assert iv[0].tolist() == [[0.0, 2.0], [3.0, 10.0]]
+    assert subtract(iv, 0, 2, 5.0, 6.0, 2)[0] == -1          # a third piece needs K = 3
+    assert subtract(iv, 0, 2, -1.0, 11.0, 2)[0] == 0         # all removed
 
 
 def raster(stepover, radius, n_pass, x0=-1.0, x1=11.0, z=0.0):

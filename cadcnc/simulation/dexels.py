@@ -7,7 +7,8 @@ index is ``iu * nv + iv``. Intervals are stored as float32 offsets from ``lo[k]`
 tile by tile (``TILE`` x ``TILE`` rays) on every numba thread; a tile applies the moves that
 reach it in program order, so a rapid meets the stock exactly as the earlier moves left it.
 A tile whose ray would need more than K intervals stops and is flagged: the caller grows K
-and cuts that tile again from the initial stock (cutting is idempotent).
+and cuts that tile again from the initial stock (cutting is idempotent). numba's cache does
+not see edits of :mod:`.sweep` (inlined here): clear ``__pycache__/*.nb[ic]`` after one.
 """
 
 from __future__ import annotations
@@ -26,22 +27,23 @@ MAX_COLLISIONS = 16  # collisions recorded per tile (distinct moves, first point
 
 
 @njit(cache=True)
-def subtract(row, n, a, b, kmax):
-    """Remove [a, b] from the ``n`` sorted intervals of ``row`` (K, 2) in place: (new n, or
-    -1 when more than ``kmax`` would be needed; overlap length; t of the first overlap)."""
+def subtract(iv, r, n, a, b, kmax):
+    """Remove [a, b] from the ``n`` sorted intervals of ray ``r`` of ``iv`` (rays, K, 2) in
+    place: (new n, or -1 when more than ``kmax`` would be needed; overlap length; t of the
+    first overlap)."""
     i0 = 0
-    while i0 < n and row[i0, 1] <= a:
+    while i0 < n and iv[r, i0, 1] <= a:
         i0 += 1
     i1 = n - 1
-    while i1 >= i0 and row[i1, 0] >= b:
+    while i1 >= i0 and iv[r, i1, 0] >= b:
         i1 -= 1
     if i0 > i1:
         return n, 0.0, 0.0
     overlap = 0.0
     for i in range(i0, i1 + 1):
-        overlap += min(float(row[i, 1]), b) - max(float(row[i, 0]), a)
-    first = max(float(row[i0, 0]), a)
-    s0, e1 = float(row[i0, 0]), float(row[i1, 1])
+        overlap += min(float(iv[r, i, 1]), b) - max(float(iv[r, i, 0]), a)
+    first = max(float(iv[r, i0, 0]), a)
+    s0, e1 = float(iv[r, i0, 0]), float(iv[r, i1, 1])
     left = s0 < a - SLIVER
     right = e1 > b + SLIVER
     p = int(left) + int(right)
@@ -52,20 +54,20 @@ def subtract(row, n, a, b, kmax):
     shift = p - m
     if shift < 0:
         for i in range(i1 + 1, n):
-            row[i + shift, 0] = row[i, 0]
-            row[i + shift, 1] = row[i, 1]
+            iv[r, i + shift, 0] = iv[r, i, 0]
+            iv[r, i + shift, 1] = iv[r, i, 1]
     elif shift > 0:
         for i in range(n - 1, i1, -1):
-            row[i + shift, 0] = row[i, 0]
-            row[i + shift, 1] = row[i, 1]
+            iv[r, i + shift, 0] = iv[r, i, 0]
+            iv[r, i + shift, 1] = iv[r, i, 1]
     j = i0
     if left:
-        row[j, 0] = s0
-        row[j, 1] = a
+        iv[r, j, 0] = s0
+        iv[r, j, 1] = a
         j += 1
     if right:
-        row[j, 0] = b
-        row[j, 1] = e1
+        iv[r, j, 0] = b
+        iv[r, j, 1] = e1
     return new_n, overlap, first
 
 
@@ -147,6 +149,10 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, axis, radius
         for q in range(start[t], start[t + 1]):
             m = moves[q]
             tlo, thi = bb_lo[m, k] - lo[k], bb_hi[m, k] - lo[k]
+            a0, a1, a2 = p0[m, 0], p0[m, 1], p0[m, 2]
+            b0, b1, b2 = p1[m, 0], p1[m, 1], p1[m, 2]
+            x0, x1, x2 = axis[m, 0], axis[m, 1], axis[m, 2]
+            rad, ln = radius[m], length[m]
             for a in range(max(u0, rng[m, 0]), min(u1, rng[m, 1]) + 1):
                 o[u] = lo[u] + (a + 0.5) * res
                 for b in range(max(v0, rng[m, 2]), min(v1, rng[m, 3]) + 1):
@@ -156,11 +162,11 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, axis, radius
                         continue
                     o[v] = lo[v] + (b + 0.5) * res
                     o[k] = lo[k]
-                    ta, tb = swept_tool(o[0], o[1], o[2], k, p0[m], p1[m], axis[m],
-                                        radius[m], length[m])
+                    ta, tb = swept_tool(o[0], o[1], o[2], k, a0, a1, a2, b0, b1, b2,
+                                        x0, x1, x2, rad, ln)
                     if ta >= tb:
                         continue
-                    n2, overlap, first = subtract(iv[r], n, ta, tb, kmax)
+                    n2, overlap, first = subtract(iv, r, n, ta, tb, kmax)
                     if n2 < 0:
                         overflow[t] = True
                         break

@@ -99,11 +99,12 @@ def _slab(lo, hi, c0, c1, vmin, vmax):
 
 
 @njit(cache=True, error_model="numpy")
-def swept_tool(o0, o1, o2, k, p0, p1, ax, r, length):
+def swept_tool(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, ax0, ax1, ax2, r, length):
     """The line o + t e_k against the tool (ball ``r``, shank to ``length`` along the unit
-    axis ``ax`` (3,)) swept from ``p0`` (3,) to ``p1`` (3,): (t_in, t_out)."""
-    v0, v1, v2 = p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]
-    e0, e1, e2 = ax[0] * length, ax[1] * length, ax[2] * length
+    axis ``ax``) swept from ``p0`` to ``p1`` (each given by its 3 coordinates, scalars so
+    that a call allocates nothing): (t_in, t_out)."""
+    v0, v1, v2 = p10 - p00, p11 - p01, p12 - p02
+    e0, e1, e2 = ax0 * length, ax1 * length, ax2 * length
     # n = e x v: the parallelogram's normal (unnormalised)
     n0, n1, n2 = e1 * v2 - e2 * v1, e2 * v0 - e0 * v2, e0 * v1 - e1 * v0
     nn = n0 * n0 + n1 * n1 + n2 * n2
@@ -112,25 +113,46 @@ def swept_tool(o0, o1, o2, k, p0, p1, ax, r, length):
     if nn <= PARALLEL * vv * ee or vv == 0.0 or length == 0.0:
         # a segment: the move along the axis, a shankless ball, or no move
         if length == 0.0:
-            return capsule(o0, o1, o2, k, p0[0], p0[1], p0[2], p1[0], p1[1], p1[2], r)
-        s0 = min(0.0, v0 * ax[0] + v1 * ax[1] + v2 * ax[2])
-        s1 = max(0.0, v0 * ax[0] + v1 * ax[1] + v2 * ax[2]) + length
-        return capsule(o0, o1, o2, k, p0[0] + s0 * ax[0], p0[1] + s0 * ax[1],
-                       p0[2] + s0 * ax[2], p0[0] + s1 * ax[0], p0[1] + s1 * ax[1],
-                       p0[2] + s1 * ax[2], r)
-    lo, hi = capsule(o0, o1, o2, k, p0[0], p0[1], p0[2], p1[0], p1[1], p1[2], r)
-    t, u = capsule(o0, o1, o2, k, p0[0] + e0, p0[1] + e1, p0[2] + e2,
-                   p1[0] + e0, p1[1] + e1, p1[2] + e2, r)
+            return capsule(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, r)
+        s0 = min(0.0, v0 * ax0 + v1 * ax1 + v2 * ax2)
+        s1 = max(0.0, v0 * ax0 + v1 * ax1 + v2 * ax2) + length
+        return capsule(o0, o1, o2, k, p00 + s0 * ax0, p01 + s0 * ax1,
+                       p02 + s0 * ax2, p00 + s1 * ax0, p01 + s1 * ax1,
+                       p02 + s1 * ax2, r)
+    lo, hi = capsule(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, r)
+    ak = ax0 if k == 0 else (ax1 if k == 1 else ax2)
+    if ak == 1.0 or ak == -1.0:
+        # a ray along the axis: the swept balls' lowest and highest points on it come from
+        # the bottom and top edges, and it misses both or meets both (the same horizontal
+        # distance to them)
+        if lo > hi:
+            return lo, hi
+        t, u = capsule(o0, o1, o2, k, p00 + e0, p01 + e1, p02 + e2,
+                       p10 + e0, p11 + e1, p12 + e2, r)
+        if t > u:               # a grazing ray, met by one of them in round-off
+            return lo, hi
+        return min(lo, t), max(hi, u)
+    if ak == 0.0:
+        # a ray across the axis at height h above p0: where every vertical segment of the
+        # parallelogram spans h, the slice is the 2-D stadium of the moved segment
+        h = (o0 - p00) * ax0 + (o1 - p01) * ax1 + (o2 - p02) * ax2
+        hv = v0 * ax0 + v1 * ax1 + v2 * ax2
+        if max(0.0, hv) <= h <= min(0.0, hv) + length:
+            return capsule(o0, o1, o2, k, p00 + h * ax0, p01 + h * ax1,
+                           p02 + h * ax2, p10 + (h - hv) * ax0,
+                           p11 + (h - hv) * ax1, p12 + (h - hv) * ax2, r)
+    t, u = capsule(o0, o1, o2, k, p00 + e0, p01 + e1, p02 + e2,
+                   p10 + e0, p11 + e1, p12 + e2, r)
     if t <= u:
         lo, hi = (t, u) if lo > hi else (min(lo, t), max(hi, u))
-    t, u = capsule(o0, o1, o2, k, p0[0], p0[1], p0[2], p0[0] + e0, p0[1] + e1, p0[2] + e2, r)
+    t, u = capsule(o0, o1, o2, k, p00, p01, p02, p00 + e0, p01 + e1, p02 + e2, r)
     if t <= u:
         lo, hi = (t, u) if lo > hi else (min(lo, t), max(hi, u))
-    t, u = capsule(o0, o1, o2, k, p1[0], p1[1], p1[2], p1[0] + e0, p1[1] + e1, p1[2] + e2, r)
+    t, u = capsule(o0, o1, o2, k, p10, p11, p12, p10 + e0, p11 + e1, p12 + e2, r)
     if t <= u:
         lo, hi = (t, u) if lo > hi else (min(lo, t), max(hi, u))
     # the slab: x - p0 = alpha e + beta v + gamma n, 0 <= alpha, beta <= 1, |gamma| |n| <= r
-    w0, w1, w2 = o0 - p0[0], o1 - p0[1], o2 - p0[2]
+    w0, w1, w2 = o0 - p00, o1 - p01, o2 - p02
     # dual vectors: f_e = (v x n) / (e . (v x n)), f_v = (n x e) / (v . (n x e))
     g0, g1, g2 = v1 * n2 - v2 * n1, v2 * n0 - v0 * n2, v0 * n1 - v1 * n0
     ge = g0 * e0 + g1 * e1 + g2 * e2
