@@ -120,11 +120,12 @@ def bin_moves(k, lo, res, nu, nv, bb_lo, bb_hi):
 
 @njit(cache=True, parallel=True)
 def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, axis, radius, length,
-              rapid, bb_lo, bb_hi, init_iv, init_cnt, iv, cnt, overflow, col_move, col_at,
-              col_n):
+              rapid, bb_lo, bb_hi, init_iv, init_cnt, iv, cnt, ext, overflow, col_move,
+              col_at, col_n):
     """Cut the grid's ``tiles`` (indices) by their moves: each ray starts from ``init_iv``,
     ``init_cnt`` and loses every move's swept tool (:func:`swept_tool`); p0, p1, axis
-    (N, 3), radius, length (N,), rapid (N,) bool. Writes ``iv``, ``cnt``; ``overflow[t]``
+    (N, 3), radius, length (N,), rapid (N,) bool. Writes ``iv``, ``cnt`` and ``ext`` (rays,
+    2): each ray's first start and last end, read first (one cache line for a ray missed); ``overflow[t]``
     for a tile that needs more intervals; rapids through material into ``col_*`` (per
     tile: moves (T, C), points (T, C, 3), counts (T,))."""
     u, v = (k + 1) % 3, (k + 2) % 3
@@ -143,6 +144,9 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, axis, radius
                     iv[r, i, 0] = init_iv[r, i, 0]
                     iv[r, i, 1] = init_iv[r, i, 1]
                 cnt[r] = c
+                if c > 0:
+                    ext[r, 0] = init_iv[r, 0, 0]
+                    ext[r, 1] = init_iv[r, c - 1, 1]
         overflow[t] = False
         col_n[t] = 0
         o = np.empty(3)
@@ -157,8 +161,10 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, axis, radius
                 o[u] = lo[u] + (a + 0.5) * res
                 for b in range(max(v0, rng[m, 2]), min(v1, rng[m, 3]) + 1):
                     r = a * nv + b
+                    if ext[r, 1] <= tlo or ext[r, 0] >= thi:
+                        continue
                     n = cnt[r]
-                    if n == 0 or iv[r, n - 1, 1] <= tlo or iv[r, 0, 0] >= thi:
+                    if n == 0:
                         continue
                     o[v] = lo[v] + (b + 0.5) * res
                     o[k] = lo[k]
@@ -171,6 +177,11 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, axis, radius
                         overflow[t] = True
                         break
                     cnt[r] = n2
+                    if n2 > 0:
+                        ext[r, 0] = iv[r, 0, 0]
+                        ext[r, 1] = iv[r, n2 - 1, 1]
+                    else:
+                        ext[r, 0], ext[r, 1] = 1.0, -1.0
                     if rapid[m] and overlap > COLLISION_OVERLAP:
                         c = col_n[t]
                         if c > 0 and col_move[t, c - 1] == m:

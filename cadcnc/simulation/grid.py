@@ -18,7 +18,7 @@ from ..core.work_limits import refuse_over
 from .dexels import MAX_COLLISIONS, TILE, bin_moves, cut_tiles
 
 K0 = 4                    # intervals a ray holds at first (grown on demand)
-BYTES_PER_RAY = 72        # K0 intervals (float32 pairs), counts, initial stock, part crossings
+BYTES_PER_RAY = 80        # K0 intervals (float32 pairs), counts, extents, initial stock, part crossings
 NS_PER_EVALUATION = 4.0   # ns of one core per ray a move's box covers (benchmarks/simulation)
 MAX_MEMORY = 6e9          # bytes one simulation may hold
 MAX_SECONDS = 1800.0      # estimated seconds of cutting one simulation may take
@@ -109,9 +109,11 @@ def box_grids(lo, hi, res: float) -> tuple[list[Grid], list[tuple[np.ndarray, np
     return grids, inits
 
 
-def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves) -> list[tuple[int, np.ndarray]]:
+def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
+        max_memory: float = MAX_MEMORY) -> list[tuple[int, np.ndarray]]:
     """Cut ``grid`` by ``moves`` (a :class:`~.moves.Moves`) from its initial stock, growing
-    K where a ray needs it; the rapids through material: [(move, point (3,))]."""
+    K where a ray needs it (refused past ``max_memory`` bytes); the rapids through
+    material: [(move, point (3,))]."""
     start, order, rng = bin_moves(grid.k, grid.lo, grid.res, grid.nu, grid.nv,
                                   moves.bb_lo, moves.bb_hi)
     ntiles = len(start) - 1
@@ -121,15 +123,22 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves) -> list[tuple[in
     col_at = np.zeros((ntiles, MAX_COLLISIONS, 3))
     col_n = np.zeros(ntiles, np.int64)
     init_iv, init_cnt = init
+    ext = np.empty((len(grid.cnt), 2), np.float32)
+    ext[:, 0], ext[:, 1] = 1.0, -1.0
     if grid.iv.shape[1] < init_iv.shape[1]:
         grid.iv = np.zeros((len(grid.cnt), init_iv.shape[1], 2), np.float32)
     while len(tiles):
         cut_tiles(grid.k, grid.lo, grid.res, grid.nu, grid.nv, tiles, start, order, rng,
                   moves.p0, moves.p1, moves.axis, moves.radius, moves.length, moves.rapid,
-                  moves.bb_lo, moves.bb_hi, init_iv, init_cnt, grid.iv, grid.cnt, overflow,
-                  col_move, col_at, col_n)
+                  moves.bb_lo, moves.bb_hi, init_iv, init_cnt, grid.iv, grid.cnt, ext,
+                  overflow, col_move, col_at, col_n)
         tiles = np.flatnonzero(overflow)
         if len(tiles):
+            need = len(grid.cnt) * 2 * grid.iv.shape[1] * 8.0
+            refuse_over(f"the grid along {'XYZ'[grid.k]} at --resolution {grid.res:g} mm "
+                        f"({2 * grid.iv.shape[1]} pieces of material on a ray)", need / 1e9,
+                        max_memory / 1e9, "GB", "give a coarser --resolution (memory goes "
+                        "as its inverse square)")
             grown = np.zeros((len(grid.cnt), 2 * grid.iv.shape[1], 2), np.float32)
             grown[:, :grid.iv.shape[1]] = grid.iv
             grid.iv = grown

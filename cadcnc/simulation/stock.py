@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from .grid import Grid, box_grids, check_limits, cut
+from .grid import MAX_MEMORY, Grid, box_grids, check_limits, cut
 from .moves import Moves, Run, moves_of_runs
 
 
@@ -67,7 +67,7 @@ def cut_stock(lo, hi, res: float, runs: list[Run], jobs: int | None = None,
     numba.set_num_threads(threads)
     collisions: dict[int, np.ndarray] = {}
     for g, init in zip(grids, inits):
-        for m, at in cut(g, init, moves):   # keep the point met first along the move
+        for m, at in cut(g, init, moves, (limits or {}).get("max_memory", MAX_MEMORY)):   # keep the point met first along the move
             v = moves.p1[m] - moves.p0[m]
             if m not in collisions or at @ v < collisions[m] @ v:
                 collisions[m] = at
