@@ -104,3 +104,17 @@ def test_gcode_through_rs274_and_the_command_exit_codes(tmp_path):
     assert "--radius" in run.stderr and not (tmp_path / "x.json").exists()
     cadcnc_cli("simulate", POCKET, ngc, "--radius", R, "--stock", "offset", "x", "-o",
                tmp_path / "x.json", check=EXIT_INPUT)
+
+
+def test_a_step_stock_and_an_offset_stock(part):
+    """The part itself as the stock holds the part's volume (within 0.1 %); the part offset
+    by 0.5 mm (OCCT's offset) holds more, within 20 %."""
+    far = [run([(-80, 0, 40), (-70, 0, 40)])]
+    same = simulate(part, far, stock=str(POCKET), resolution=0.5, jobs=1)
+    volume = json.loads((FIXTURES / "fixtures.json").read_text())["pocket"]["volume"]
+    assert same.stock.volume() == pytest.approx(volume, rel=1e-3)
+    assert same.to_dict()["stock"]["kind"] == "step" and same.to_dict()["gouges"] == []
+    grown = simulate(part, far, stock=0.5, resolution=0.5, jobs=1)
+    assert grown.to_dict()["stock"] == {**grown.to_dict()["stock"], "kind": "offset",
+                                        "offset_mm": 0.5}
+    assert volume < grown.stock.volume() < volume * 1.2
