@@ -6,22 +6,17 @@ resolution."""
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
 
 import cadcnc
 from cadcnc.simulation.run import simulate
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+from helpers.six_pockets import AXES, FACTS, R, STEP
 
 pytestmark = pytest.mark.slow
 
-STEP = FIXTURES / "six_pockets.step"
-FACTS = json.loads((FIXTURES / "setup_fixtures.json").read_text())
-R, RES = FACTS["radius"], 0.1
-AXES = {"+X": (1, 0, 0), "-X": (-1, 0, 0), "+Y": (0, 1, 0), "-Y": (0, -1, 0), "+Z": (0, 0, 1),
-        "-Z": (0, 0, -1)}
+RES = 0.1
 
 
 @pytest.fixture(scope="module")

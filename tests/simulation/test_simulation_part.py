@@ -14,7 +14,8 @@ import cadcnc
 from cadcnc.core.errors import EXIT_GOUGE, EXIT_INPUT, EXIT_OK, InputError
 from cadcnc.simulation.moves import Run
 from cadcnc.simulation.run import simulate
-from conftest import FIXTURES, cadcnc_cli
+from helpers.cli import cadcnc_cli
+from helpers.fixtures import FIXTURES
 
 POCKET = FIXTURES / "pocket.step"
 R, RES, FLOOR = 3.0, 0.2, 15.0
