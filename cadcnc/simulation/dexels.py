@@ -31,12 +31,22 @@ def subtract(iv, r, n, a, b, kmax):
     """Remove [a, b] from the ``n`` sorted intervals of ray ``r`` of ``iv`` (rays, K, 2) in
     place: (new n, or -1 when more than ``kmax`` would be needed; overlap length; t of the
     first overlap)."""
-    i0 = 0
-    while i0 < n and iv[r, i0, 1] <= a:
-        i0 += 1
-    i1 = n - 1
-    while i1 >= i0 and iv[r, i1, 0] >= b:
-        i1 -= 1
+    lo_, hi_ = 0, n            # i0: the first interval ending after a (binary search)
+    while lo_ < hi_:
+        mid = (lo_ + hi_) >> 1
+        if iv[r, mid, 1] <= a:
+            lo_ = mid + 1
+        else:
+            hi_ = mid
+    i0 = lo_
+    lo_, hi_ = i0, n           # i1 + 1: the first interval starting at or after b
+    while lo_ < hi_:
+        mid = (lo_ + hi_) >> 1
+        if iv[r, mid, 0] < b:
+            lo_ = mid + 1
+        else:
+            hi_ = mid
+    i1 = lo_ - 1
     if i0 > i1:
         return n, 0.0, 0.0
     overlap = 0.0
@@ -169,7 +179,7 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, axis, radius
                     o[v] = lo[v] + (b + 0.5) * res
                     o[k] = lo[k]
                     ta, tb = swept_tool(o[0], o[1], o[2], k, a0, a1, a2, b0, b1, b2,
-                                        x0, x1, x2, rad, ln)
+                                        x0, x1, x2, rad, ln, ext[r, 0], ext[r, 1])
                     if ta >= tb:
                         continue
                     n2, overlap, first = subtract(iv, r, n, ta, tb, kmax)

@@ -99,10 +99,12 @@ def _slab(lo, hi, c0, c1, vmin, vmax):
 
 
 @njit(cache=True, error_model="numpy")
-def swept_tool(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, ax0, ax1, ax2, r, length):
+def swept_tool(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, ax0, ax1, ax2, r, length,
+               tmin=-1e300, tmax=1e300):
     """The line o + t e_k against the tool (ball ``r``, shank to ``length`` along the unit
     axis ``ax``) swept from ``p0`` to ``p1`` (each given by its 3 coordinates, scalars so
-    that a call allocates nothing): (t_in, t_out)."""
+    that a call allocates nothing): (t_in, t_out). ``tmin``, ``tmax``: where the ray's
+    material lies; an end of the swept interval beyond them may be returned as +-1e300."""
     v0, v1, v2 = p10 - p00, p11 - p01, p12 - p02
     e0, e1, e2 = ax0 * length, ax1 * length, ax2 * length
     # n = e x v: the parallelogram's normal (unnormalised)
@@ -127,6 +129,12 @@ def swept_tool(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, ax0, ax1, ax2, r, le
         # distance to them)
         if lo > hi:
             return lo, hi
+        ok, pk0, pk1 = (o0, p00, p10) if k == 0 else ((o1, p01, p11) if k == 1 else
+                                                       (o2, p02, p12))
+        if ak > 0.0 and min(pk0, pk1) + length - ok >= tmax:
+            return lo, 1e300       # the shank reaches past the material
+        if ak < 0.0 and max(pk0, pk1) - length - ok <= tmin:
+            return -1e300, hi
         t, u = capsule(o0, o1, o2, k, p00 + e0, p01 + e1, p02 + e2,
                        p10 + e0, p11 + e1, p12 + e2, r)
         if t > u:               # a grazing ray, met by one of them in round-off
@@ -137,10 +145,25 @@ def swept_tool(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, ax0, ax1, ax2, r, le
         # parallelogram spans h, the slice is the 2-D stadium of the moved segment
         h = (o0 - p00) * ax0 + (o1 - p01) * ax1 + (o2 - p02) * ax2
         hv = v0 * ax0 + v1 * ax1 + v2 * ax2
+        if h <= min(0.0, hv):
+            return lo, hi          # below both centres: the bottom edge's balls alone
         if max(0.0, hv) <= h <= min(0.0, hv) + length:
             return capsule(o0, o1, o2, k, p00 + h * ax0, p01 + h * ax1,
                            p02 + h * ax2, p10 + (h - hv) * ax0,
                            p11 + (h - hv) * ax1, p12 + (h - hv) * ax2, r)
+        if h <= min(0.0, hv) + length:
+            # between the centres' heights: the balls below h, and the stadium of the part
+            # of the moved segment whose vertical segments span h (s hv <= h)
+            sa, sb = (0.0, h / hv) if hv > 0.0 else (h / hv, 1.0)
+            t, u = capsule(o0, o1, o2, k, p00 + sa * v0 + (h - sa * hv) * ax0,
+                           p01 + sa * v1 + (h - sa * hv) * ax1,
+                           p02 + sa * v2 + (h - sa * hv) * ax2,
+                           p00 + sb * v0 + (h - sb * hv) * ax0,
+                           p01 + sb * v1 + (h - sb * hv) * ax1,
+                           p02 + sb * v2 + (h - sb * hv) * ax2, r)
+            if t > u:
+                return lo, hi
+            return (t, u) if lo > hi else (min(lo, t), max(hi, u))
     t, u = capsule(o0, o1, o2, k, p00 + e0, p01 + e1, p02 + e2,
                    p10 + e0, p11 + e1, p12 + e2, r)
     if t <= u:
