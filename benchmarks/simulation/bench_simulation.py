@@ -16,7 +16,7 @@ import numba
 import numpy as np
 
 from cadcnc.simulation.grid import evaluations, rays
-from cadcnc.simulation.moves import Run
+from cadcnc.simulation.tool_moves import Run
 from cadcnc.simulation.stock import cut_stock
 
 LO, HI = np.array([0.0, 0.0, 0.0]), np.array([100.0, 100.0, 50.0])

@@ -1,6 +1,6 @@
 """``cadcnc simulate``: the stock cut by programs, compared with the part (docs/simulate.md).
 
-Parses, calls :func:`cadcnc.simulation.run.simulate`, writes the outputs (all or none),
+Parses, calls :func:`cadcnc.simulation.simulator.simulate`, writes the outputs (all or none),
 prints the summary. Exit 0 no gouge and no collision, 5 a gouge deeper than
 ``--gouge-tolerance`` or a rapid through stock (the report and pictures are written all the
 same: they show where), 2 bad input or work over its limit, 4 an output that cannot be
@@ -63,8 +63,8 @@ def _stock(words: list[str]):
 
 def simulate_command(args) -> int:
     import cadcnc  # ~1.5 s (OCCT): not for --help
-    from cadcnc.simulation.outputs import check_outputs, write_outputs
-    from cadcnc.simulation.run import simulate
+    from cadcnc.simulation.report_files import check_outputs, write_outputs
+    from cadcnc.simulation.simulator import simulate
 
     from .options import tolerances
 

@@ -8,7 +8,7 @@ tile by tile (``TILE`` x ``TILE`` rays) on every numba thread; a tile applies th
 reach it in program order, so a rapid meets the stock exactly as the earlier moves left it.
 A tile whose ray would need more than K intervals stops and is flagged: the caller grows K
 and cuts that tile again from the initial stock (cutting is idempotent). numba's cache does
-not see edits of :mod:`.sweep` (inlined here): clear ``__pycache__/*.nb[ic]`` after one.
+not see edits of :mod:`.tool_sweep` (inlined here): clear ``__pycache__/*.nb[ic]`` after one.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .sweep import swept_tool
+from .tool_sweep import swept_tool
 
 TILE = 32
 SLIVER = 1e-6        # mm: a piece of material shorter than this along a ray is dropped

@@ -1,5 +1,5 @@
 """The tri-dexel stock: three dexel grids (rays along X, Y and Z) over one box, at one
-resolution, and their cutting by a list of moves (:mod:`.dexels`, :mod:`.moves`).
+resolution, and their cutting by a list of moves (:mod:`.dexels`, :mod:`.tool_moves`).
 
 Sizes: the box lo..hi (3,) mm holds ``n[i] = ceil((hi[i] - lo[i]) / res)`` cells along
 axis i; the grid along k has ``n[u] * n[v]`` rays. Memory and work are estimated before

@@ -13,7 +13,7 @@ import numba
 import numpy as np
 
 from .grid import MAX_MEMORY, Grid, box_grids, check_limits, cut
-from .moves import Moves, Run, moves_of_runs
+from .tool_moves import Moves, Run, moves_of_runs
 
 
 @dataclass

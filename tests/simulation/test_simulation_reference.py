@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from cadcnc.simulation.moves import Run
+from cadcnc.simulation.tool_moves import Run
 from cadcnc.simulation.stock import cut_stock
 
 manifold3d = pytest.importorskip("manifold3d")

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.simulation.run import simulate
+from cadcnc.simulation.simulator import simulate
 from helpers.cli import cadcnc_cli
 from helpers.six_pockets import AXES, FACTS, R, STEP
 

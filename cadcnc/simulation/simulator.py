@@ -5,7 +5,7 @@ Steps: the stock (the part's box grown by a margin, the part offset, or a STEP s
 three dexel grids; every program's moves cut in order (:mod:`.stock`); the part's mesh
 met by the same rays (:mod:`.part_rays`) and the stock measured at each crossing
 (:mod:`.compare`); the suspected gouges measured again by OCCT's exact distance
-(:mod:`cadcnc.verification.stock_part`); the report (:mod:`.report`).
+(:mod:`cadcnc.verification.stock_part`); the report (:mod:`.stock_report`).
 """
 
 from __future__ import annotations
@@ -19,14 +19,14 @@ import numpy as np
 from ..core.errors import InputError
 from ..geometry.part import Part
 from ..io.program_json import read_program_and_setup
-from ..io.rs274 import gcode_moves
+from ..io.gcode_reader import gcode_moves
 from ..program.program import Program
 from ..verification.stock_part import (PartDistance, offset_triangles, part_triangles,
                                        step_triangles)
 from .compare import joined, sample_grid
-from .moves import Run, run_of_gcode, run_of_program
+from .tool_moves import Run, run_of_gcode, run_of_program
 from .part_rays import crossings, solid_intervals
-from .report import SimulationReport, build_report
+from .stock_report import SimulationReport, build_report
 from .stock import cut_stock
 
 MARGIN = 1.0          # mm: the default stock box grows the part's box by this on every side

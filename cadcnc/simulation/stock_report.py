@@ -24,7 +24,7 @@ MAX_GOUGES = 50      # gouge clusters listed
 
 @dataclass
 class SimulationReport:
-    """What :func:`~cadcnc.simulation.run.simulate` found (module doc); ``stock`` and
+    """What :func:`~cadcnc.simulation.simulator.simulate` found (module doc); ``stock`` and
     ``samples`` keep the arrays the pictures draw."""
 
     data: dict

@@ -2,7 +2,7 @@
 
 The tool is a ball of radius R (centre c) on a shank of radius R along the unit tool axis
 ``a`` up to ``c + L a``: the set of points within R of the segment [c, c + L a] (a capsule;
-its top cap lies above the stock when L reaches past it, see :mod:`.moves`). Moved from
+its top cap lies above the stock when L reaches past it, see :mod:`.tool_moves`). Moved from
 ``p0`` to ``p1`` (v = p1 - p0) it sweeps the points within R of the parallelogram
 {p0 + s v + h a : s in [0, 1], h in [0, L]}: the parallelogram's slab (thickness 2R along
 its normal) united with the capsules of its four edges. That set is convex, so a line meets
@@ -164,6 +164,16 @@ def swept_tool(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, ax0, ax1, ax2, r, le
             if t > u:
                 return lo, hi
             return (t, u) if lo > hi else (min(lo, t), max(hi, u))
+    return _parallelogram(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, v0, v1, v2, e0, e1,
+                          e2, n0, n1, n2, r, lo, hi)
+
+
+@njit(cache=True, error_model="numpy")
+def _parallelogram(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, v0, v1, v2, e0, e1, e2, n0,
+                   n1, n2, r, lo, hi):
+    """The general case of :func:`swept_tool`: [lo, hi] (the bottom edge's capsule) united
+    with the other three edges' capsules and the parallelogram's slab (normal n = e x v)."""
+    nn = n0 * n0 + n1 * n1 + n2 * n2
     t, u = capsule(o0, o1, o2, k, p00 + e0, p01 + e1, p02 + e2,
                    p10 + e0, p11 + e1, p12 + e2, r)
     if t <= u:

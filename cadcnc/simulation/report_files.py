@@ -9,7 +9,7 @@ from pathlib import Path
 from ..core.jsonable import plain
 from ..io.output_set import OutputSet
 from ..io.simulation_plot import SUFFIXES, glb_bytes, png_bytes, stl_bytes
-from .report import SimulationReport
+from .stock_report import SimulationReport
 from .stock_mesh import height_field_mesh
 
 
