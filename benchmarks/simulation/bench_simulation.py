@@ -10,6 +10,7 @@ The issue's target: 1e5 moves at 0.05 mm in at most 60 s on 2 cores (docs/simula
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numba
@@ -47,17 +48,19 @@ def main(argv=None) -> int:
     ap.add_argument("--resolution", type=float, default=0.05)
     ap.add_argument("--jobs", type=int, default=None)
     args = ap.parse_args(argv)
+    load = os.getloadavg()[0]
     run = raster(args.moves)
     warm = Run(run.points[:50], run.rapid[:49], R, run.axis, CLEARANCE)
     cut_stock(LO, HI, 1.0, [warm], jobs=args.jobs)          # compile / load the cache
-    clock = time.perf_counter()
+    clock, cpu = time.perf_counter(), time.process_time()
     stock = cut_stock(LO, HI, args.resolution, [run], jobs=args.jobs)
-    seconds = time.perf_counter() - clock
+    seconds, cpu = time.perf_counter() - clock, time.process_time() - cpu
     n, nr = len(stock.moves), rays(LO, HI, args.resolution)
     ev = evaluations(LO, HI, args.resolution, stock.moves.bb_lo, stock.moves.bb_hi)
     mem = sum(g.iv.nbytes + g.cnt.nbytes for g in stock.grids)
     print(f"{n} moves on {nr:.3g} rays ({HI - LO} mm at {args.resolution} mm), "
-          f"{numba.get_num_threads()} threads: {seconds:.1f} s")
+          f"{numba.get_num_threads()} threads: {seconds:.1f} s ({cpu:.1f} s of CPU; load "
+          f"average before {load:.1f})")
     print(f"  per move {seconds / n * 1e6:.0f} us; per ray {seconds / nr * 1e6:.2f} us; per "
           f"ray a move's box covers {seconds / ev * 1e9:.2f} ns ({ev:.3g} of them)")
     print(f"  intervals per ray at most {max(g.iv.shape[1] for g in stock.grids)}; "
