@@ -17,8 +17,8 @@ import numba
 import numpy as np
 
 from cadcnc.simulation.grid import evaluations, rays
-from cadcnc.simulation.tool_moves import Run
 from cadcnc.simulation.stock import cut_stock
+from cadcnc.simulation.tool_moves import Run
 
 LO, HI = np.array([0.0, 0.0, 0.0]), np.array([100.0, 100.0, 50.0])
 R, CLEARANCE = 3.0, 60.0

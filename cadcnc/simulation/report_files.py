@@ -9,8 +9,8 @@ from pathlib import Path
 from ..core.jsonable import plain
 from ..io.output_set import OutputSet
 from ..io.simulation_plot import SUFFIXES, glb_bytes, png_bytes, stl_bytes
-from .stock_report import SimulationReport
 from .stock_mesh import height_field_mesh
+from .stock_report import SimulationReport
 
 
 def check_outputs(outs, inputs=()) -> OutputSet:

@@ -18,16 +18,15 @@ import numpy as np
 
 from ..core.errors import InputError
 from ..geometry.part import Part
-from ..io.program_json import read_program_and_setup
 from ..io.gcode_reader import gcode_moves
+from ..io.program_json import read_program_and_setup
 from ..program.program import Program
-from ..verification.stock_part import (PartDistance, offset_triangles, part_triangles,
-                                       step_triangles)
+from ..verification.stock_part import PartDistance, offset_triangles, part_triangles, step_triangles
 from .compare import joined, sample_grid
-from .tool_moves import Run, run_of_gcode, run_of_program
 from .part_rays import crossings, solid_intervals
-from .stock_report import SimulationReport, build_report
 from .stock import cut_stock
+from .stock_report import SimulationReport, build_report
+from .tool_moves import Run, run_of_gcode, run_of_program
 
 MARGIN = 1.0          # mm: the default stock box grows the part's box by this on every side
 RESOLUTION = 0.1      # mm: the default ray spacing

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from cadcnc.simulation.dexels import subtract
-from cadcnc.simulation.tool_moves import Run
 from cadcnc.simulation.stock import cut_stock
+from cadcnc.simulation.tool_moves import Run
 from cadcnc.simulation.tool_sweep import swept_tool
 
 UP = np.array([0.0, 0.0, 1.0])

@@ -12,8 +12,8 @@ import pytest
 
 import cadcnc
 from cadcnc.core.errors import EXIT_GOUGE, EXIT_INPUT, EXIT_OK, InputError
-from cadcnc.simulation.tool_moves import Run
 from cadcnc.simulation.simulator import simulate
+from cadcnc.simulation.tool_moves import Run
 from helpers.cli import cadcnc_cli
 from helpers.fixtures import FIXTURES
 

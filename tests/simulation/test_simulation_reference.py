@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from cadcnc.simulation.tool_moves import Run
 from cadcnc.simulation.stock import cut_stock
+from cadcnc.simulation.tool_moves import Run
 
 manifold3d = pytest.importorskip("manifold3d")
 

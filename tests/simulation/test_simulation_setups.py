@@ -12,7 +12,7 @@ import pytest
 import cadcnc
 from cadcnc.simulation.simulator import simulate
 from helpers.cli import cadcnc_cli
-from helpers.six_pockets import AXES, FACTS, R, STEP
+from helpers.six_pockets import AXES, FACTS, STEP, R
 
 pytestmark = pytest.mark.slow
 
