@@ -64,12 +64,16 @@ def cut_stock(lo, hi, res: float, runs: list[Run], jobs: int | None = None,
     grids, inits = box_grids(lo, hi, res)
     if initial is not None:
         inits = list(initial)
+    before = numba.get_num_threads()
     numba.set_num_threads(threads)
     collisions: dict[int, np.ndarray] = {}
-    for g, init in zip(grids, inits):
-        for m, at in cut(g, init, moves, (limits or {}).get("max_memory", MAX_MEMORY)):   # keep the point met first along the move
-            v = moves.p1[m] - moves.p0[m]
-            if m not in collisions or at @ v < collisions[m] @ v:
-                collisions[m] = at
+    try:
+        for g, init in zip(grids, inits):
+            for m, at in cut(g, init, moves, (limits or {}).get("max_memory", MAX_MEMORY)):
+                v = moves.p1[m] - moves.p0[m]      # keep the point met first along the move
+                if m not in collisions or at @ v < collisions[m] @ v:
+                    collisions[m] = at
+    finally:
+        numba.set_num_threads(before)
     found = [Collision(m, int(moves.run[m]), collisions[m]) for m in sorted(collisions)]
     return Stock(lo, hi, res, grids, moves, found)
