@@ -6,7 +6,7 @@ The public API (docs/api.md): a part (:class:`Part`, :func:`load_step`), a job
 to run every operation (:func:`run`; :func:`finish`, the finishing shortcut of a CadQuery
 script), the :class:`Program` it returns (:func:`read_program`), the gate
 (:func:`gate_program`), CQ-editor (:func:`show_program`), the real-time stepper
-(:func:`make_stepper`) and the errors' root (:class:`CadcncError`, :class:`InputError`).
+(:func:`make_stepper`), the stock simulation (:func:`simulate`) and the errors' root (:class:`CadcncError`, :class:`InputError`).
 Everything else is in its stage's module (docs/architecture.md). Units: mm, mm/min, s.
 
 The names that need OCCT are loaded on first use: importing OCCT takes about 1.5 s, which
@@ -27,7 +27,7 @@ _LAZY = {
     "run": "ops.run", "finish": "ops.finish.shortcut",
     "Program": "program.program", "read_program": "io.program_json",
     "gate_program": "verification", "show_program": "io.program_cq",
-    "make_stepper": "ops.path.pair_path",
+    "make_stepper": "ops.path.pair_path", "simulate": "simulation.simulator",
 }
 
 __all__ = ["CadcncError", "InputError", "Job", "Tool", "PairPath", "Pencil", "Raster",

@@ -138,7 +138,7 @@ LONG_FUNCTIONS = {
         86, "the report's text, one line of the table after another: a split would cut "
             "one table in two places"),
     "cadcnc.cli.app.build_parser": (
-        86, "the command line's subcommands declared in one place, in the order --help "
+        87, "the command line's subcommands declared in one place, in the order --help "
             "shows them"),
 }
 """Functions allowed over FUNCTION_LINES, each at most as long as it is today."""
@@ -190,7 +190,7 @@ def test_no_flat_verification_modules():
     assert (PKG / "verification" / "__init__.py").is_file()
 
 
-NO_OCCT_STAGES = ("cadcnc.ops", "cadcnc.program", "cadcnc.controller")
+NO_OCCT_STAGES = ("cadcnc.ops", "cadcnc.program", "cadcnc.controller", "cadcnc.simulation")
 
 
 @pytest.mark.parametrize("name", sorted(n for n in MODULES if n.startswith(NO_OCCT_STAGES)))
@@ -217,7 +217,7 @@ def test_no_private_name_imported_across_modules():
 
 
 STAGES = ["core", "interp", "geometry", "parallel", "guard", "program", "ops", "controller",
-          "io", "verification", "apt", "pipeline", "batch", "cli", "testing"]
+          "io", "verification", "simulation", "apt", "pipeline", "batch", "cli", "testing"]
 """The data flow, in the order the code has (docs/architecture.md): a stage imports only from
 itself and the stages before it. ``testing`` (the independent references the tests and the
 benchmarks share) comes last: nothing in cadcnc imports it."""

@@ -18,7 +18,7 @@ from cadcnc.core.errors import EXIT_INTERRUPTED, CadcncError  # light: the packa
 from cadcnc.core.interrupts import sigint_deferred
 from cadcnc.parallel import pool
 
-from . import batch_options, finish_options, pencil_options, stream_options
+from . import batch_options, finish_options, pencil_options, simulate_options, stream_options
 from .commands import handler
 from .operation_options import DEFAULT_FEED, DEFAULT_PERIOD, add_axis_options, add_max_cycles
 
@@ -138,6 +138,7 @@ def build_parser() -> argparse.ArgumentParser:
     finish_options.add_parser(add, _flip_option, _gouge_options, _gcode_options)
     stream_options.add_parser(add, _flip_option, _gouge_options)
     batch_options.add_parser(add, parser)
+    simulate_options.add_parser(add, _gouge_options)
 
     p = add("run", "execute an APT-like part program (PATH = P/[...])",
             "Execute an APT-like part program (grammar: docs/notes/apt.md). Prints a summary per "

@@ -24,6 +24,7 @@ HANDLERS = {
     "demo": "cadcnc.cli.demo_command:demo",
     "plot": "cadcnc.cli.program_commands:plot",
     "verify": "cadcnc.cli.program_commands:verify",
+    "simulate": "cadcnc.cli.simulate_command:simulate",
 }
 """``{command: "module:function"}`` of every command's handler."""
 

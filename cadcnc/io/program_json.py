@@ -193,3 +193,12 @@ def read_program(file) -> Program:
     """Read a program (version 2) or toolpath (version 1) JSON file; errors name the file."""
     require("file", file, (str, os.PathLike), "a JSON file's path")
     return v1.read_json_file(file, "program", program_from_dict)
+
+
+def read_program_and_setup(file) -> tuple[Program, Setup | None]:
+    """A program file's :class:`Program` in its work coordinates and its recorded setup
+    (None for the +Z identity): :func:`~cadcnc.program.transform.in_part_coordinates`
+    turns it back into part coordinates."""
+    require("file", file, (str, os.PathLike), "a JSON file's path")
+    return v1.read_json_file(file, "program", lambda d: (
+        program_from_dict(d), setup_of_dict(d.get("setup")) if isinstance(d, dict) else None))

@@ -1,0 +1,211 @@
+"""One dexel grid: rays along axis k, each holding sorted, disjoint intervals of material.
+
+Ray (iu, iv) of the grid along axis ``k`` runs along e_k through ``u = lo[u] + (iu + 1/2)
+res``, ``v = lo[v] + (iv + 1/2) res`` with ``(u, v) = ((k + 1) % 3, (k + 2) % 3)``; its
+index is ``iu * nv + iv``. Intervals are stored as float32 offsets from ``lo[k]`` (mm):
+``iv[ray, i] = (start, end)`` for ``i < cnt[ray]``, at most ``K`` of them. Rays are cut
+tile by tile (``TILE`` x ``TILE`` rays) on every numba thread; a tile applies the moves that
+reach it in program order, so a rapid meets the stock exactly as the earlier moves left it.
+A tile whose ray would need more than K intervals stops and is flagged: the caller grows K
+and cuts that tile again from the initial stock (cutting is idempotent). numba's cache does
+not see edits of :mod:`.tool_sweep` (inlined here): clear ``__pycache__/*.nb[ic]`` after one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .tool_sweep import swept_tool
+
+TILE = 32
+SLIVER = 1e-6        # mm: a piece of material shorter than this along a ray is dropped
+COLLISION_OVERLAP = 1e-3   # mm: a rapid's tool overlapping material longer than this on a ray
+MAX_COLLISIONS = 16  # collisions recorded per tile (distinct moves, first point of each)
+
+
+@njit(cache=True)
+def subtract(iv, r, n, a, b, kmax):
+    """Remove [a, b] from the ``n`` sorted intervals of ray ``r`` of ``iv`` (rays, K, 2) in
+    place: (new n, or -1 when more than ``kmax`` would be needed; overlap length; t of the
+    first overlap)."""
+    lo_, hi_ = 0, n            # i0: the first interval ending after a (binary search)
+    while lo_ < hi_:
+        mid = (lo_ + hi_) >> 1
+        if iv[r, mid, 1] <= a:
+            lo_ = mid + 1
+        else:
+            hi_ = mid
+    i0 = lo_
+    lo_, hi_ = i0, n           # i1 + 1: the first interval starting at or after b
+    while lo_ < hi_:
+        mid = (lo_ + hi_) >> 1
+        if iv[r, mid, 0] < b:
+            lo_ = mid + 1
+        else:
+            hi_ = mid
+    i1 = lo_ - 1
+    if i0 > i1:
+        return n, 0.0, 0.0
+    overlap = 0.0
+    for i in range(i0, i1 + 1):
+        overlap += min(float(iv[r, i, 1]), b) - max(float(iv[r, i, 0]), a)
+    first = max(float(iv[r, i0, 0]), a)
+    s0, e1 = float(iv[r, i0, 0]), float(iv[r, i1, 1])
+    left = s0 < a - SLIVER
+    right = e1 > b + SLIVER
+    p = int(left) + int(right)
+    m = i1 - i0 + 1
+    new_n = n - m + p
+    if new_n > kmax:
+        return -1, overlap, first
+    shift = p - m
+    if shift < 0:
+        for i in range(i1 + 1, n):
+            iv[r, i + shift, 0] = iv[r, i, 0]
+            iv[r, i + shift, 1] = iv[r, i, 1]
+    elif shift > 0:
+        for i in range(n - 1, i1, -1):
+            iv[r, i + shift, 0] = iv[r, i, 0]
+            iv[r, i + shift, 1] = iv[r, i, 1]
+    j = i0
+    if left:
+        iv[r, j, 0] = s0
+        iv[r, j, 1] = a
+        j += 1
+    if right:
+        iv[r, j, 0] = b
+        iv[r, j, 1] = e1
+    return new_n, overlap, first
+
+
+@njit(cache=True)
+def _ahead(kept, o, k, tk, p0, p1):
+    """Whether the ``kept`` point (3,) comes before the point o with o[k] = tk along the
+    move p0 -> p1."""
+    s_kept, s_new = 0.0, 0.0
+    for i in range(3):
+        d = p1[i] - p0[i]
+        s_kept += kept[i] * d
+        s_new += (tk if i == k else o[i]) * d
+    return s_kept <= s_new
+
+
+@njit(cache=True)
+def bin_moves(k, lo, res, nu, nv, bb_lo, bb_hi):
+    """Moves per tile (CSR: ``start`` (tiles + 1,), ``moves`` in program order) from the
+    moves' boxes ``bb_lo``, ``bb_hi`` (N, 3)."""
+    u, v = (k + 1) % 3, (k + 2) % 3
+    ntu, ntv = (nu + TILE - 1) // TILE, (nv + TILE - 1) // TILE
+    counts = np.zeros(ntu * ntv + 1, np.int64)
+    n = bb_lo.shape[0]
+    rng = np.empty((n, 4), np.int64)
+    for m in range(n):
+        a0 = max(0, int(math.floor((bb_lo[m, u] - lo[u]) / res - 0.5)))
+        a1 = min(nu - 1, int(math.ceil((bb_hi[m, u] - lo[u]) / res - 0.5)))
+        b0 = max(0, int(math.floor((bb_lo[m, v] - lo[v]) / res - 0.5)))
+        b1 = min(nv - 1, int(math.ceil((bb_hi[m, v] - lo[v]) / res - 0.5)))
+        rng[m, 0], rng[m, 1], rng[m, 2], rng[m, 3] = a0, a1, b0, b1
+        if a0 > a1 or b0 > b1:
+            continue
+        for tu in range(a0 // TILE, a1 // TILE + 1):
+            for tv in range(b0 // TILE, b1 // TILE + 1):
+                counts[tu * ntv + tv + 1] += 1
+    start = np.cumsum(counts)
+    fill = start[:-1].copy()
+    moves = np.empty(start[-1], np.int64)
+    for m in range(n):
+        a0, a1, b0, b1 = rng[m, 0], rng[m, 1], rng[m, 2], rng[m, 3]
+        if a0 > a1 or b0 > b1:
+            continue
+        for tu in range(a0 // TILE, a1 // TILE + 1):
+            for tv in range(b0 // TILE, b1 // TILE + 1):
+                t = tu * ntv + tv
+                moves[fill[t]] = m
+                fill[t] += 1
+    return start, moves, rng
+
+
+@njit(cache=True, parallel=True)
+def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, axis, radius, length,
+              rapid, bb_lo, bb_hi, init_iv, init_cnt, iv, cnt, ext, overflow, col_move,
+              col_at, col_n):
+    """Cut the grid's ``tiles`` (indices) by their moves: each ray starts from ``init_iv``,
+    ``init_cnt`` and loses every move's swept tool (:func:`swept_tool`); p0, p1, axis
+    (N, 3), radius, length (N,), rapid (N,) bool. Writes ``iv``, ``cnt`` and ``ext`` (rays,
+    2): each ray's first start and last end, read first (one cache line for a ray missed); ``overflow[t]``
+    for a tile that needs more intervals; rapids through material into ``col_*`` (per
+    tile: moves (T, C), points (T, C, 3), counts (T,))."""
+    u, v = (k + 1) % 3, (k + 2) % 3
+    ntv = (nv + TILE - 1) // TILE
+    kmax = iv.shape[1]
+    for ti in prange(tiles.shape[0]):
+        t = tiles[ti]
+        tu, tv = t // ntv, t % ntv
+        u0, u1 = tu * TILE, min(nu, tu * TILE + TILE) - 1
+        v0, v1 = tv * TILE, min(nv, tv * TILE + TILE) - 1
+        for a in range(u0, u1 + 1):
+            for b in range(v0, v1 + 1):
+                r = a * nv + b
+                c = init_cnt[r]
+                for i in range(c):
+                    iv[r, i, 0] = init_iv[r, i, 0]
+                    iv[r, i, 1] = init_iv[r, i, 1]
+                cnt[r] = c
+                if c > 0:
+                    ext[r, 0] = init_iv[r, 0, 0]
+                    ext[r, 1] = init_iv[r, c - 1, 1]
+        overflow[t] = False
+        col_n[t] = 0
+        o = np.empty(3)
+        for q in range(start[t], start[t + 1]):
+            m = moves[q]
+            tlo, thi = bb_lo[m, k] - lo[k], bb_hi[m, k] - lo[k]
+            a0, a1, a2 = p0[m, 0], p0[m, 1], p0[m, 2]
+            b0, b1, b2 = p1[m, 0], p1[m, 1], p1[m, 2]
+            x0, x1, x2 = axis[m, 0], axis[m, 1], axis[m, 2]
+            rad, ln = radius[m], length[m]
+            for a in range(max(u0, rng[m, 0]), min(u1, rng[m, 1]) + 1):
+                o[u] = lo[u] + (a + 0.5) * res
+                for b in range(max(v0, rng[m, 2]), min(v1, rng[m, 3]) + 1):
+                    r = a * nv + b
+                    if ext[r, 1] <= tlo or ext[r, 0] >= thi:
+                        continue
+                    n = cnt[r]
+                    if n == 0:
+                        continue
+                    o[v] = lo[v] + (b + 0.5) * res
+                    o[k] = lo[k]
+                    ta, tb = swept_tool(o[0], o[1], o[2], k, a0, a1, a2, b0, b1, b2,
+                                        x0, x1, x2, rad, ln, ext[r, 0], ext[r, 1])
+                    if ta >= tb:
+                        continue
+                    n2, overlap, first = subtract(iv, r, n, ta, tb, kmax)
+                    if n2 < 0:
+                        overflow[t] = True
+                        break
+                    cnt[r] = n2
+                    if n2 > 0:
+                        ext[r, 0] = iv[r, 0, 0]
+                        ext[r, 1] = iv[r, n2 - 1, 1]
+                    else:
+                        ext[r, 0], ext[r, 1] = 1.0, -1.0
+                    if rapid[m] and overlap > COLLISION_OVERLAP:
+                        c = col_n[t]
+                        if c > 0 and col_move[t, c - 1] == m:
+                            c -= 1      # the same move: keep the point met first
+                            if _ahead(col_at[t, c], o, k, lo[k] + first, p0[m], p1[m]):
+                                continue
+                        elif c == MAX_COLLISIONS:
+                            continue
+                        col_move[t, c] = m
+                        col_at[t, c, u] = o[u]
+                        col_at[t, c, v] = o[v]
+                        col_at[t, c, k] = lo[k] + first
+                        col_n[t] = c + 1
+                if overflow[t]:
+                    break
+            if overflow[t]:
+                break
