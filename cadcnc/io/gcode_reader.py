@@ -67,7 +67,7 @@ def arc_points(start, args, plane: str, scale: float, chord: float = CHORD) -> n
     a0 = math.atan2(start[s] - c2, start[f] - c1)
     a1 = math.atan2(e2 - c2, e1 - c1)
     sweep = (a1 - a0) % (2 * math.pi) if turns > 0 else -((a0 - a1) % (2 * math.pi))
-    if abs(sweep) < 1e-12:
+    if abs(sweep) < 1e-12:   # rad: end on start, a full circle (rs274 gives no 0-turn arc)
         sweep = math.copysign(2 * math.pi, turns)
     sweep += math.copysign(2 * math.pi * (abs(turns) - 1), turns)
     step = 2 * math.acos(max(1 - chord / r, -1.0)) if r > chord else math.pi

@@ -41,7 +41,7 @@ def scale_of(left, threshold: float = 0.0) -> float:
     """The colour bar's top (mm): the 99th percentile of the material left where it was
     cut (below ``UNCUT``), at least twice ``threshold`` and 1 um; above it: grey."""
     cut = np.asarray(left)[np.asarray(left) < UNCUT]
-    return max(float(np.percentile(cut, 99)) if len(cut) else 0.0, 2 * threshold, 1e-3)
+    return max(float(np.percentile(cut, 99)) if len(cut) else 0.0, 2 * threshold, 1e-3)  # mm: 1 um
 
 
 def png_bytes(part, points, left, gouges: list[dict], threshold: float = 0.0,
@@ -71,7 +71,7 @@ def png_bytes(part, points, left, gouges: list[dict], threshold: float = 0.0,
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
         ax.set_zlim(lo[2], hi[2])
-        ax.set_box_aspect(np.maximum(hi - lo, 1e-6))
+        ax.set_box_aspect(np.maximum(hi - lo, 1e-6))  # mm: a flat box still has an aspect
         ax.view_init(elev=elev, azim=azim)
         ax.set_xlabel("X mm")
         ax.set_ylabel("Y mm")

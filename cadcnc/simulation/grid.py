@@ -56,7 +56,7 @@ class Grid:
 
 def cells(lo, hi, res: float) -> np.ndarray:
     """(3,) cells along X, Y, Z of the box lo..hi at ``res``."""
-    return np.maximum(np.ceil((np.asarray(hi) - np.asarray(lo)) / res - 1e-9), 1).astype(int)
+    return np.maximum(np.ceil((np.asarray(hi) - np.asarray(lo)) / res - 1e-9), 1).astype(int)  # round-off: a whole number of cells stays one
 
 
 def rays(lo, hi, res: float) -> int:
@@ -75,7 +75,7 @@ def evaluations(lo, hi, res: float, bb_lo: np.ndarray, bb_hi: np.ndarray) -> flo
 def estimate(lo, hi, res: float, bb_lo, bb_hi, threads: int) -> tuple[float, float]:
     """(bytes, seconds) the simulation is about to need."""
     return (rays(lo, hi, res) * BYTES_PER_RAY,
-            evaluations(lo, hi, res, bb_lo, bb_hi) * NS_PER_EVALUATION * 1e-9 / max(threads, 1))
+            evaluations(lo, hi, res, bb_lo, bb_hi) * NS_PER_EVALUATION * 1e-9 / max(threads, 1))  # ns to s
 
 
 def check_limits(lo, hi, res: float, bb_lo, bb_hi, threads: int,

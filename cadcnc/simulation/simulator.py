@@ -23,6 +23,7 @@ from ..io.program_json import read_program_and_setup
 from ..program.program import Program
 from ..verification.stock_part import PartDistance, offset_triangles, part_triangles, step_triangles
 from .compare import joined, sample_grid
+from .grid import cells
 from .part_rays import crossings, solid_intervals
 from .stock import cut_stock
 from .stock_report import SimulationReport, build_report
@@ -105,15 +106,15 @@ def simulate(part: Part, programs, *, stock="box", resolution: float = RESOLUTIO
         raise InputError(f"resolution must be > 0 mm, got {resolution!r}")
     runs = read_runs(programs, radius, tool_tip, shank)
     lam = part.tol.gouge
-    deflection = max(MESH_SHARE * lam, 1e-5)
+    deflection = max(MESH_SHARE * lam, 1e-5)  # mm: a finer mesh than 10 nm is OCCT's noise
     lo, hi, solid, desc = _stock(part, stock, resolution, deflection)
     clock = time.perf_counter()
     initial = None
     if solid is not None:
         initial = []
+        n = cells(lo, hi, resolution)
         for k in range(3):
             u, v = (k + 1) % 3, (k + 2) % 3
-            n = np.maximum(np.ceil((hi - lo) / resolution - 1e-9), 1).astype(int)
             start, t, *_ = crossings(k, lo, resolution, n[u], n[v], solid,
                                      np.zeros(len(solid), np.int32))
             initial.append(solid_intervals(start, t))

@@ -56,7 +56,7 @@ def part_triangles(part: Part, deflection: float) -> tuple[np.ndarray, np.ndarra
 def offset_triangles(part: Part, margin: float, deflection: float):
     """The triangles of the part grown by ``margin`` mm (OCCT's offset, arcs at edges)."""
     maker = BRepOffsetAPI_MakeOffsetShape()
-    maker.PerformByJoin(part.shape, float(margin), 1e-6, BRepOffset_Skin, False, False,
+    maker.PerformByJoin(part.shape, float(margin), 1e-6, BRepOffset_Skin, False, False,  # tol mm
                         GeomAbs_Arc)
     if not maker.IsDone():
         raise InputError(f"OCCT cannot offset the part by {margin:g} mm: give --stock box "
