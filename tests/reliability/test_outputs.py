@@ -18,6 +18,8 @@ import pytest
 from helpers.cli import cadcnc_cli
 from helpers.fixtures import FIXTURES
 
+pytestmark = pytest.mark.slow  # subprocesses interrupted mid-write: about 20 s of the fast tier
+
 BOSS = FIXTURES / "bspline_boss.step"
 POCKET = FIXTURES / "pocket.step"  # faces 10 17: a straight edge, a program in ~0.2 s
 SLOT = FIXTURES / "narrow_slot.step"
