@@ -31,7 +31,7 @@ CLI_MODULES = {"test_cli.py", "test_cli_program.py", "test_cli_smoke.py", "test_
                "test_pencil_cli.py", "test_finish_cli.py", "test_controller_cli.py",
                "test_outputs.py", "test_bad_input.py", "test_bounds_and_inputs.py",
                "test_fuzz_operations.py", "test_one_job.py", "test_surface_models.py",
-               "test_batch.py", "test_waterline_cli.py"}
+               "test_batch.py", "test_waterline_cli.py", "test_programs_identical.py"}
 
 
 def pytest_xdist_auto_num_workers(config):
