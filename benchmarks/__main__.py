@@ -1,7 +1,9 @@
 """``python -m benchmarks perf [--quick | --full] ...``: regenerate docs/performance.md's
 tables (benchmarks/perf.py). ``python -m benchmarks profile [CASE...] [--base DIR]``: each
 stage's CPU time and the OCCT calls of a corner path, a pencil and a setups run
-(benchmarks/profile/bench_profile.py). Each benchmark also runs alone, e.g.
+(benchmarks/profile/bench_profile.py). ``python -m benchmarks identity [--shared DIR]
+[--record FILE | --check FILE]``: the programs' SHA-256 against a record
+(benchmarks/identity/README.md). Each benchmark also runs alone, e.g.
 ``python -m benchmarks.kernel.bench_kernel``; benchmarks/README.md lists them."""
 
 from __future__ import annotations
@@ -19,6 +21,10 @@ def main(argv: list[str]) -> int:
         from benchmarks.profile.bench_profile import main as profile  # noqa: PLC0415
 
         return profile(argv[1:])
+    if argv[0] == "identity":
+        from benchmarks.identity.__main__ import main as identity  # noqa: PLC0415
+
+        return identity(argv[1:])
     if argv[0] != "perf":
         print(f"unknown command {argv[0]!r}\n\n{USAGE}", file=sys.stderr)
         return 2

@@ -1,0 +1,1 @@
+"""Byte identity of cadcnc's programs: benchmarks/identity/README.md."""
