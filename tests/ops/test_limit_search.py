@@ -20,10 +20,17 @@ from cadcnc.guard import guard_for
 from cadcnc.ops.path import stretches
 from cadcnc.ops.path.limit_search import limit_samples, root_limit
 from cadcnc.ops.path.pair_path import pair_job
-from cadcnc.ops.path.stretches import (FEASIBLE, LIMIT_TOL, ONE_SIDED, SPACING, Feasibility,
-                                       bisect_limit, pair_stretches)
-
+from cadcnc.ops.path.stretches import (
+    FEASIBLE,
+    LIMIT_TOL,
+    ONE_SIDED,
+    SPACING,
+    Feasibility,
+    bisect_limit,
+    pair_stretches,
+)
 from helpers.fixtures import FIXTURES
+from helpers.programs import pencil_run
 
 TOL = DEFAULT.stretch_limit
 CASES = [   # (fixture, radius, pairs): every rule's limits
@@ -220,15 +227,14 @@ def test_a_pencil_program_moves_by_less_than_the_gouge_limit(monkeypatch):
     end within the limit's accuracy of the other's, far under the gouge limit, and the
     gate's verdict on every cut the same (passed)."""
     from cadcnc.ops.path import stretch_split
-    from cadcnc.ops.pencil.pencil import pencil
     from cadcnc.verification import gouge_gate
 
     part = cadcnc.load_step(FIXTURES / "step_slot.step")
-    now = pencil(part, radius=3.0)
+    now = pencil_run(part, radius=3.0)
     with monkeypatch.context() as m:
         m.setattr(stretches, "locate_limit", bisect_limit)
         m.setattr(stretch_split, "locate_limit", bisect_limit)
-        before = pencil(cadcnc.load_step(FIXTURES / "step_slot.step"), radius=3.0)
+        before = pencil_run(cadcnc.load_step(FIXTURES / "step_slot.step"), radius=3.0)
     assert len(now.cuts) == len(before.cuts) and len(now.skipped) == len(before.skipped)
 
     def ends(cut):

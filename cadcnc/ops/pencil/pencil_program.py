@@ -36,8 +36,8 @@ from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program, Skipped
 from ..common import refuse_cycles, require_ball, run_stretch, safe_height
 from ..entries import UNREACHABLE, entered_program_segments
-from ..path.pair_path import plan_path
 from ..path.limit_search import limit_samples
+from ..path.pair_path import plan_path
 from ..path.pair_program import stretch_cuts
 from ..path.stretches import (
     MIN_SAMPLES,
