@@ -9,6 +9,8 @@ from .errors import InputError
 
 STRETCH_TANGENT_MARGIN = 2.0
 """The stretch search's tangent limit over the interpolator's (``stretch_tangent_sin``)."""
+STRETCH_LIMIT_SHARE = 0.1
+"""The accuracy of a stretch limit over the gouge limit (``stretch_limit``)."""
 STREAM_LIMIT_SLACK = 1e-6
 """Relative: a streamed position's finite-difference velocity, acceleration or jerk may
 exceed the machine's limit by this share (round-off), not more
@@ -45,6 +47,13 @@ class Tolerances:
       intersection curve along its ill-conditioned direction (by ~2 um at sin 0.01, still
       on both offset surfaces), so its own |n1 x n2| reads a few per cent off the exact
       value; the margin keeps a cut started at a tangent limit from stopping there.
+    - ``stretch_limit`` (derived, not set): a stretch limit (where a corner's ball
+      position turns infeasible) is located until the last feasible and the first
+      infeasible centre are this close, and the feasible one kept: STRETCH_LIMIT_SHARE (a
+      tenth) of ``gouge``, 1e-4 mm. A cut ends at most this short of the exact limit; the
+      ball there is the exact limit's moved by at most this, so the material it leaves is
+      at most this thick, a tenth of what the gate lets a program cut too deep and of
+      the ``accuracy`` every point keeps, and a thousandth of the 0.1 mm step.
     - ``tangent_edge_deg``: a dihedral angle within this of 180 deg classifies an edge
       sample as tangent/smooth.
     - ``start`` (mm): the initial tangency is solved to this residual.
@@ -120,6 +129,10 @@ class Tolerances:
     @property
     def stretch_tangent_sin(self) -> float:
         return STRETCH_TANGENT_MARGIN * self.tangent_sin
+
+    @property
+    def stretch_limit(self) -> float:
+        return STRETCH_LIMIT_SHARE * self.gouge
 
     def __post_init__(self):
         for f in fields(self):

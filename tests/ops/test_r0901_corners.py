@@ -120,10 +120,13 @@ def test_a_cut_starts_towards_its_stretch():
 
 
 def test_the_corner_does_not_depend_on_the_work_zero():
-    """The same program (part coordinates) whatever the work zero. Before, with the zero
-    at the part's origin the search's first sample solved on another offset intersection
-    curve (its contact on the cylinder off the face) and followed it: "no feasible ball
-    position" (exit 3) for a corner cut complete with the default zero."""
+    """The same program (part coordinates) whatever the work zero, to the accuracy of its
+    stretch limits (``Tolerances.stretch_limit``: the grids' samples differ between the
+    frames by round-off, so the root search starts from other brackets; 5e-6 mm here).
+    Before, with the zero at the part's origin the search's first sample solved on
+    another offset intersection curve (its contact on the cylinder off the face) and
+    followed it: "no feasible ball position" (exit 3) for a corner cut complete with the
+    default zero."""
     name = "r0901_near_tangent"
     p, base = part(name), job(name)
     expected = job_setup(base, p).to_part(
@@ -133,4 +136,4 @@ def test_the_corner_does_not_depend_on_the_work_zero():
         got = job_setup(j, p).to_part(
             np.concatenate([c.path.points for c in cadcnc.run(p, j).cuts]))
         assert got.shape == expected.shape
-        assert np.abs(got - expected).max() < 1e-9
+        assert np.abs(got - expected).max() < DEFAULT.stretch_limit

@@ -13,9 +13,10 @@ Method: tangency samples anchored on planes normal to the edge, every ``spacing`
 edge (0.4 mm, at least 9 per edge) and continued ``R' + 1`` mm beyond each end of an
 open edge along its end tangent; a sample interval whose centres are more than
 ``MAX_CHORD`` apart is split until they are not. Each change feasible/infeasible
-between neighbouring samples is located by bisection on the anchor's arc length until
-the feasible and the infeasible centres are less than ``LIMIT_TOL`` apart; the limit is
-the feasible one, its rule the one that fails beside it.
+between neighbouring samples is located by a root search on the failing rule's signed
+margin (:mod:`.limit_search`; bisection for the rules without one) until the feasible and
+the infeasible centres are less than ``Tolerances.stretch_limit`` (a tenth of the gouge
+limit) apart; the limit is the feasible one, its rule the one that fails beside it.
 
 Guarantee: neighbouring samples' centres are at most MAX_CHORD = 0.45 mm apart, so a
 stretch (or a gap between stretches) can be missed only if it is shorter than the
@@ -36,7 +37,7 @@ import numpy as np
 
 from ...core.errors import GeometryError, StartPointError
 from ...core.job import Job
-from ...core.tolerances import Tolerances
+from ...core.tolerances import DEFAULT, Tolerances
 from ...geometry.edge_curve import EdgeCurve
 from ...geometry.part import CONCAVE
 from ...guard import guard_for
@@ -45,11 +46,13 @@ from ...interp.cycle import Contact
 from ...interp.stepper import Tangency
 from ...interp.tangency import solve_tangency
 from .centre_curve import polyline_length, travel_direction
+from .limit_search import bisect, root_limit
 
 SPACING = 0.4       # mm of edge between samples (refined to MAX_CHORD of centres)
 MIN_SAMPLES = 9     # per edge
 MAX_CHORD = 0.45    # mm: neighbouring sample centres are refined to at most this apart
-LIMIT_TOL = 1e-7    # mm: a limit is located until its two sides are this close
+LIMIT_TOL = 1e-7    # mm: the reference bisection's accuracy (bisect_limit), and the
+#                     anchors' where the failing side has no centre (the root search)
 MAX_SPLITS = 6      # halvings of a sample interval whose centres are too far apart
 
 FEASIBLE = "feasible"
@@ -57,6 +60,10 @@ BOUNDARY, COLLISION, CURVATURE, TANGENT = "boundary", "collision", "curvature", 
 UNSOLVED = "unsolved"   # no tangency found from the sample's anchor
 SEARCH = "search"       # the stretch goes on past the searched extension of the edge
 CLOSED = "closed"       # a closed edge feasible all around
+
+ONE_SIDED = (COLLISION,)
+"""Rules whose margin is exact only where they fail (the guard's clearance: a lower bound
+where it clears, :mod:`.limit_search`)."""
 
 RESEED = (BOUNDARY, TANGENT, UNSOLVED)
 """Rules a seeded sample may fail on the wrong branch (two offset intersection curves
@@ -82,6 +89,10 @@ class Sample:
     detail: str
     tangency: Tangency | None       # None when no tangency was found
     tangent: tuple[float, float, float]   # the edge's unit tangent at the anchor
+    margins: dict = field(default_factory=dict, compare=False)
+    """The signed margins the verdict computed, by rule (> 0 feasible side; see
+    :mod:`.limit_search`): every rule's with a margin on a feasible sample, up to the
+    failing one on another."""
 
     @property
     def ok(self) -> bool:
@@ -182,15 +193,22 @@ class Feasibility:
         if np.linalg.norm(np.subtract(tan.p, anchor)) > self.max_reach:
             return Sample(s, UNSOLVED, "the tangency found is far from the edge", None,
                           tangent)
-        rule, detail = self.judge(tan)
-        return Sample(s, rule, detail, tan, tangent)
+        margins: dict[str, float] = {}
+        rule, detail = self._verdict(tan, margins)
+        return Sample(s, rule, detail, tan, tangent, margins)
 
     def judge(self, tan: Tangency) -> tuple[str, str]:
         """(FEASIBLE, "") or the first failing rule and a detail naming the face."""
+        return self._verdict(tan, {})
+
+    def _verdict(self, tan: Tangency, margins: dict) -> tuple[str, str]:
+        """:meth:`judge`, filling ``margins`` with each rule's signed margin as it is
+        checked (from what the check computes: no call is added)."""
         c1 = Contact(self.s1, self.offsets[0], *tan.uv1)
         c2 = Contact(self.s2, self.offsets[1], *tan.uv2)
         t = np.cross(c1.n, c2.n)
         sin = float(np.linalg.norm(t))
+        margins[TANGENT] = sin - self.tol.stretch_tangent_sin
         if sin < self.tol.stretch_tangent_sin:
             return TANGENT, f"|n1 x n2| = {sin:.3g}"
         off = [f"face {s.number}" for s, uv in ((self.s1, tan.uv1), (self.s2, tan.uv2))
@@ -198,12 +216,17 @@ class Feasibility:
         if off:
             return BOUNDARY, "contact off " + " and ".join(off)
         t = tuple(t / sin)
+        margins[CURVATURE] = math.inf
         for c, s in ((c1, self.s1), (c2, self.s2)):
             k = c.curvature(t)
+            if c.offset > 0.0:
+                margins[CURVATURE] = min(margins[CURVATURE], 1.0 + self.tol.gouge / (
+                    2.0 * c.offset) - c.offset * k)
             if too_tight(c.offset * k, c.offset, self.tol):
                 return CURVATURE, f"face {s.number}: R' k = {c.offset * k:.4g} > 1"
         if self.guard is not None:
             m, detail = self.guard.margin(tan.p)
+            margins[COLLISION] = m
             if m < 0.0:
                 return COLLISION, f"{detail} ({-m:.4g} mm too near)"
         return FEASIBLE, ""
@@ -307,20 +330,21 @@ def _refine(feas, curve, samples: list[Sample], out: EdgeStretches) -> list[Samp
 
 
 def locate_limit(feas, curve, good: Sample, bad: Sample) -> tuple[Sample, Sample]:
-    """Bisection on arc length between a feasible and an infeasible sample, until their
-    centres are LIMIT_TOL apart (or the anchors 1e-12 mm): (last feasible, first failing)."""
-    for _ in range(80):
-        if bad.tangency is not None and np.linalg.norm(
-                np.subtract(good.tangency.p, bad.tangency.p)) < LIMIT_TOL:
-            break
-        if abs(bad.s - good.s) < 1e-12:
-            break
-        mid = sample_at(feas, curve, 0.5 * (good.s + bad.s), good)
-        if mid.ok:
-            good = mid
-        else:
-            bad = mid
+    """(last feasible, first failing) between a feasible and an infeasible sample: a root
+    search on the failing rule's margin (:func:`.limit_search.root_limit`) until their
+    centres are ``Tolerances.stretch_limit`` apart (the anchors LIMIT_TOL where the failing
+    side has no centre)."""
+    tol = getattr(feas, "tol", DEFAULT).stretch_limit
+    good, bad, _ = root_limit(lambda s, seed: sample_at(feas, curve, s, seed), good, bad,
+                              tol, LIMIT_TOL, ONE_SIDED,
+                              () if curve.closed else (0.0, curve.length))
     return good, bad
+
+
+def bisect_limit(feas, curve, good: Sample, bad: Sample) -> tuple[Sample, Sample]:
+    """The reference: the search before the root search (:func:`.limit_search.bisect`,
+    centres LIMIT_TOL apart); tests compare the two."""
+    return bisect(lambda s, seed: sample_at(feas, curve, s, seed), good, bad, LIMIT_TOL)
 
 
 def _limit(feas, curve, good: Sample, bad: Sample | None) -> Limit:

@@ -27,6 +27,7 @@ from dataclasses import replace
 from ...core.errors import CadcncError
 from ...core.job import Job, PairPath
 from ...core.progress import Progress
+from ...core.tolerances import DEFAULT
 from ...core.work_limits import MAX_CYCLES, Heartbeat, refuse_over
 from ...geometry.part import Part
 from ...guard import guard_for
@@ -35,10 +36,10 @@ from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program, Skipped
 from ..common import refuse_cycles, require_ball, run_stretch, safe_height
 from ..entries import UNREACHABLE, entered_program_segments
+from ..path.limit_search import limit_samples
 from ..path.pair_path import plan_path
 from ..path.pair_program import stretch_cuts
 from ..path.stretches import (
-    LIMIT_TOL,
     MIN_SAMPLES,
     SPACING,
     Feasibility,
@@ -213,14 +214,16 @@ MAX_SAMPLES = 400_000
 the search is refused up front (:func:`search_samples`)."""
 
 
-def search_samples(length: float, offset: float, closed: bool = False) -> int:
+def search_samples(length: float, offset: float, closed: bool = False,
+                   tol: float = DEFAULT.stretch_limit) -> int:
     """About how many ball positions the search of an edge of ``length`` mm solves for a
     ball of offset R' = ``offset`` mm: the grid every SPACING mm (at least MIN_SAMPLES),
-    R' + 1 mm past each end of an open edge, and the bisection of two limits (SPACING to
-    LIMIT_TOL); more stretches and the refinement add on top."""
+    R' + 1 mm past each end of an open edge, and the search of two limits (SPACING to
+    ``tol``, the job's ``stretch_limit``: a bisection's count, which a limit with a margin
+    undercuts); more stretches and the refinement add on top."""
     n = max(MIN_SAMPLES, int(math.ceil(length / SPACING)) + 1)
     ext = 0.0 if closed else max(offset, 0.0) + 1.0
-    bisect = 2 * int(math.ceil(math.log2(SPACING / LIMIT_TOL)))
+    bisect = 2 * limit_samples(SPACING, tol)
     return n + 2 * int(math.ceil(ext / max(SPACING, length / max(n - 1, 1)))) + bisect
 
 
@@ -232,7 +235,8 @@ def estimate_work(todo: list[Corner], job: Job, max_cycles: int = MAX_CYCLES) ->
     (:func:`search_samples`), over MAX_SAMPLES."""
     rp = job.tool.offset
     length = sum(c.length for c in todo)
-    samples = sum(search_samples(c.length, rp, c.closed) for c in todo
+    samples = sum(search_samples(c.length, rp, c.closed, job.tolerances.stretch_limit)
+                  for c in todo
                   if c.kind == EDGE or len(c.rails) == 1)
     runs = 1 if job.operation.side is None else 2   # a cut may be run again the other way
     cycles = refuse_cycles([runs * length], job, f"pencil of {len(todo)} corner(s)",
