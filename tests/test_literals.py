@@ -21,9 +21,7 @@ import cadcnc
 PACKAGE = Path(cadcnc.__file__).parent
 EXPONENT = re.compile(r"e-", re.IGNORECASE)
 ALLOWED = {"core/tolerances.py"}
-# another branch is rewriting ops/path/stretches.py (its ``abs(bad.s - good.s) < 1e-12``):
-# drop this exemption once that branch has landed and names or explains it
-EXEMPT = {"ops/path/stretches.py"}
+EXEMPT: set[str] = set()
 
 
 def _upper_targets(node: ast.stmt) -> bool:

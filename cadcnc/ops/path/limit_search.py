@@ -41,6 +41,8 @@ from __future__ import annotations
 import math
 from typing import Callable
 
+ANCHORS_MET = 1e-12
+"""mm of edge: anchors this close are one point, no arc length is left to search."""
 MAX_TRIALS = 80
 """Samples one limit may take (the bisection's 22 to 1e-7 mm, twice over, and more)."""
 
@@ -78,7 +80,7 @@ def root_limit(trial: Callable, good, bad, tol: float, anchor_tol: float,
     used = 0
     while used < max_trials:
         w = hi.s - lo.s            # signed: the infeasible end may lie either side
-        if abs(w) < 1e-12:
+        if abs(w) < ANCHORS_MET:
             break
         if hi.tangency is None:
             if abs(w) < anchor_tol:
@@ -154,7 +156,7 @@ def bisect(trial: Callable, good, bad, tol: float) -> tuple[object, object]:
     for _ in range(80):
         if bad.tangency is not None and _distance(good.tangency.p, bad.tangency.p) < tol:
             break
-        if abs(bad.s - good.s) < 1e-12:
+        if abs(bad.s - good.s) < ANCHORS_MET:
             break
         mid = trial(0.5 * (good.s + bad.s), good)
         if mid.ok:
