@@ -8,6 +8,8 @@ by the operation; every file a command writes is digested (pictures are not aske
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from .harness import Case
 
 PROGRAM = ("-o", "program.json", "-o", "program.ngc")   # JSON and G-code
@@ -218,12 +220,17 @@ NOTHING_AT_R3 = {"screw", "tr8_bv1_ct", "exhaust", "box-openshell", "toroidal"}
 
 
 def _refused(case: Case) -> Case:
-    return Case(case.name, case.part, case.commands, exits=(3,))
+    """``case`` expected to exit 3 (nothing to cut), writing nothing."""
+    return replace(case, exits=(3,))
+
+
+def _pencil_r3(key: str, part: str) -> Case:
+    case = pencil(f"shared-pencil-{key}-R3", part, 3)
+    return _refused(case) if key in NOTHING_AT_R3 else case
 
 
 SHARED = [
-    *[(_refused if key in NOTHING_AT_R3 else lambda c: c)(
-        pencil(f"shared-pencil-{key}-R3", part, 3)) for key, part in SHARED_PARTS.items()],
+    *[_pencil_r3(key, part) for key, part in SHARED_PARTS.items()],
     pencil("shared-pencil-l-bracket-R2", L_BRACKET, 2),
     pencil("shared-pencil-lever-R2", LEVER, 2),
     pencil("shared-pencil-abc-R2", ABC, 2),
