@@ -156,10 +156,11 @@ SLOW = [
     # surface models: loose faces sewn
     path("path-surf_boss_faces-4-5", "surf_boss_faces.step", (4, 5), 3),
     # options: tool tip, spindle, clearance, plunge feed, feed, period, allowance
-    path("path-bspline_boss-options", "bspline_boss.step", (4, 5), 3, "--tool-tip", "--spindle", "12000", "--clearance", "60",
+    path("path-bspline_boss-options", "bspline_boss.step", (4, 5), 3, "--tool-tip",
+         "--spindle", "12000", "--clearance", "60",
          "--plunge-feed", "300", "--feed", "3000", "--period", "2ms", "--allowance",
          "0.25"),
-    # the stream on a custom machine (INI) and at a replaced feed, and --stream
+    # the stream at a replaced feed and jerk (default machine); pencil's own --stream
     path("path-bspline_boss-stream-feed", "bspline_boss.step", (4, 5), 3,
          then=(("stream", "program.json", "--feed", "10000", "--jerk", "20000", "-o",
                 "stream.npy"),)),
