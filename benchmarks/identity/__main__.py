@@ -1,7 +1,8 @@
 """``python -m benchmarks identity``: are the programs the same bytes as recorded?
 
     python -m benchmarks identity [--tier fast|slow|all] --check tests/data/program_digests.json
-    python -m benchmarks identity --shared /work/shared/parts --check benchmarks/identity/shared_digests.json
+    python -m benchmarks identity --shared /work/shared/parts \\
+        --check benchmarks/identity/shared_digests.json
     python -m benchmarks identity --shared DIR --record FILE     # after an intended change
     python -m benchmarks identity --list
 
@@ -107,7 +108,8 @@ def check(args, cases, base) -> int:
             print(f"CHANGED  {name}: recorded but no longer a case")
             changed += 1
     print(f"{same} of {len(cases)} case(s) identical, {changed} changed; {total:.1f} s CPU "
-          f"(recorded with the code of {doc.get('recorded_with_code_at', '?')}, checked with {git_commit()})")
+          f"(recorded with the code of {doc.get('recorded_with_code_at', '?')}, "
+          f"checked with {git_commit()})")
     return 1 if changed else 0
 
 

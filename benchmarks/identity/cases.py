@@ -8,6 +8,8 @@ by the operation; every file a command writes is digested (pictures are not aske
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from .harness import Case
 
 PROGRAM = ("-o", "program.json", "-o", "program.ngc")   # JSON and G-code
@@ -154,10 +156,11 @@ SLOW = [
     # surface models: loose faces sewn
     path("path-surf_boss_faces-4-5", "surf_boss_faces.step", (4, 5), 3),
     # options: tool tip, spindle, clearance, plunge feed, feed, period, allowance
-    path("path-bspline_boss-options", "bspline_boss.step", (4, 5), 3, "--tool-tip", "--spindle", "12000", "--clearance", "60",
+    path("path-bspline_boss-options", "bspline_boss.step", (4, 5), 3, "--tool-tip",
+         "--spindle", "12000", "--clearance", "60",
          "--plunge-feed", "300", "--feed", "3000", "--period", "2ms", "--allowance",
          "0.25"),
-    # the stream on a custom machine (INI) and at a replaced feed, and --stream
+    # the stream at a replaced feed and jerk (default machine); pencil's own --stream
     path("path-bspline_boss-stream-feed", "bspline_boss.step", (4, 5), 3,
          then=(("stream", "program.json", "--feed", "10000", "--jerk", "20000", "-o",
                 "stream.npy"),)),
@@ -218,12 +221,17 @@ NOTHING_AT_R3 = {"screw", "tr8_bv1_ct", "exhaust", "box-openshell", "toroidal"}
 
 
 def _refused(case: Case) -> Case:
-    return Case(case.name, case.part, case.commands, exits=(3,))
+    """``case`` expected to exit 3 (nothing to cut), writing nothing."""
+    return replace(case, exits=(3,))
+
+
+def _pencil_r3(key: str, part: str) -> Case:
+    case = pencil(f"shared-pencil-{key}-R3", part, 3)
+    return _refused(case) if key in NOTHING_AT_R3 else case
 
 
 SHARED = [
-    *[(_refused if key in NOTHING_AT_R3 else lambda c: c)(
-        pencil(f"shared-pencil-{key}-R3", part, 3)) for key, part in SHARED_PARTS.items()],
+    *[_pencil_r3(key, part) for key, part in SHARED_PARTS.items()],
     pencil("shared-pencil-l-bracket-R2", L_BRACKET, 2),
     pencil("shared-pencil-lever-R2", LEVER, 2),
     pencil("shared-pencil-abc-R2", ABC, 2),
