@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from ..core.work_limits import refuse_over
@@ -117,7 +118,9 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
     start, order, rng = bin_moves(grid.k, grid.lo, grid.res, grid.nu, grid.nv,
                                   moves.bb_lo, moves.bb_hi)
     ntiles = len(start) - 1
-    tiles = np.arange(ntiles)
+    # longest first, handed out one at a time: tiles without moves (the grid along Y, say,
+    # below the program) would otherwise leave a thread idle under prange's equal split
+    tiles = np.argsort(-np.diff(start), kind="stable")
     overflow = np.zeros(ntiles, np.bool_)
     col_move = np.zeros((ntiles, MAX_COLLISIONS), np.int64)
     col_at = np.zeros((ntiles, MAX_COLLISIONS, 3))
@@ -128,10 +131,11 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
     if grid.iv.shape[1] < init_iv.shape[1]:
         grid.iv = np.zeros((len(grid.cnt), init_iv.shape[1], 2), np.float32)
     while len(tiles):
-        cut_tiles(grid.k, grid.lo, grid.res, grid.nu, grid.nv, tiles, start, order, rng,
-                  moves.p0, moves.p1, moves.axis, moves.radius, moves.length, moves.rapid,
-                  moves.bb_lo, moves.bb_hi, init_iv, init_cnt, grid.iv, grid.cnt, ext,
-                  overflow, col_move, col_at, col_n)
+        with numba.parallel_chunksize(1):
+            cut_tiles(grid.k, grid.lo, grid.res, grid.nu, grid.nv, tiles, start, order, rng,
+                      moves.p0, moves.p1, moves.axis, moves.radius, moves.length,
+                      moves.rapid, moves.bb_lo, moves.bb_hi, init_iv, init_cnt, grid.iv,
+                      grid.cnt, ext, overflow, col_move, col_at, col_n)
         tiles = np.flatnonzero(overflow)
         if len(tiles):
             need = len(grid.cnt) * 2 * grid.iv.shape[1] * 8.0

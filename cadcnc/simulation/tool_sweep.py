@@ -121,8 +121,19 @@ def swept_tool(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, ax0, ax1, ax2, r, le
         return capsule(o0, o1, o2, k, p00 + s0 * ax0, p01 + s0 * ax1,
                        p02 + s0 * ax2, p00 + s1 * ax0, p01 + s1 * ax1,
                        p02 + s1 * ax2, r)
-    lo, hi = capsule(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, r)
     ak = ax0 if k == 0 else (ax1 if k == 1 else ax2)
+    h, hv = 0.0, 0.0
+    if ak == 0.0:
+        # a ray across the axis in the shank's band (above both centres, where every
+        # vertical segment of the parallelogram spans its height h): the 2-D stadium of the
+        # moved segment at h alone, which holds the bottom edge's balls' slice (not computed)
+        h = (o0 - p00) * ax0 + (o1 - p01) * ax1 + (o2 - p02) * ax2
+        hv = v0 * ax0 + v1 * ax1 + v2 * ax2
+        if h > min(0.0, hv) and max(0.0, hv) <= h <= min(0.0, hv) + length:
+            return capsule(o0, o1, o2, k, p00 + h * ax0, p01 + h * ax1,
+                           p02 + h * ax2, p10 + (h - hv) * ax0,
+                           p11 + (h - hv) * ax1, p12 + (h - hv) * ax2, r)
+    lo, hi = capsule(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, r)
     if ak == 1.0 or ak == -1.0:
         # a ray along the axis: the swept balls' lowest and highest points on it come from
         # the bottom and top edges, and it misses both or meets both (the same horizontal
@@ -141,16 +152,9 @@ def swept_tool(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, ax0, ax1, ax2, r, le
             return lo, hi
         return min(lo, t), max(hi, u)
     if ak == 0.0:
-        # a ray across the axis at height h above p0: where every vertical segment of the
-        # parallelogram spans h, the slice is the 2-D stadium of the moved segment
-        h = (o0 - p00) * ax0 + (o1 - p01) * ax1 + (o2 - p02) * ax2
-        hv = v0 * ax0 + v1 * ax1 + v2 * ax2
+        # a ray across the axis at height h above p0 (h, hv from above), not in the band
         if h <= min(0.0, hv):
             return lo, hi          # below both centres: the bottom edge's balls alone
-        if max(0.0, hv) <= h <= min(0.0, hv) + length:
-            return capsule(o0, o1, o2, k, p00 + h * ax0, p01 + h * ax1,
-                           p02 + h * ax2, p10 + (h - hv) * ax0,
-                           p11 + (h - hv) * ax1, p12 + (h - hv) * ax2, r)
         if h <= min(0.0, hv) + length:
             # between the centres' heights: the balls below h, and the stadium of the part
             # of the moved segment whose vertical segments span h (s hv <= h)
