@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import math
 
+import cadquery as cq
 import numpy as np
 import pytest
 
@@ -152,3 +153,20 @@ def test_the_job_records_the_strategy():
     job = Job(Tool(3.0), 1500.0, 0.004, op)
     again = Job.from_inputs(json.loads(json.dumps(job.to_inputs())))
     assert again.operation == op
+
+
+def test_two_loops_on_one_face_are_both_cut():
+    """A torus's outer face cut by a level gives two circles on the same face: the pieces
+    of one face differ only in their arrays, and choosing the nearest must not compare
+    them (comparing their arrays raised a ValueError: exit 1 on bug28414's torus)."""
+    torus = cq.Workplane().add(cq.Solid.makeTorus(20.0, 6.0))
+    part = cadcnc.Part.from_cadquery(torus)
+    job = Job(Tool(3.0), 1500.0, 0.004, Waterline(faces=(1,), stepdown=5.0),
+              source=part.source)
+    program = cadcnc.run(part, job)
+    assert program.complete
+    at = {}
+    for cut in program.cuts:
+        z = round(float(cut.points[0][2]), 6)
+        at.setdefault(z, []).append(cut)
+    assert any(len(cuts) >= 2 for cuts in at.values()), {z: len(c) for z, c in at.items()}

@@ -181,8 +181,7 @@ class _Level:
                     return 0.0
                 pts = pc.wire.points if pc.start is None else np.array([pc.start.p])
                 return float(np.linalg.norm(pts - self.here, axis=1).min())
-            piece = min(todo, key=distance)
-            todo.remove(piece)
+            piece = todo.pop(min(range(len(todo)), key=lambda k: distance(todo[k])))
             try:
                 self.cut(piece)
             except CadcncError as e:
