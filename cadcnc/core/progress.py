@@ -16,9 +16,6 @@ class Progress(Protocol):
     def __call__(self, done: int, total: int, what: str) -> None: ...
 
 
-def cycles_progress(progress: Progress | None, total: int = 0):
-    """The interpolator's own callback, ``(cycles, mm travelled)`` (``Stepper.run``), as a
-    call of ``progress``: ``(cycles, total, "<mm> mm")``; None for None."""
-    if progress is None:
-        return None
-    return lambda cycles, mm: progress(cycles, total, f"{mm:.1f} mm")
+def travelled_text(mm: float) -> str:
+    """The interpolator's ``what``: the distance travelled so far (mm, 3 decimals)."""
+    return f"{mm:.3f} mm"

@@ -21,6 +21,7 @@ import numpy as np
 from ..core.errors import GeometryError
 from ..core.job import MIN_STEP as JOB_MIN_STEP
 from ..core.job import check_number, check_step
+from ..core.progress import travelled_text
 from ..core.tolerances import DEFAULT
 from ..core.trim_labels import OUTSIDE
 from .cycle import (
@@ -223,7 +224,7 @@ class CompiledStepper(Stepper):
             cycles = self.cycles
             if progress is not None and cycles % every == 0 and cycles != reported:
                 reported = cycles
-                progress(cycles, self.travelled)
+                progress(cycles, 0, travelled_text(self.travelled))
         return self
 
     def follow(self, plan: np.ndarray, args: np.ndarray) -> np.ndarray:

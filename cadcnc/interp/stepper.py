@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from ..core.job import MIN_STEP, check_number, check_step
+from ..core.progress import travelled_text
 from ..core.tolerances import DEFAULT, Tolerances
 from ..core.trim_labels import OUTSIDE
 from .cycle import (
@@ -376,8 +377,9 @@ class Stepper:
         return dp
 
     def run(self, progress=None, every: int = 10000) -> "Stepper":
-        """Step until stopped; ``progress(cycles, travelled_mm)`` every ``every`` cycles."""
+        """Step until stopped; ``progress(cycles, 0, "<travelled> mm")`` (the package's
+        :class:`~cadcnc.core.progress.Progress`, total unknown) every ``every`` cycles."""
         while self.step() is not None:
             if progress is not None and self.cycles % every == 0:
-                progress(self.cycles, self.travelled)
+                progress(self.cycles, 0, travelled_text(self.travelled))
         return self

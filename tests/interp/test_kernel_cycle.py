@@ -93,6 +93,7 @@ def test_a_surface_without_compiled_data_keeps_the_reference():
 def test_the_progress_callback_sees_the_compiled_loop():
     plan, job = plan_for("torus_cone", 1, 2)
     seen = []
-    st = make(plan, job, True).run(lambda n, mm: seen.append((n, mm)), every=256)  # the record fills (1024 rows) between reports
+    st = make(plan, job, True).run(lambda n, total, what: seen.append((n, float(what.split()[0]))),
+                                   every=256)  # the record fills (1024 rows) between reports
     assert [n for n, _ in seen] == list(range(256, st.cycles + 1, 256))
     assert all(0 < mm < st.travelled for _, mm in seen)

@@ -354,8 +354,8 @@ class _Pass:
                           period=job.period, direction=tuple(tau), end=end,
                           tol=job.tolerances, max_cycles=max_cycles, guard=guard)
         where = self.where(face)
-        stepper.run(progress=lambda cycles, mm: self.beat(
-            lambda: f"{where}: {self.cycles + cycles} cycles, {mm:.3f} mm"), every=BEAT_CYCLES)
+        stepper.run(progress=lambda cycles, _total, travelled: self.beat(
+            lambda: f"{where}: {self.cycles + cycles} cycles, {travelled}"), every=BEAT_CYCLES)
         self.cycles += stepper.cycles
         self.result.cycles = self.cycles
         op = PairPath(faces=(face, None), offsets=(None, 0.0), start=start.p, edge=None)

@@ -14,7 +14,7 @@ import numpy as np
 
 from ...core.errors import FacePairError, GeometryError, InputError, StartPointError
 from ...core.job import Job, PairPath, Tool
-from ...core.progress import Progress, cycles_progress
+from ...core.progress import Progress
 from ...core.tolerances import DEFAULT, Tolerances
 from ...geometry.face_surface import FaceSurface
 from ...geometry.part import CONCAVE
@@ -206,7 +206,7 @@ def run_plan(plan: PathPlan, max_cycles: int = 1_000_000,
              progress: Progress | None = None) -> Toolpath:
     """Run the stepper of a plan to its stop; the toolpath with its error bounds.
     ``progress(cycles, 0, "<mm> mm")`` every 10 000 cycles."""
-    stepper = stepper_for(plan, max_cycles, True).run(cycles_progress(progress))
+    stepper = stepper_for(plan, max_cycles, True).run(progress)
     if stepper.cycles == 0:
         raise GeometryError(f"no path: the interpolator stopped at the start point "
                             f"({stepper.stop_reason}): {stepper.stop_detail}")

@@ -24,7 +24,7 @@ import numpy as np
 
 from ...core.errors import InputError, NothingToCutError, StartPointError
 from ...core.job import Job
-from ...core.progress import Progress, cycles_progress
+from ...core.progress import Progress
 from ...guard import guard_for
 from ...interp.cycle import BOUNDARY, COLLISION
 from ...interp.stepper import Tangency
@@ -73,11 +73,10 @@ def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000,
     if i is None or j is None:
         raise InputError("the job names no faces: give the two face numbers")
     require_ball(job)
-    steps = cycles_progress(progress)   # the stepper's (cycles, mm)
     s1, s2 = part.face(i), part.face(j)
     guard = guard_for(part, (i, j), job)
     if op.start is not None:
-        return _from_start(part, job, s1, s2, guard, max_cycles, steps)
+        return _from_start(part, job, s1, s2, guard, max_cycles, progress)
     shared_edge_for(s1, s2)  # FacePairError unless they share a concave edge
     if found is None:
         found = pair_stretches(s1, s2, job, guard)
@@ -87,7 +86,7 @@ def program_for_job(part, job: Job, *, max_cycles: int = 1_000_000,
                              f"is no edge {op.edge + 1}")
         found = [found[op.edge]]
     refuse_without_stretch(s1, s2, found)
-    cuts, skipped = stretch_cuts(s1, s2, job, found, guard, max_cycles, steps)
+    cuts, skipped = stretch_cuts(s1, s2, job, found, guard, max_cycles, progress)
     if op.stretch is not None and not cuts:
         n = max(len(e.stretches) for e in found)
         raise InputError(f"faces {i} and {j}: there is no stretch {op.stretch} (the edges "
@@ -153,7 +152,7 @@ def stretch_cuts(s1, s2, job: Job, found, guard, max_cycles: int = 1_000_000,
     the travel for climb; see :func:`climb_measure`), re-running a cut from its other end
     where the edge's own direction is the other way; None keeps the edge's direction.
     ``work["cycles"]`` (when given) counts every stepper cycle run, re-runs included;
-    ``steps``: the stepper's own ``(cycles, mm)`` callback (``Stepper.run``)."""
+    ``steps``: the stepper's progress callback (``Stepper.run``: cycles, 0, the distance)."""
     i, j = s1.number, s2.number
     cuts, skipped = [], []
     work = {} if work is None else work
@@ -230,7 +229,7 @@ def _point_cut(plan: PathPlan) -> Toolpath:
         "reached by the plunge"), plan.edge_length)
 
 
-def _from_start(part, job, s1, s2, guard, max_cycles, steps) -> Program:
+def _from_start(part, job, s1, s2, guard, max_cycles, progress) -> Program:
     """One cut from the user's start, moved to the nearest stretch limit when the ball
     cannot sit there (a contact off its face, a third face or the shank in the way)."""
     notes = []
@@ -247,6 +246,6 @@ def _from_start(part, job, s1, s2, guard, max_cycles, steps) -> Program:
         notes.append(note or f"start moved into a stretch ({rule}: {detail})")
         moved = replace(job, operation=replace(job.operation, start=tuple(tan.p)))
         plan = plan_path(s1, s2, moved)
-    tp = run_stretch(plan, guard, max_cycles, steps)
+    tp = run_stretch(plan, guard, max_cycles, progress)
     cut = CutSegment(tp, edge=None, at_limit=tp.stop_reason in (BOUNDARY, COLLISION))
     return entered_program(part, plan.job, [cut], [], notes)

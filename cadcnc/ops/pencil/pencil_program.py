@@ -141,7 +141,8 @@ def _pair_corners(part: Part, task, beat=None) -> tuple[list, dict, dict]:
         cjob = replace(job, operation=PairPath(faces=(i, j), edge=corner.edge))
         at = f"faces {i} {j}"
         feas = None
-        steps = (lambda cycles, mm: beat.beat(f"{at}: interpolating, {cycles} cycles"))
+        steps = (lambda cycles, _total, _travelled: beat.beat(
+            f"{at}: interpolating, {cycles} cycles"))
         cuts: list[CutSegment] = []
         skipped: list[Skipped] = []
         try:
