@@ -48,7 +48,7 @@ def run_stretch(plan: PathPlan, guard, max_cycles: int, steps,
     """Run the plan's stepper with ``guard`` inside it (given to the constructor, so that
     the compiled stepper asks it before committing a step); a path of its start alone is
     an error unless ``allow_empty`` (the caller then skips it with the stop's reason);
-    ``steps``: the stepper's own ``(cycles, mm)`` callback, or None."""
+    ``steps``: the stepper's progress (``Progress``: cycles, 0, the distance), or None."""
     stepper = stepper_for(plan, max_cycles, True, guard=guard)
     stepper.run(steps)
     if stepper.cycles == 0 and not allow_empty:

@@ -49,7 +49,7 @@ FILES = ("path.json", "path.csv", "path.ngc", "demo.apt", "verification.txt",
 
 def run_demo(out, say, progress=None) -> int:
     """Run the demo into the folder ``out``; ``say(text)``: its narrative for the user,
-    ``progress``: the path's ``(cycles, mm)`` callback. The exit code."""
+    ``progress``: the path's ``Progress`` (cycles, 0, the distance). The exit code."""
     step = demo_step()
     out = Path(out)
     try:

@@ -64,7 +64,7 @@ def verify_program(source: str, tol: Tolerances, *, part_file: str | None = None
                    links_progress=None) -> VerifyRun:
     """Verify every cut of a program against OCCT: the program saved in ``source`` (a
     .json) or computed from ``job`` on the STEP file ``source``; then its links by the
-    operations' gate. ``progress``: the computation's ``(cycles, mm)``;
+    operations' gate. ``progress``: the computation's ``Progress`` (cycles, 0, the distance);
     ``cut_progress()`` / ``links_progress()``: a new ``(stage, done, total)`` callback for
     each cut's checks and for the links gate, made when they start."""
     if job is None:
