@@ -130,10 +130,13 @@ def _connect_in(pid: int | None, port: int, timeout: float) -> socket.socket:
 
 class Rsh:
     """A linuxcncrsh client on 127.0.0.1 (echo off, verbose on: every ``set`` is ACKed);
-    ``netns_pid``: a process in the network namespace linuxcncrsh runs in (None: ours)."""
+    ``netns_pid``: a process in the network namespace linuxcncrsh runs in (None: ours).
+    ``timeout``: seconds an answer may take (LinuxCNC's task answers slowly on a loaded
+    machine: ``machine on`` waits for HAL's threads)."""
 
-    def __init__(self, port: int, connectpw: str, enablepw: str, timeout: float = 10.0,
+    def __init__(self, port: int, connectpw: str, enablepw: str, timeout: float = 60.0,
                  netns_pid: int | None = None):
+        self.timeout = timeout
         self.sock = _connect_in(netns_pid, port, timeout)
         self.buf = b""
         self.ask(f"hello {connectpw} cadcnc 1.0", expect="HELLO ACK")
@@ -161,7 +164,11 @@ class Rsh:
         """
         self.send(line)
         while True:
-            answer = self._line()
+            try:
+                answer = self._line()
+            except TimeoutError:
+                raise HalError(f"linuxcncrsh did not answer {line!r} within "
+                               f"{self.timeout:g} s") from None
             if answer.startswith(expect):
                 return answer
             if "NAK" in answer:
