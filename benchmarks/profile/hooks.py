@@ -26,6 +26,7 @@ STAGES = {   # stage name: (module, attribute path)
     "limits": ("cadcnc.ops.path.stretches", "locate_limit"),
     "stepping": ("cadcnc.ops.common", "run_stretch"),
     "guard.margin": ("cadcnc.guard.clearance", "ClearanceGuard.margin"),
+    "guard.first_hit": ("cadcnc.guard.clearance", "ClearanceGuard.first_hit"),
     "guard.budget": ("cadcnc.guard.guard", "OperationGuard.budget"),
     "linking": ("cadcnc.ops.entries", "entered_program_segments"),
     "settle (cut-back)": ("cadcnc.pipeline.exit_policy", "settle"),

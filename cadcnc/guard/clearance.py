@@ -34,7 +34,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Builder
+from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape, BRepExtrema_IsInFace
 from OCP.gp import gp_Pnt
@@ -89,6 +91,8 @@ class ClearanceGuard:
         self._broad_at: tuple[float, float, float] | None = None
         self._near: list[int] = []          # face numbers within reach at _broad_at
         self._bound: dict[int, tuple] = {}  # face -> (p0, lower bound of the margin at p0, slope)
+        self._hits: dict[int, tuple] = {}   # third face -> (p0, its exact margin < 0 at p0, who)
+        self._shared: dict[int, tuple] = {}  # third face -> boxes of what it shares with i, j
         self.calls = 0
         self.exact_calls = 0     # OCCT distances
         self.closed_calls = 0    # closed-form distances
@@ -101,18 +105,29 @@ class ClearanceGuard:
         >= 0: clear ("" or the nearest face's name); < 0: a hit, with the detail
         "ball touches face K" or "shank touches face K".
         """
+        return self._margin(p, False)[:2]
+
+    def first_hit(self, p) -> tuple[float, str, bool]:
+        """:meth:`margin`, or as soon as one face is found cutting in (the faces taken
+        from the lowest bound up): (clearance or, on such a hit, the hit face's exact
+        margin, an upper bound of the clearance, mm; detail; whether it is the exact
+        clearance). For a verdict that needs only the sign."""
+        return self._margin(p, True)
+
+    def _margin(self, p, stop: bool) -> tuple[float, str, bool]:
+        """:meth:`margin`, stopping at the first hit when ``stop`` (:meth:`first_hit`)."""
         self.calls += 1
         p = (float(p[0]), float(p[1]), float(p[2]))
         if not math.isfinite(p[0] + p[1] + p[2]):
-            return -math.inf, "ball centre is not a finite point"   # fail closed
+            return -math.inf, "ball centre is not a finite point", True   # fail closed
         moved = math.inf if self._broad_at is None else distance(p, self._broad_at)
         if moved > self.reach:
             self._broad_phase(p)
             moved = 0.0
         best, detail = self.reach - moved, ""   # lower bound for the faces not near
-        for k in self._near:
-            p0, m0, slope = self._bound[k]
-            m = m0 - slope * distance(p, p0)
+        bounds = [(self._bound[k][1] - self._bound[k][2] * distance(p, self._bound[k][0]), k)
+                  for k in self._near]
+        for m, k in sorted(bounds) if stop else bounds:
             who = ""
             if m < 0.0:    # the bound cannot clear it: measure
                 m, who = self._exact(k, p)
@@ -121,7 +136,9 @@ class ClearanceGuard:
                 best = m
                 detail = f"{who} touches face {k}" if m < 0.0 else \
                     (f"{who} nearest face {k}" if who else f"face {k} within reach")
-        return best, detail
+            if stop and best < 0.0:
+                return best, detail, False
+        return best, detail, True
 
     def _broad_phase(self, p) -> None:
         """Faces whose box may come within R' of the tool before the centre moves
@@ -178,8 +195,41 @@ class ClearanceGuard:
         self._bound[k] = (p, m, 2.0 if own else 1.0)
         if own or m >= 0.0:
             return m, "shank" if own else "tool"
-        return m, "ball" if below or self._point_distance(k, p) < self.threshold \
-            else "shank"
+        who = "ball" if below or self._point_distance(k, p) < self.threshold else "shank"
+        if math.isfinite(m):   # (-inf: an unknown distance, measured again)
+            self._hits[k] = (p, m, who)
+        return m, who
+
+    def proven_hit(self, p) -> tuple[float, str] | None:
+        """(an upper bound < 0 of the clearance at ``p`` (mm), detail) when a hit measured
+        nearby proves one without OCCT, else None. A third face's margin is 1-Lipschitz
+        in the centre (the distance from the tool's segment, which moves with it): a
+        margin m0 < 0 measured at p0 leaves at most m = m0 + |p - p0| at p. A contact met
+        only on an edge or vertex the face shares with face i or j counts as clear, so
+        for a face that shares any, the boxes of those edges and vertices must also lie
+        further than R' - tol + m from the segment (then no nearest point is on them).
+        The detail names the face and who touched it at p0."""
+        p = (float(p[0]), float(p[1]), float(p[2]))
+        best = None
+        for k, (p0, m0, who) in self._hits.items():
+            m = m0 + distance(p, p0)
+            if m < 0.0 and (best is None or m < best[0]) and \
+                    self._shared_distance(k, p) > self.threshold + m:
+                best = (m, f"{who} touches face {k}")
+        return best
+
+    def _shared_distance(self, k: int, p) -> float:
+        """A lower bound (mm) of the distance from the tool's segment at ``p`` to the edges
+        and vertices face k shares with face i or j (their boxes'; inf: none shared)."""
+        if k not in self._shared:
+            self._shared[k] = _shared_boxes(self._faces[k - 1].topods, self._own_shapes)
+        lo, hi = self._shared[k]
+        if not len(lo):
+            return math.inf
+        seg_lo = np.array(p)
+        seg_hi = seg_lo + (0.0, 0.0, self.shank)
+        gap = np.maximum(np.maximum(lo - seg_hi, seg_lo - hi), 0.0)
+        return float(np.sqrt((gap * gap).sum(axis=1)).min())
 
     def _segment_distance(self, k: int, p, length: float | None = None,
                           cap: float | None = None) -> tuple[float, bool]:
@@ -311,6 +361,22 @@ class ClearanceGuard:
         face = self._faces[k - 1].topods
         ext = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(), face)
         return ext.Value() if ext.IsDone() and ext.NbSolution() else -math.inf
+
+
+def _shared_boxes(face, own_shapes) -> tuple[np.ndarray, np.ndarray]:
+    """(lows (m, 3), highs (m, 3)): the boxes (exact geometry, widened by BOX_SLACK mm) of
+    the edges and vertices of ``face`` that ``own_shapes`` holds."""
+    boxes = []
+    for kind in (TopAbs_EDGE, TopAbs_VERTEX):
+        shapes = TopTools_IndexedMapOfShape()
+        TopExp.MapShapes_s(face, kind, shapes)
+        for n in range(1, shapes.Extent() + 1):
+            if own_shapes.Contains(shapes.FindKey(n)):
+                box = Bnd_Box()
+                BRepBndLib.AddOptimal_s(shapes.FindKey(n), box, False, False)
+                boxes.append(box.Get())
+    b = np.array(boxes, dtype=float).reshape(-1, 6)
+    return b[:, :3] - BOX_SLACK, b[:, 3:] + BOX_SLACK
 
 
 def _part_data(part) -> tuple:

@@ -160,6 +160,8 @@ class EdgeStretches:
         rule = max(counts, key=counts.get)
         failing = [x for x in on_edge if x.rule == rule]
         example = failing[len(failing) // 2]   # the middle one: away from the edge's ends
+        if self.judge is not None:
+            example = self.judge.exact(example)
         return (f"edge {self.edge + 1}: no feasible ball position: {REASONS.get(rule, rule)}"
                 f" ({example.detail}; at {counts[rule]} of {len(on_edge)} samples on the "
                 "edge)")
@@ -176,9 +178,13 @@ class Feasibility:
         self.max_reach = 10.0 * max(max(self.offsets), 1e-3)   # mm from the anchor
         self.samples, self.beat = 0, None   # positions judged; called after each (progress)
 
-    def sample(self, s: float, anchor, tangent, seed: Tangency | None = None) -> Sample:
+    def sample(self, s: float, anchor, tangent, seed: Tangency | None = None,
+               quick: bool = False) -> Sample:
         """Solve the tangency in the plane through ``anchor`` normal to ``tangent`` (seeded
-        from ``seed`` or the projections of the anchor) and judge it."""
+        from ``seed`` or the projections of the anchor) and judge it; ``quick``: a hit the
+        guard proves from a nearby one (:meth:`ClearanceGuard.proven_hit`), or the first
+        face found cutting in (:meth:`ClearanceGuard.first_hit`), is taken without the
+        exact clearance (the sample then has no COLLISION margin; :meth:`exact`)."""
         tangent = tuple(map(float, tangent))
         self.samples += 1
         if self.beat is not None:
@@ -194,16 +200,25 @@ class Feasibility:
             return Sample(s, UNSOLVED, "the tangency found is far from the edge", None,
                           tangent)
         margins: dict[str, float] = {}
-        rule, detail = self._verdict(tan, margins)
+        rule, detail = self._verdict(tan, margins, quick)
         return Sample(s, rule, detail, tan, tangent, margins)
+
+    def exact(self, x: Sample) -> Sample:
+        """``x`` judged again with every margin it failed on exact (a quick sample)."""
+        if x.tangency is None or x.rule != COLLISION or COLLISION in x.margins:
+            return x
+        margins: dict[str, float] = {}
+        rule, detail = self._verdict(x.tangency, margins)
+        return replace(x, rule=rule, detail=detail, margins=margins)
 
     def judge(self, tan: Tangency) -> tuple[str, str]:
         """(FEASIBLE, "") or the first failing rule and a detail naming the face."""
         return self._verdict(tan, {})
 
-    def _verdict(self, tan: Tangency, margins: dict) -> tuple[str, str]:
+    def _verdict(self, tan: Tangency, margins: dict, quick: bool = False) -> tuple[str, str]:
         """:meth:`judge`, filling ``margins`` with each rule's signed margin as it is
-        checked (from what the check computes: no call is added)."""
+        checked (from what the check computes: no call is added); ``quick``: see
+        :meth:`sample`."""
         c1 = Contact(self.s1, self.offsets[0], *tan.uv1)
         c2 = Contact(self.s2, self.offsets[1], *tan.uv2)
         t = np.cross(c1.n, c2.n)
@@ -225,7 +240,13 @@ class Feasibility:
             if too_tight(c.offset * k, c.offset, self.tol):
                 return CURVATURE, f"face {s.number}: R' k = {c.offset * k:.4g} > 1"
         if self.guard is not None:
-            m, detail = self.guard.margin(tan.p)
+            hit = self.guard.proven_hit(tan.p) if quick else None
+            if hit is not None:
+                return COLLISION, f"{hit[1]} (at least {-hit[0]:.4g} mm too near)"
+            m, detail, exact = self.guard.first_hit(tan.p) if quick else \
+                (*self.guard.margin(tan.p), True)
+            if not exact:
+                return COLLISION, f"{detail} (at least {-m:.4g} mm too near)"
             margins[COLLISION] = m
             if m < 0.0:
                 return COLLISION, f"{detail} ({-m:.4g} mm too near)"
@@ -287,19 +308,22 @@ def edge_stretches(feas: Feasibility, shared_edge, edge: int,
 
 
 def _reseeded(feas: Feasibility, curve: EdgeCurve, s: float, last: Sample | None) -> Sample:
-    """The sample at ``s`` seeded from ``last``, or from the anchor (see RESEED)."""
-    x = sample_at(feas, curve, s, last)
+    """The (quick) sample at ``s`` seeded from ``last``, or from the anchor (see RESEED)."""
+    x = sample_at(feas, curve, s, last, quick=True)
     if last is None or x.rule not in RESEED or x.rule == last.rule or not 0 <= s <= curve.length:
         return x
-    return max(x, sample_at(feas, curve, s, None), key=lambda y: y.ok)
+    return max(x, sample_at(feas, curve, s, None, quick=True), key=lambda y: y.ok)
 
 
-def sample_at(feas: Feasibility, curve: EdgeCurve, s: float, seed: Sample | None) -> Sample:
+def sample_at(feas: Feasibility, curve: EdgeCurve, s: float, seed: Sample | None,
+              quick: bool = False) -> Sample:
+    """The sample at arc length ``s`` seeded from ``seed`` (else, or when that fails to
+    solve, from the anchor); ``quick``: see :meth:`Feasibility.sample`."""
     anchor, tangent = curve.point_tangent(s)
     tan = seed.tangency if seed is not None else None
-    got = feas.sample(s, anchor, tangent, tan)
+    got = feas.sample(s, anchor, tangent, tan, quick)
     if got.rule == UNSOLVED and tan is not None:   # the seed may mislead: try the anchor
-        got = feas.sample(s, anchor, tangent, None)
+        got = feas.sample(s, anchor, tangent, None, quick)
     return got
 
 
@@ -322,7 +346,7 @@ def _refine(feas, curve, samples: list[Sample], out: EdgeStretches) -> list[Samp
                     # seeded from a's tangency, feasible or not, as the grid is: from the
                     # anchor alone Newton may land on another branch of the curve (millimetres
                     # away), and every halving would land there again
-                    stack.append(sample_at(feas, curve, 0.5 * (a.s + b.s), a))
+                    stack.append(sample_at(feas, curve, 0.5 * (a.s + b.s), a, quick=True))
                     continue
                 out.missed += 1
             result.append(stack.pop())
@@ -335,6 +359,7 @@ def locate_limit(feas, curve, good: Sample, bad: Sample) -> tuple[Sample, Sample
     centres are ``Tolerances.stretch_limit`` apart (the anchors LIMIT_TOL where the failing
     side has no centre)."""
     tol = getattr(feas, "tol", DEFAULT).stretch_limit
+    bad = feas.exact(bad)
     good, bad, _ = root_limit(lambda s, seed: sample_at(feas, curve, s, seed), good, bad,
                               tol, LIMIT_TOL, ONE_SIDED,
                               () if curve.closed else (0.0, curve.length))
