@@ -10,7 +10,9 @@ gets its own exact path, never a chord across a join:
 - any other cut (a corner path between two faces): the two offset surfaces, by OCCT
   (``BRepExtrema_DistShapeShape`` through ``cadcnc.verification.probe.FaceProbe``): for a
   point p, max(|dist(p, face_a) - R_a|, |dist(p, face_b) - R_b|); beyond the cut's first
-  or last point, at least the distance to that point.
+  or last point, at least the distance to that point;
+- a finishing pass on a free-form face (one face, its points in a plane): the face's
+  offset surface by OCCT and the guide plane, max(|dist(p, face) - R|, |plane distance|).
 
 Positions (K, 3) mm; distances (K,) mm. ``stream_error`` measures each stream row against
 its own piece; ``distance`` measures a sample against the nearest piece (LinuxCNC's runs,
@@ -164,6 +166,46 @@ class Offsets:
         return out
 
 
+class Guided(Offsets):
+    """A finishing pass: the face's offset surface at R (OCCT distance) and the guide
+    plane the pass lies in (fitted to the cut's points, residual within ``FIT_TOL``, as
+    an arc's plane is): max(|dist(p, face) - R|, |(p - o) . n|); past an end, at least
+    the distance to it (as :class:`Offsets`)."""
+
+    kind = "guided"
+
+    def __init__(self, face, radius: float, pts: np.ndarray, o: np.ndarray, n: np.ndarray):
+        super().__init__([face], (radius,), pts)
+        self.o, self.n = o, n
+
+    def distance(self, p: np.ndarray) -> np.ndarray:
+        p = np.atleast_2d(p)
+        return np.maximum(super().distance(p), np.abs((p - self.o) @ self.n))
+
+    def on_path(self, q: np.ndarray, steps: int = 6) -> np.ndarray:
+        """A point on the offset surface and the plane near q (3,): Newton in the span of
+        the face's normal and the plane's (points known on the path, to check it)."""
+        q = np.asarray(q, float).copy()
+        for _ in range(steps):
+            ((d, f),) = self.feet(q)
+            N = np.vstack([(q - f) / d, self.n])
+            rhs = -np.array([d - self.radii[0], (q - self.o) @ self.n])
+            q = q + N.T @ np.linalg.solve(N @ N.T, rhs)
+        return q
+
+
+def fit_plane(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(a point, unit normal) of the plane through the points, if every point is within
+    FIT_TOL of it (and they span one: not a line)."""
+    if len(pts) < 3:
+        return None
+    o = pts.mean(axis=0)
+    _, sv, vt = np.linalg.svd(pts - o, full_matrices=False)
+    if sv[1] <= FIT_TOL * len(pts) or np.abs((pts - o) @ vt[2]).max() > FIT_TOL:
+        return None
+    return o, vt[2]
+
+
 def piece_reference(piece, program, part):
     """The exact path of one piece: Line, Arc or Offsets (see the module doc)."""
     pts = np.asarray(piece.points, float)
@@ -174,6 +216,9 @@ def piece_reference(piece, program, part):
         return ref
     path = program.cuts[piece.cut].path
     fa, fb = path.faces
+    plane = fit_plane(pts) if fa is not None and fb is None else None
+    if plane is not None:   # a finishing pass: one face on a guide plane
+        return Guided(part.face(fa).topods, path.offsets[0], pts, *plane)
     if fa is None or fb is None:
         raise ValueError(f"cut {piece.cut}: neither a line nor an arc, and not between "
                          f"two faces of the part (faces {path.faces})")
@@ -210,11 +255,11 @@ class PathReference:
         p = np.atleast_2d(p)
         best = np.full(len(p), np.inf)
         for ref in self.refs:   # lines and arcs are cheap: all of them
-            if ref.kind != "offsets":
+            if ref.kind not in ("offsets", "guided"):
                 best = np.minimum(best, ref.distance(p))
         d0, _ = self._tree.query(p)
         for ref in self.refs:   # a corner path where its points are near enough
-            if ref.kind == "offsets":
+            if ref.kind in ("offsets", "guided"):
                 dj, _ = ref._tree.query(p)
                 sel = dj <= np.minimum(best, d0) + ref.h + NEAR
                 if sel.any():

@@ -111,3 +111,29 @@ def test_stream_true_contour_error_within_a_tenth_of_a_micron(streams):
         assert err.max() <= 0.1 * UM, (tag, err.max())
         # rows are measured against their own piece: the nearest piece gives no more
         assert ref.distance(s.positions[::7]).max() <= err.max() + 1e-15
+
+
+@pytest.mark.slow
+def test_a_finishing_pass_on_a_free_form_face_is_measured_on_its_offset_and_plane():
+    """finish_slab's B-spline face 5, raster R 3: each pass is a Guided reference (the
+    face's offset by OCCT, the plane fitted to the pass); the kernel's points lie on it,
+    a point moved 1 µm off the plane is 1 µm off, and Newton's point is on it."""
+    import cadcnc
+    from cadcnc.controller import Machine
+    from cadcnc.controller.pieces import pieces_of
+    from cadcnc.ops.finish.shortcut import finish
+    from cadcnc.testing.contour_reference import Guided, piece_reference
+    from helpers.fixtures import FIXTURES
+
+    part = cadcnc.load_step(FIXTURES / "finish_slab.step")
+    program = finish(part, [5], radius=3.0, stepover=4.0)
+    pieces = [pc for pc in pieces_of(program, Machine.default(), 10_000.0)
+              if pc.cut is not None][:2]
+    for pc in pieces:
+        ref = piece_reference(pc, program, part)
+        assert isinstance(ref, Guided)
+        pts = np.asarray(pc.points)[::7]
+        assert ref.distance(pts).max() < 1e-9
+        assert np.allclose(ref.distance(pts + UM * ref.n), UM, rtol=0, atol=1e-9)
+        q = ref.on_path(pts[len(pts) // 2] + np.array([2e-3, -1e-3, 3e-3]))
+        assert ref.distance(q)[0] < 1e-12
