@@ -164,12 +164,33 @@ def dense_ngc(program, part, ref: PathReference, machine: Machine, feed: float) 
     return "\n".join(lines + ["M2", "%", ""])
 
 
-def run_all(out: Path, machines: list[str], only: list[str] | None = None) -> list[dict]:
-    """Every case (``only``: these programs, the other rows of results.json kept)."""
+def long_programs(folder: Path, shared: Path | None):
+    """The long free-form programs (name, part, program): a raster finish of the free-form
+    slab (R 3, stepover 1: about 56 000 points), a waterline program of the same face
+    (R 3, stepdown 1), and, with ``shared``, the whole-part pencil of the L-bracket (R 3)."""
+    import cadcnc
+    from benchmarks.pace.bench_pace import slab_case
+
+    path, job = slab_case(str(folder))
+    part = cadcnc.load_step(path)
+    yield "finish-slab free-form raster R 3 stepover 1", part, cadcnc.run(part, job)
+    top = job.operation.faces
+    yield "waterline-slab free-form R 3 stepdown 1", part, cadcnc.run(part, replace(
+        job, operation=cadcnc.Waterline(top, 1.0)))
+    if shared is not None:
+        part = cadcnc.load_step(shared / "bug3883_xr2-ct-214_l-bracket.stp")
+        yield "pencil-bracket whole part R 3", part, cadcnc.run(part, cadcnc.Job(
+            cadcnc.Tool(3.0), 1500.0, 0.004, cadcnc.Pencil(), source=part.source))
+
+
+def run_all(out: Path, machines: list[str], only: list[str] | None = None,
+            cases=None) -> list[dict]:
+    """Every case of ``cases`` (default: the three programs; ``only``: these programs,
+    the other rows of results.json kept)."""
     done = out / "results.json"
     rows = [r for r in json.loads(done.read_text()) if not r["program"].startswith(
         tuple(only)) or r["machine"] not in machines] if only and done.exists() else []
-    for name, part, program in programs():
+    for name, part, program in (programs() if cases is None else cases):
         if only and not name.startswith(tuple(only)):
             continue
         tag, first, last = name.split()[0], program.segments[0].points[0], last_move(program)
@@ -257,12 +278,17 @@ def main() -> None:
                     help="run only these programs (corner, pencil, finish)")
     ap.add_argument("--remeasure", action="store_true",
                     help="measure the positions saved in --out again (no HAL, no LinuxCNC)")
+    ap.add_argument("--long", action="store_true",
+                    help="the long free-form programs (long_programs) instead of the three")
+    ap.add_argument("--shared", type=Path, help="the public parts' folder (--long: the "
+                    "whole-part pencil of the L-bracket)")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     if args.remeasure:
         remeasure(args.out)
     else:
-        run_all(args.out, args.machines, args.only)
+        run_all(args.out, args.machines, args.only,
+                long_programs(args.out, args.shared) if args.long else None)
 
 
 if __name__ == "__main__":
