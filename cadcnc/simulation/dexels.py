@@ -6,9 +6,11 @@ index is ``iu * nv + iv``. Intervals are stored as float32 offsets from ``lo[k]`
 ``iv[ray, i] = (start, end)`` for ``i < cnt[ray]``, at most ``K`` of them. Rays are cut
 tile by tile (``TILE`` x ``TILE`` rays) on every numba thread; a tile applies the moves that
 reach it in program order, so a rapid meets the stock exactly as the earlier moves left it.
-A tile whose ray would need more than K intervals stops and is flagged: the caller grows K
-and cuts that tile again from the initial stock (cutting is idempotent). numba's cache does
-not see edits of :mod:`.tool_sweep` (inlined here): clear ``__pycache__/*.nb[ic]`` after one.
+A tile whose ray would need more than K intervals stops at that move: the caller grows K
+and the tile resumes there (cutting is idempotent: the move's rays already cut lose nothing
+more). A ray that a move cannot cut (:mod:`.sweep_bounds`) is skipped before the closed form
+(:mod:`.tool_sweep`), whose per-move terms are computed once a move. numba's cache does not
+see edits of those modules (inlined here): clear ``__pycache__/*.nb[ic]`` after one.
 """
 
 from __future__ import annotations
@@ -18,7 +20,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .tool_sweep import swept_tool
+from .sweep_bounds import misses
+from .tool_sweep import swept_ray
 
 TILE = 32
 SLIVER = 1e-6        # mm: a piece of material shorter than this along a ray is dropped
@@ -129,15 +132,18 @@ def bin_moves(k, lo, res, nu, nv, bb_lo, bb_hi):
 
 
 @njit(cache=True, parallel=True)
-def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, axis, radius, length,
-              rapid, bb_lo, bb_hi, init_iv, init_cnt, iv, cnt, ext, overflow, col_move,
-              col_at, col_n):
+def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, table, bounds, rapid,
+              bb_lo, bb_hi, init_iv, init_cnt, iv, cnt, ext, resume, col_move, col_at, col_n):
     """Cut the grid's ``tiles`` (indices) by their moves: each ray starts from ``init_iv``,
-    ``init_cnt`` and loses every move's swept tool (:func:`swept_tool`); p0, p1, axis
-    (N, 3), radius, length (N,), rapid (N,) bool. Writes ``iv``, ``cnt`` and ``ext`` (rays,
-    2): each ray's first start and last end, read first (one cache line for a ray missed); ``overflow[t]``
-    for a tile that needs more intervals; rapids through material into ``col_*`` (per
-    tile: moves (T, C), points (T, C, 3), counts (T,))."""
+    ``init_cnt`` and loses every move's swept tool (:func:`~.tool_sweep.swept_ray` of the
+    move's row of ``table``, :func:`~.tool_sweep.move_table`, unless the row of ``bounds``
+    says it cannot cut: :func:`~.sweep_bounds.bounds_table`); p0, p1 (N, 3), rapid (N,)
+    bool. Writes ``iv``, ``cnt`` and ``ext`` (rays, 2): each ray's first start and last
+    end, read first (one cache line for a ray missed); rapids through material into
+    ``col_*`` (per tile: moves (T, C), points (T, C, 3), counts (T,)). ``resume[t]``: where
+    tile t starts in ``moves`` (``start[t]``: from the initial stock); set to the move that
+    needed more intervals than K, -1 when the tile is done: the caller grows K and calls
+    again, the move applied again to the rays it already cut (cutting is idempotent)."""
     u, v = (k + 1) % 3, (k + 2) % 3
     ntv = (nv + TILE - 1) // TILE
     kmax = iv.shape[1]
@@ -146,66 +152,85 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, axis, radius
         tu, tv = t // ntv, t % ntv
         u0, u1 = tu * TILE, min(nu, tu * TILE + TILE) - 1
         v0, v1 = tv * TILE, min(nv, tv * TILE + TILE) - 1
-        for a in range(u0, u1 + 1):
-            for b in range(v0, v1 + 1):
-                r = a * nv + b
-                c = init_cnt[r]
-                for i in range(c):
-                    iv[r, i, 0] = init_iv[r, i, 0]
-                    iv[r, i, 1] = init_iv[r, i, 1]
-                cnt[r] = c
-                if c > 0:
-                    ext[r, 0] = init_iv[r, 0, 0]
-                    ext[r, 1] = init_iv[r, c - 1, 1]
-        overflow[t] = False
-        col_n[t] = 0
+        first_move = resume[t]
+        resume[t] = -1
+        if first_move == start[t]:
+            _load_tile(u0, u1, v0, v1, nv, init_iv, init_cnt, iv, cnt, ext)
+            col_n[t] = 0
         o = np.empty(3)
-        for q in range(start[t], start[t + 1]):
+        for q in range(first_move, start[t + 1]):
             m = moves[q]
             tlo, thi = bb_lo[m, k] - lo[k], bb_hi[m, k] - lo[k]
-            a0, a1, a2 = p0[m, 0], p0[m, 1], p0[m, 2]
-            b0, b1, b2 = p1[m, 0], p1[m, 1], p1[m, 2]
-            x0, x1, x2 = axis[m, 0], axis[m, 1], axis[m, 2]
-            rad, ln = radius[m], length[m]
+            c, bm = table[m], bounds[m]
             for a in range(max(u0, rng[m, 0]), min(u1, rng[m, 1]) + 1):
                 o[u] = lo[u] + (a + 0.5) * res
                 for b in range(max(v0, rng[m, 2]), min(v1, rng[m, 3]) + 1):
                     r = a * nv + b
-                    if ext[r, 1] <= tlo or ext[r, 0] >= thi:
+                    e0, e1 = ext[r, 0], ext[r, 1]
+                    if e1 <= tlo or e0 >= thi:
                         continue
                     n = cnt[r]
                     if n == 0:
                         continue
                     o[v] = lo[v] + (b + 0.5) * res
-                    o[k] = lo[k]
-                    ta, tb = swept_tool(o[0], o[1], o[2], k, a0, a1, a2, b0, b1, b2,
-                                        x0, x1, x2, rad, ln, ext[r, 0], ext[r, 1])
-                    if ta >= tb:
+                    if misses(bm, o[u], o[v], e0, e1):
                         continue
+                    o[k] = lo[k]
+                    ta, tb = swept_ray(o[0], o[1], o[2], k, c, e0, e1)
+                    if ta >= tb or tb <= e0 or ta >= e1:
+                        continue       # (no material met: subtract would change nothing)
                     n2, overlap, first = subtract(iv, r, n, ta, tb, kmax)
                     if n2 < 0:
-                        overflow[t] = True
+                        resume[t] = q
                         break
                     cnt[r] = n2
-                    if n2 > 0:
-                        ext[r, 0] = iv[r, 0, 0]
-                        ext[r, 1] = iv[r, n2 - 1, 1]
-                    else:
-                        ext[r, 0], ext[r, 1] = 1.0, -1.0
+                    _extent(iv, r, n2, ext)
                     if rapid[m] and overlap > COLLISION_OVERLAP:
-                        c = col_n[t]
-                        if c > 0 and col_move[t, c - 1] == m:
-                            c -= 1      # the same move: keep the point met first
-                            if _ahead(col_at[t, c], o, k, lo[k] + first, p0[m], p1[m]):
-                                continue
-                        elif c == MAX_COLLISIONS:
-                            continue
-                        col_move[t, c] = m
-                        col_at[t, c, u] = o[u]
-                        col_at[t, c, v] = o[v]
-                        col_at[t, c, k] = lo[k] + first
-                        col_n[t] = c + 1
-                if overflow[t]:
+                        _collision(t, m, o, u, v, k, lo[k] + first, p0[m], p1[m], col_move,
+                                   col_at, col_n)
+                if resume[t] >= 0:
                     break
-            if overflow[t]:
+            if resume[t] >= 0:
                 break
+
+
+@njit(cache=True)
+def _load_tile(u0, u1, v0, v1, nv, init_iv, init_cnt, iv, cnt, ext):
+    """The tile's rays (u0..u1, v0..v1) set to their initial stock."""
+    for a in range(u0, u1 + 1):
+        for b in range(v0, v1 + 1):
+            r = a * nv + b
+            c = init_cnt[r]
+            for i in range(c):
+                iv[r, i, 0] = init_iv[r, i, 0]
+                iv[r, i, 1] = init_iv[r, i, 1]
+            cnt[r] = c
+            _extent(iv, r, c, ext)
+
+
+@njit(cache=True)
+def _extent(iv, r, n, ext):
+    """``ext[r]`` set to ray r's first start and last end of its ``n`` intervals (1, -1: none)."""
+    if n > 0:
+        ext[r, 0] = iv[r, 0, 0]
+        ext[r, 1] = iv[r, n - 1, 1]
+    else:
+        ext[r, 0], ext[r, 1] = 1.0, -1.0
+
+
+@njit(cache=True)
+def _collision(t, m, o, u, v, k, tk, p0, p1, col_move, col_at, col_n):
+    """Record rapid ``m`` through material at o (o[k] = tk) for tile t: the first point
+    met of each move, at most MAX_COLLISIONS moves a tile."""
+    c = col_n[t]
+    if c > 0 and col_move[t, c - 1] == m:
+        c -= 1      # the same move: keep the point met first
+        if _ahead(col_at[t, c], o, k, tk, p0, p1):
+            return
+    elif c == MAX_COLLISIONS:
+        return
+    col_move[t, c] = m
+    col_at[t, c, u] = o[u]
+    col_at[t, c, v] = o[v]
+    col_at[t, c, k] = tk
+    col_n[t] = c + 1

@@ -17,9 +17,12 @@ import numpy as np
 
 from ..core.work_limits import refuse_over
 from .dexels import MAX_COLLISIONS, TILE, bin_moves, cut_tiles
+from .sweep_bounds import BOUNDS, bounds_table
+from .tool_sweep import CONSTANTS, move_table
 
 K0 = 4                    # intervals a ray holds at first (grown on demand)
 BYTES_PER_RAY = 80        # K0 intervals (float32 pairs), counts, extents, initial stock, part crossings
+BYTES_PER_MOVE = 8 * (CONSTANTS + BOUNDS)   # a move's constants and bounds (float64 rows)
 NS_PER_EVALUATION = 4.0   # ns of one core per ray a move's box covers (benchmarks/simulation)
 MAX_MEMORY = 6e9          # bytes one simulation may hold
 MAX_SECONDS = 1800.0      # estimated seconds of cutting one simulation may take
@@ -75,7 +78,7 @@ def evaluations(lo, hi, res: float, bb_lo: np.ndarray, bb_hi: np.ndarray) -> flo
 
 def estimate(lo, hi, res: float, bb_lo, bb_hi, threads: int) -> tuple[float, float]:
     """(bytes, seconds) the simulation is about to need."""
-    return (rays(lo, hi, res) * BYTES_PER_RAY,
+    return (rays(lo, hi, res) * BYTES_PER_RAY + len(bb_lo) * BYTES_PER_MOVE,
             evaluations(lo, hi, res, bb_lo, bb_hi) * NS_PER_EVALUATION * 1e-9 / max(threads, 1))  # ns to s
 
 
@@ -121,7 +124,7 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
     # longest first, handed out one at a time: tiles without moves (the grid along Y, say,
     # below the program) would otherwise leave a thread idle under prange's equal split
     tiles = np.argsort(-np.diff(start), kind="stable")
-    overflow = np.zeros(ntiles, np.bool_)
+    resume = start[:-1].copy()
     col_move = np.zeros((ntiles, MAX_COLLISIONS), np.int64)
     col_at = np.zeros((ntiles, MAX_COLLISIONS, 3))
     col_n = np.zeros(ntiles, np.int64)
@@ -130,13 +133,15 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
     ext[:, 0], ext[:, 1] = 1.0, -1.0
     if grid.iv.shape[1] < init_iv.shape[1]:
         grid.iv = np.zeros((len(grid.cnt), init_iv.shape[1], 2), np.float32)
+    table = move_table(moves.p0, moves.p1, moves.axis, moves.radius, moves.length)
+    bounds = bounds_table(grid.k, grid.lo[grid.k], table)
     while len(tiles):
         with numba.parallel_chunksize(1):
             cut_tiles(grid.k, grid.lo, grid.res, grid.nu, grid.nv, tiles, start, order, rng,
-                      moves.p0, moves.p1, moves.axis, moves.radius, moves.length,
-                      moves.rapid, moves.bb_lo, moves.bb_hi, init_iv, init_cnt, grid.iv,
-                      grid.cnt, ext, overflow, col_move, col_at, col_n)
-        tiles = np.flatnonzero(overflow)
+                      moves.p0, moves.p1, table, bounds, moves.rapid, moves.bb_lo, moves.bb_hi,
+                      init_iv, init_cnt, grid.iv, grid.cnt, ext, resume, col_move, col_at,
+                      col_n)
+        tiles = np.flatnonzero(resume >= 0)      # resumed where they stopped, K doubled
         if len(tiles):
             need = len(grid.cnt) * 2 * grid.iv.shape[1] * 8.0
             refuse_over(f"the grid along {'XYZ'[grid.k]} at --resolution {grid.res:g} mm "
