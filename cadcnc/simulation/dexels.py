@@ -34,7 +34,9 @@ def subtract(iv, r, n, a, b, kmax):
     """Remove [a, b] from the ``n`` sorted intervals of ray ``r`` of ``iv`` (rays, K, 2) in
     place: (new n, or -1 when more than ``kmax`` would be needed; overlap length; t of the
     first overlap)."""
-    lo_, hi_ = 0, n            # i0: the first interval ending after a (binary search)
+    # i0: the first interval ending after a (binary search; the first one when the cut
+    # takes the front of the material, the common case)
+    lo_, hi_ = (0, 0) if n == 0 or iv[r, 0, 1] > a else (1, n)
     while lo_ < hi_:
         mid = (lo_ + hi_) >> 1
         if iv[r, mid, 1] <= a:
@@ -42,7 +44,8 @@ def subtract(iv, r, n, a, b, kmax):
         else:
             hi_ = mid
     i0 = lo_
-    lo_, hi_ = i0, n           # i1 + 1: the first interval starting at or after b
+    # i1 + 1: the first interval starting at or after b (n when the last one starts before)
+    lo_, hi_ = (n, n) if i0 < n and iv[r, n - 1, 0] < b else (i0, n)
     while lo_ < hi_:
         mid = (lo_ + hi_) >> 1
         if iv[r, mid, 0] < b:
