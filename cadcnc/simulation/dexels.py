@@ -20,7 +20,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .sweep_bounds import misses
+from .sweep_bounds import misses, misses_box
 from .tool_sweep import swept_ray
 
 TILE = 32
@@ -161,19 +161,29 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, table, bound
             _load_tile(u0, u1, v0, v1, nv, init_iv, init_cnt, iv, cnt, ext)
             col_n[t] = 0
         o = np.empty(3)
+        # the tile's rays' material lies within [te0, te1]: it only shrinks, so an old
+        # extent stays a bound; renewed by every move that visits all the tile's rays
+        te0, te1 = _tile_extent(u0, u1, v0, v1, nv, cnt, ext)
+        cu, hu = lo[u] + (0.5 * (u0 + u1) + 0.5) * res, 0.5 * (u1 - u0) * res
+        cv, hv = lo[v] + (0.5 * (v0 + v1) + 0.5) * res, 0.5 * (v1 - v0) * res
         for q in range(first_move, start[t + 1]):
             m = moves[q]
-            tlo, thi = bb_lo[m, k] - lo[k], bb_hi[m, k] - lo[k]
             c, bm = table[m], bounds[m]
+            if misses_box(bm, cu, cv, hu, hv, te0, te1):
+                continue                # no ray of the tile: the move is behind them all
+            tlo, thi = bb_lo[m, k] - lo[k], bb_hi[m, k] - lo[k]
+            whole = rng[m, 0] <= u0 and rng[m, 1] >= u1 and rng[m, 2] <= v0 and rng[m, 3] >= v1
+            ne0, ne1 = np.inf, -np.inf
             for a in range(max(u0, rng[m, 0]), min(u1, rng[m, 1]) + 1):
                 o[u] = lo[u] + (a + 0.5) * res
                 for b in range(max(v0, rng[m, 2]), min(v1, rng[m, 3]) + 1):
                     r = a * nv + b
-                    e0, e1 = ext[r, 0], ext[r, 1]
-                    if e1 <= tlo or e0 >= thi:
-                        continue
                     n = cnt[r]
                     if n == 0:
+                        continue
+                    e0, e1 = ext[r, 0], ext[r, 1]
+                    ne0, ne1 = min(ne0, e0), max(ne1, e1)
+                    if e1 <= tlo or e0 >= thi:
                         continue
                     o[v] = lo[v] + (b + 0.5) * res
                     if misses(bm, o[u], o[v], e0, e1):
@@ -195,6 +205,20 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, table, bound
                     break
             if resume[t] >= 0:
                 break
+            if whole:
+                te0, te1 = ne0, ne1
+
+
+@njit(cache=True)
+def _tile_extent(u0, u1, v0, v1, nv, cnt, ext):
+    """(lowest start, highest end) of the material of the tile's rays (inf, -inf: none)."""
+    e0, e1 = np.inf, -np.inf
+    for a in range(u0, u1 + 1):
+        for b in range(v0, v1 + 1):
+            r = a * nv + b
+            if cnt[r] > 0:
+                e0, e1 = min(e0, ext[r, 0]), max(e1, ext[r, 1])
+    return e0, e1
 
 
 @njit(cache=True)

@@ -83,6 +83,25 @@ def misses(b, pu, pv, e0, e1):
     d = 0.0
     for i in range(DIRECTIONS):
         d = max(d, b[3 * i] * pu + b[3 * i + 1] * pv - b[3 * i + 2])
+    return _beyond(b, d, e0, e1)
+
+
+@njit(cache=True)
+def misses_box(b, cu, cv, hu, hv, e0, e1):
+    """:func:`misses` for every ray within the rectangle centred at (cu, cv), half sides
+    hu, hv (mm), whose material lies within [e0, e1]: the support lines' distance taken
+    at the rectangle's nearest corner."""
+    d = 0.0
+    for i in range(DIRECTIONS):
+        nu, nv = b[3 * i], b[3 * i + 1]
+        d = max(d, nu * cu + nv * cv - abs(nu) * hu - abs(nv) * hv - b[3 * i + 2])
+    return _beyond(b, d, e0, e1)
+
+
+@njit(cache=True)
+def _beyond(b, d, e0, e1):
+    """Whether material within [e0, e1] lies beyond the tool of bounds row ``b`` on rays at
+    least ``d`` mm from its projected parallelogram (module doc)."""
     if d >= b[MISS]:
         return True
     q = b[R2] - d * d
