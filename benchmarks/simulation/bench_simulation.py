@@ -71,7 +71,7 @@ def main(argv=None) -> int:
     dexel_mesh(stock, max_side=10)                           # compile / load the cache
     clock = time.perf_counter()
     verts, tris = dexel_mesh(stock)
-    print(f"  stock mesh from the three grids: every {stride_for(stock)}th ray, "
+    print(f"  stock mesh from the three grids: one ray in {stride_for(stock)}, "
           f"{len(tris):.3g} triangles in {time.perf_counter() - clock:.1f} s; load average "
           f"after {os.getloadavg()[0]:.1f}")
     return 0

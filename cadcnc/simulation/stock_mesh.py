@@ -26,6 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
+MESH_SUFFIXES = (".stl", ".glb")   # the outputs that hold the stock mesh
 MAX_SIDE = 400        # nodes along the lattice's longest side (a coarser stride beyond)
 TRIANGLES_PER_CUBE = 10   # at most: 12 crossings in loops of at least 3
 # the cube's corners c = dx + 2 dy + 4 dz; its faces' corners counter-clockwise seen from
@@ -216,6 +217,13 @@ def stride_for(stock, max_side: int = MAX_SIDE) -> int:
     """The rays' stride that keeps the lattice's longest side within ``max_side`` nodes."""
     n = max(stock.grids[2].nu, stock.grids[2].nv, stock.grids[0].nv)
     return max(1, math.ceil(n / max_side))
+
+
+def mesh_note(stock, max_side: int = MAX_SIDE) -> str:
+    """The line that says the stock mesh uses every s-th ray (empty when it uses all)."""
+    s = stride_for(stock, max_side)
+    return "" if s == 1 else (f"stock mesh: one ray in {s}, {s * stock.res:g} mm between its "
+                              f"nodes (at most {max_side} a side)")
 
 
 def dexel_mesh(stock, max_side: int = MAX_SIDE) -> tuple[np.ndarray, np.ndarray]:

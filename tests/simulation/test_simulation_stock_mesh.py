@@ -10,7 +10,7 @@ import pytest
 
 from cadcnc.io.simulation_plot import stl_bytes
 from cadcnc.simulation.stock import cut_stock
-from cadcnc.simulation.stock_mesh import dexel_mesh, stride_for
+from cadcnc.simulation.stock_mesh import dexel_mesh, mesh_note, stride_for
 from cadcnc.simulation.tool_moves import Run
 
 trimesh = pytest.importorskip("trimesh")
@@ -63,6 +63,7 @@ def test_an_uncut_box_is_closed_and_holds_the_box():
     assert stl.is_watertight and stl.volume == pytest.approx(mesh.volume, rel=1e-6)  # float32
     coarse = closed_mesh(stock, max_side=20)           # every 4th ray
     assert stride_for(stock, 20) == 4
+    assert mesh_note(stock, 20).startswith("stock mesh: one ray in 4, 1 mm") and not mesh_note(stock)
     assert 0 <= float(np.prod(HI - LO)) - coarse.volume <= chamfer_loss(HI - LO, 4 * res)
 
 
