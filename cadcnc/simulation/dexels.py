@@ -4,8 +4,9 @@ Ray (iu, iv) of the grid along axis ``k`` runs along e_k through ``u = lo[u] + (
 res``, ``v = lo[v] + (iv + 1/2) res`` with ``(u, v) = ((k + 1) % 3, (k + 2) % 3)``; its
 index is ``iu * nv + iv``. Intervals are stored as float32 offsets from ``lo[k]`` (mm):
 ``iv[ray, i] = (start, end)`` for ``i < cnt[ray]``, at most ``K`` of them. Rays are cut
-tile by tile (``TILE`` x ``TILE`` rays) on every numba thread; a tile applies the moves that
-reach it in program order, so a rapid meets the stock exactly as the earlier moves left it.
+tile by tile (``tile`` x ``tile`` rays, :data:`TILES`) on every numba thread; a tile applies
+the moves that reach it in program order, so a rapid meets the stock exactly as the earlier
+moves left it.
 A tile whose ray would need more than K intervals stops at that move: the caller grows K
 and the tile resumes there (cutting is idempotent: the move's rays already cut lose nothing
 more). A ray that a move cannot cut (:mod:`.sweep_bounds`) is skipped before the closed form
@@ -23,10 +24,13 @@ from numba import njit, prange
 from .sweep_bounds import misses, misses_box
 from .tool_sweep import swept_ray
 
-TILE = 32
+# rays a tile's side, per grid (X, Y, Z): across a +Z program's tool a larger tile meets
+# fewer tile-move pairs (the benchmark's Y grid: 0.87 of the CPU at 64 against 32); along it
+# the moves' footprints are small and a whole tile is skipped more often at 32 (64: 1.17)
+TILES = (64, 64, 32)
 SLIVER = 1e-6        # mm: a piece of material shorter than this along a ray is dropped
 COLLISION_OVERLAP = 1e-3   # mm: a rapid's tool overlapping material longer than this on a ray
-MAX_COLLISIONS = 16  # collisions recorded per tile (distinct moves, first point of each)
+MAX_COLLISIONS = 64  # collisions recorded per tile (distinct moves, first point of each)
 
 
 @njit(cache=True)
@@ -100,11 +104,11 @@ def _ahead(kept, o, k, tk, p0, p1):
 
 
 @njit(cache=True)
-def bin_moves(k, lo, res, nu, nv, bb_lo, bb_hi):
+def bin_moves(k, lo, res, nu, nv, bb_lo, bb_hi, tile):
     """Moves per tile (CSR: ``start`` (tiles + 1,), ``moves`` in program order) from the
-    moves' boxes ``bb_lo``, ``bb_hi`` (N, 3)."""
+    moves' boxes ``bb_lo``, ``bb_hi`` (N, 3); ``tile`` rays a tile's side."""
     u, v = (k + 1) % 3, (k + 2) % 3
-    ntu, ntv = (nu + TILE - 1) // TILE, (nv + TILE - 1) // TILE
+    ntu, ntv = (nu + tile - 1) // tile, (nv + tile - 1) // tile
     counts = np.zeros(ntu * ntv + 1, np.int64)
     n = bb_lo.shape[0]
     rng = np.empty((n, 4), np.int64)
@@ -116,8 +120,8 @@ def bin_moves(k, lo, res, nu, nv, bb_lo, bb_hi):
         rng[m, 0], rng[m, 1], rng[m, 2], rng[m, 3] = a0, a1, b0, b1
         if a0 > a1 or b0 > b1:
             continue
-        for tu in range(a0 // TILE, a1 // TILE + 1):
-            for tv in range(b0 // TILE, b1 // TILE + 1):
+        for tu in range(a0 // tile, a1 // tile + 1):
+            for tv in range(b0 // tile, b1 // tile + 1):
                 counts[tu * ntv + tv + 1] += 1
     start = np.cumsum(counts)
     fill = start[:-1].copy()
@@ -126,8 +130,8 @@ def bin_moves(k, lo, res, nu, nv, bb_lo, bb_hi):
         a0, a1, b0, b1 = rng[m, 0], rng[m, 1], rng[m, 2], rng[m, 3]
         if a0 > a1 or b0 > b1:
             continue
-        for tu in range(a0 // TILE, a1 // TILE + 1):
-            for tv in range(b0 // TILE, b1 // TILE + 1):
+        for tu in range(a0 // tile, a1 // tile + 1):
+            for tv in range(b0 // tile, b1 // tile + 1):
                 t = tu * ntv + tv
                 moves[fill[t]] = m
                 fill[t] += 1
@@ -136,7 +140,8 @@ def bin_moves(k, lo, res, nu, nv, bb_lo, bb_hi):
 
 @njit(cache=True, parallel=True)
 def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, table, bounds, rapid,
-              bb_lo, bb_hi, init_iv, init_cnt, iv, cnt, ext, resume, col_move, col_at, col_n):
+              bb_lo, bb_hi, init_iv, init_cnt, iv, cnt, ext, resume, col_move, col_at, col_n,
+              tile):
     """Cut the grid's ``tiles`` (indices) by their moves: each ray starts from ``init_iv``,
     ``init_cnt`` and loses every move's swept tool (:func:`~.tool_sweep.swept_ray` of the
     move's row of ``table``, :func:`~.tool_sweep.move_table`, unless the row of ``bounds``
@@ -146,15 +151,16 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, table, bound
     ``col_*`` (per tile: moves (T, C), points (T, C, 3), counts (T,)). ``resume[t]``: where
     tile t starts in ``moves`` (``start[t]``: from the initial stock); set to the move that
     needed more intervals than K, -1 when the tile is done: the caller grows K and calls
-    again, the move applied again to the rays it already cut (cutting is idempotent)."""
+    again, the move applied again to the rays it already cut (cutting is idempotent).
+    ``tile``: rays a tile's side, as :func:`bin_moves` had them."""
     u, v = (k + 1) % 3, (k + 2) % 3
-    ntv = (nv + TILE - 1) // TILE
+    ntv = (nv + tile - 1) // tile
     kmax = iv.shape[1]
     for ti in prange(tiles.shape[0]):
         t = tiles[ti]
         tu, tv = t // ntv, t % ntv
-        u0, u1 = tu * TILE, min(nu, tu * TILE + TILE) - 1
-        v0, v1 = tv * TILE, min(nv, tv * TILE + TILE) - 1
+        u0, u1 = tu * tile, min(nu, tu * tile + tile) - 1
+        v0, v1 = tv * tile, min(nv, tv * tile + tile) - 1
         first_move = resume[t]
         resume[t] = -1
         if first_move == start[t]:

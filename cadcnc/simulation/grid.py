@@ -16,7 +16,7 @@ import numba
 import numpy as np
 
 from ..core.work_limits import refuse_over
-from .dexels import MAX_COLLISIONS, TILE, bin_moves, cut_tiles
+from .dexels import MAX_COLLISIONS, TILES, bin_moves, cut_tiles
 from .sweep_bounds import BOUNDS, bounds_table
 from .tool_sweep import CONSTANTS, move_table
 
@@ -118,8 +118,9 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
     """Cut ``grid`` by ``moves`` (a :class:`~.moves.Moves`) from its initial stock, growing
     K where a ray needs it (refused past ``max_memory`` bytes); the rapids through
     material: [(move, point (3,))]."""
+    tile = TILES[grid.k]
     start, order, rng = bin_moves(grid.k, grid.lo, grid.res, grid.nu, grid.nv,
-                                  moves.bb_lo, moves.bb_hi)
+                                  moves.bb_lo, moves.bb_hi, tile)
     ntiles = len(start) - 1
     # longest first, handed out one at a time: tiles without moves (the grid along Y, say,
     # below the program) would otherwise leave a thread idle under prange's equal split
@@ -140,7 +141,7 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
             cut_tiles(grid.k, grid.lo, grid.res, grid.nu, grid.nv, tiles, start, order, rng,
                       moves.p0, moves.p1, table, bounds, moves.rapid, moves.bb_lo, moves.bb_hi,
                       init_iv, init_cnt, grid.iv, grid.cnt, ext, resume, col_move, col_at,
-                      col_n)
+                      col_n, tile)
         tiles = np.flatnonzero(resume >= 0)      # resumed where they stopped, K doubled
         if len(tiles):
             need = len(grid.cnt) * 2 * grid.iv.shape[1] * 8.0
@@ -155,4 +156,4 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
             for t in range(ntiles) for c in range(col_n[t])]
 
 
-__all__ = ["Grid", "TILE", "box_grids", "check_limits", "cut", "estimate", "rays"]
+__all__ = ["Grid", "TILES", "box_grids", "check_limits", "cut", "estimate", "rays"]
