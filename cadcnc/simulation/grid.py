@@ -113,6 +113,16 @@ def box_grids(lo, hi, res: float) -> tuple[list[Grid], list[tuple[np.ndarray, np
     return grids, inits
 
 
+def dealt(tiles: np.ndarray, work: np.ndarray) -> np.ndarray:
+    """``tiles`` (T,) reordered for prange's split into one contiguous block per thread
+    (numba's static schedule: ``parallel_chunksize`` did not apply here, one thread got
+    every tile with moves): sorted by ``work`` (T,), longest first, then dealt out
+    round-robin, so that each block holds an equal share of long and short tiles."""
+    threads = numba.get_num_threads()
+    order = tiles[np.argsort(-work, kind="stable")]
+    return np.concatenate([order[j::threads] for j in range(threads)])
+
+
 def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
         max_memory: float = MAX_MEMORY) -> list[tuple[int, np.ndarray]]:
     """Cut ``grid`` by ``moves`` (a :class:`~.moves.Moves`) from its initial stock, growing
@@ -122,9 +132,7 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
     start, order, rng = bin_moves(grid.k, grid.lo, grid.res, grid.nu, grid.nv,
                                   moves.bb_lo, moves.bb_hi, tile)
     ntiles = len(start) - 1
-    # longest first, handed out one at a time: tiles without moves (the grid along Y, say,
-    # below the program) would otherwise leave a thread idle under prange's equal split
-    tiles = np.argsort(-np.diff(start), kind="stable")
+    tiles = dealt(np.arange(ntiles), np.diff(start))
     resume = start[:-1].copy()
     col_move = np.zeros((ntiles, MAX_COLLISIONS), np.int64)
     col_at = np.zeros((ntiles, MAX_COLLISIONS, 3))
@@ -137,12 +145,12 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
     table = move_table(moves.p0, moves.p1, moves.axis, moves.radius, moves.length)
     bounds = bounds_table(grid.k, grid.lo[grid.k], table)
     while len(tiles):
-        with numba.parallel_chunksize(1):
-            cut_tiles(grid.k, grid.lo, grid.res, grid.nu, grid.nv, tiles, start, order, rng,
-                      moves.p0, moves.p1, table, bounds, moves.rapid, moves.bb_lo, moves.bb_hi,
-                      init_iv, init_cnt, grid.iv, grid.cnt, ext, resume, col_move, col_at,
-                      col_n, tile)
+        cut_tiles(grid.k, grid.lo, grid.res, grid.nu, grid.nv, tiles, start, order, rng,
+                  moves.p0, moves.p1, table, bounds, moves.rapid, moves.bb_lo, moves.bb_hi,
+                  init_iv, init_cnt, grid.iv, grid.cnt, ext, resume, col_move, col_at,
+                  col_n, tile)
         tiles = np.flatnonzero(resume >= 0)      # resumed where they stopped, K doubled
+        tiles = dealt(tiles, start[tiles + 1] - resume[tiles])
         if len(tiles):
             need = len(grid.cnt) * 2 * grid.iv.shape[1] * 8.0
             refuse_over(f"the grid along {'XYZ'[grid.k]} at --resolution {grid.res:g} mm "
