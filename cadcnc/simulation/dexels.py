@@ -267,3 +267,16 @@ def _collision(t, m, o, u, v, k, tk, p0, p1, col_move, col_at, col_n):
     col_at[t, c, v] = o[v]
     col_at[t, c, k] = tk
     col_n[t] = c + 1
+
+
+@njit(cache=True, parallel=True)
+def grown(iv, kmax):
+    """``iv`` (rays, K, 2) copied into (rays, kmax, 2), the new slots zero; on every thread
+    (1 GB at the benchmark's K = 64: numpy's copy was 5 s of one core)."""
+    out = np.empty((iv.shape[0], kmax, 2), iv.dtype)
+    k = iv.shape[1]
+    for r in prange(iv.shape[0]):
+        for i in range(kmax):
+            out[r, i, 0] = iv[r, i, 0] if i < k else 0.0
+            out[r, i, 1] = iv[r, i, 1] if i < k else 0.0
+    return out

@@ -16,7 +16,7 @@ import numba
 import numpy as np
 
 from ..core.work_limits import refuse_over
-from .dexels import MAX_COLLISIONS, TILES, bin_moves, cut_tiles
+from .dexels import MAX_COLLISIONS, TILES, bin_moves, cut_tiles, grown
 from .sweep_bounds import BOUNDS, bounds_table
 from .tool_sweep import CONSTANTS, move_table
 
@@ -157,9 +157,7 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
                         f"({2 * grid.iv.shape[1]} pieces of material on a ray)", need / 1e9,
                         max_memory / 1e9, "GB", "give a coarser --resolution (memory goes "
                         "as its inverse square)")
-            grown = np.zeros((len(grid.cnt), 2 * grid.iv.shape[1], 2), np.float32)
-            grown[:, :grid.iv.shape[1]] = grid.iv
-            grid.iv = grown
+            grid.iv = grown(grid.iv, 2 * grid.iv.shape[1])
     return [(int(col_move[t, c]), col_at[t, c].copy())
             for t in range(ntiles) for c in range(col_n[t])]
 
