@@ -1,6 +1,7 @@
 """The stock simulation's speed: a raster program of about 1e5 moves (ball R 3 mm, shank to
 the clearance) over a wavy surface, on a 100 x 100 x 50 mm box at 0.05 mm (8e6 rays).
-Prints the time per move and per ray, the threads, the K the rays grew to, the memory.
+Prints the time per move and per ray, the threads, the K the rays grew to, the memory, and
+the time of the stock mesh from the three grids.
 
     python -m benchmarks.simulation.bench_simulation [--moves N] [--resolution MM] [--jobs N]
 
@@ -18,6 +19,7 @@ import numpy as np
 
 from cadcnc.simulation.grid import evaluations, rays
 from cadcnc.simulation.stock import cut_stock
+from cadcnc.simulation.stock_mesh import dexel_mesh, stride_for
 from cadcnc.simulation.tool_moves import Run
 
 LO, HI = np.array([0.0, 0.0, 0.0]), np.array([100.0, 100.0, 50.0])
@@ -62,9 +64,16 @@ def main(argv=None) -> int:
           f"{numba.get_num_threads()} threads: {seconds:.1f} s ({cpu:.1f} s of CPU; load "
           f"average before {load:.1f})")
     print(f"  per move {seconds / n * 1e6:.0f} us; per ray {seconds / nr * 1e6:.2f} us; per "
-          f"ray a move's box covers {seconds / ev * 1e9:.2f} ns ({ev:.3g} of them)")
+          f"ray a move's box covers {seconds / ev * 1e9:.2f} ns ({ev:.3g} of them; "
+          f"{cpu / ev * 1e9:.2f} ns of CPU)")
     print(f"  intervals per ray at most {max(g.iv.shape[1] for g in stock.grids)}; "
           f"stock {mem / 1e6:.0f} MB; volume left {stock.volume() / 1e3:.1f} cm^3")
+    dexel_mesh(stock, max_side=10)                           # compile / load the cache
+    clock = time.perf_counter()
+    verts, tris = dexel_mesh(stock)
+    print(f"  stock mesh from the three grids: one ray in {stride_for(stock)}, "
+          f"{len(tris):.3g} triangles in {time.perf_counter() - clock:.1f} s; load average "
+          f"after {os.getloadavg()[0]:.1f}")
     return 0
 
 

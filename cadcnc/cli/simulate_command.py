@@ -10,11 +10,14 @@ written (checked first).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from cadcnc.core.errors import InputError
 from cadcnc.core.units import parse_length
 from cadcnc.geometry.part import load_step
 from cadcnc.simulation.report_files import check_outputs, write_outputs
 from cadcnc.simulation.simulator import simulate as run_simulation
+from cadcnc.simulation.stock_mesh import MESH_SUFFIXES, mesh_note
 
 from .options import tolerances
 
@@ -50,5 +53,8 @@ def simulate(args) -> int:
     write_outputs(report, part, outputs, f"{args.step}: {', '.join(args.programs)}")
     if not args.quiet:
         print(report.summary())
+        note = mesh_note(report.stock)
+        if note and any(Path(d).suffix.lower() in MESH_SUFFIXES for d in outputs.destinations):
+            print("  " + note)
         print("wrote " + ", ".join(str(d) for d in outputs.destinations))
     return report.exit_code

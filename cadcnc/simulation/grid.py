@@ -16,11 +16,14 @@ import numba
 import numpy as np
 
 from ..core.work_limits import refuse_over
-from .dexels import MAX_COLLISIONS, TILE, bin_moves, cut_tiles
+from .dexels import MAX_COLLISIONS, TILES, bin_moves, cut_tiles, grown
+from .sweep_bounds import BOUNDS, bounds_table
+from .tool_sweep import CONSTANTS, move_table
 
 K0 = 4                    # intervals a ray holds at first (grown on demand)
 BYTES_PER_RAY = 80        # K0 intervals (float32 pairs), counts, extents, initial stock, part crossings
-NS_PER_EVALUATION = 4.0   # ns of one core per ray a move's box covers (benchmarks/simulation)
+BYTES_PER_MOVE = 8 * (CONSTANTS + BOUNDS)   # a move's constants and bounds (float64 rows)
+NS_PER_EVALUATION = 20.0  # ns of one core per ray a move's box covers (benchmarks/simulation: 19)
 MAX_MEMORY = 6e9          # bytes one simulation may hold
 MAX_SECONDS = 1800.0      # estimated seconds of cutting one simulation may take
 
@@ -75,7 +78,7 @@ def evaluations(lo, hi, res: float, bb_lo: np.ndarray, bb_hi: np.ndarray) -> flo
 
 def estimate(lo, hi, res: float, bb_lo, bb_hi, threads: int) -> tuple[float, float]:
     """(bytes, seconds) the simulation is about to need."""
-    return (rays(lo, hi, res) * BYTES_PER_RAY,
+    return (rays(lo, hi, res) * BYTES_PER_RAY + len(bb_lo) * BYTES_PER_MOVE,
             evaluations(lo, hi, res, bb_lo, bb_hi) * NS_PER_EVALUATION * 1e-9 / max(threads, 1))  # ns to s
 
 
@@ -110,18 +113,27 @@ def box_grids(lo, hi, res: float) -> tuple[list[Grid], list[tuple[np.ndarray, np
     return grids, inits
 
 
+def dealt(tiles: np.ndarray, work: np.ndarray) -> np.ndarray:
+    """``tiles`` (T,) reordered for prange's split into one contiguous block per thread
+    (numba's static schedule: ``parallel_chunksize`` did not apply here, one thread got
+    every tile with moves): sorted by ``work`` (T,), longest first, then dealt out
+    round-robin, so that each block holds an equal share of long and short tiles."""
+    threads = numba.get_num_threads()
+    order = tiles[np.argsort(-work, kind="stable")]
+    return np.concatenate([order[j::threads] for j in range(threads)])
+
+
 def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
         max_memory: float = MAX_MEMORY) -> list[tuple[int, np.ndarray]]:
     """Cut ``grid`` by ``moves`` (a :class:`~.moves.Moves`) from its initial stock, growing
     K where a ray needs it (refused past ``max_memory`` bytes); the rapids through
     material: [(move, point (3,))]."""
+    tile = TILES[grid.k]
     start, order, rng = bin_moves(grid.k, grid.lo, grid.res, grid.nu, grid.nv,
-                                  moves.bb_lo, moves.bb_hi)
+                                  moves.bb_lo, moves.bb_hi, tile)
     ntiles = len(start) - 1
-    # longest first, handed out one at a time: tiles without moves (the grid along Y, say,
-    # below the program) would otherwise leave a thread idle under prange's equal split
-    tiles = np.argsort(-np.diff(start), kind="stable")
-    overflow = np.zeros(ntiles, np.bool_)
+    tiles = dealt(np.arange(ntiles), np.diff(start))
+    resume = start[:-1].copy()
     col_move = np.zeros((ntiles, MAX_COLLISIONS), np.int64)
     col_at = np.zeros((ntiles, MAX_COLLISIONS, 3))
     col_n = np.zeros(ntiles, np.int64)
@@ -130,24 +142,24 @@ def cut(grid: Grid, init: tuple[np.ndarray, np.ndarray], moves,
     ext[:, 0], ext[:, 1] = 1.0, -1.0
     if grid.iv.shape[1] < init_iv.shape[1]:
         grid.iv = np.zeros((len(grid.cnt), init_iv.shape[1], 2), np.float32)
+    table = move_table(moves.p0, moves.p1, moves.axis, moves.radius, moves.length)
+    bounds = bounds_table(grid.k, grid.lo[grid.k], table)
     while len(tiles):
-        with numba.parallel_chunksize(1):
-            cut_tiles(grid.k, grid.lo, grid.res, grid.nu, grid.nv, tiles, start, order, rng,
-                      moves.p0, moves.p1, moves.axis, moves.radius, moves.length,
-                      moves.rapid, moves.bb_lo, moves.bb_hi, init_iv, init_cnt, grid.iv,
-                      grid.cnt, ext, overflow, col_move, col_at, col_n)
-        tiles = np.flatnonzero(overflow)
+        cut_tiles(grid.k, grid.lo, grid.res, grid.nu, grid.nv, tiles, start, order, rng,
+                  moves.p0, moves.p1, table, bounds, moves.rapid, moves.bb_lo, moves.bb_hi,
+                  init_iv, init_cnt, grid.iv, grid.cnt, ext, resume, col_move, col_at,
+                  col_n, tile)
+        tiles = np.flatnonzero(resume >= 0)      # resumed where they stopped, K doubled
+        tiles = dealt(tiles, start[tiles + 1] - resume[tiles])
         if len(tiles):
             need = len(grid.cnt) * 2 * grid.iv.shape[1] * 8.0
             refuse_over(f"the grid along {'XYZ'[grid.k]} at --resolution {grid.res:g} mm "
                         f"({2 * grid.iv.shape[1]} pieces of material on a ray)", need / 1e9,
                         max_memory / 1e9, "GB", "give a coarser --resolution (memory goes "
                         "as its inverse square)")
-            grown = np.zeros((len(grid.cnt), 2 * grid.iv.shape[1], 2), np.float32)
-            grown[:, :grid.iv.shape[1]] = grid.iv
-            grid.iv = grown
+            grid.iv = grown(grid.iv, 2 * grid.iv.shape[1])
     return [(int(col_move[t, c]), col_at[t, c].copy())
             for t in range(ntiles) for c in range(col_n[t])]
 
 
-__all__ = ["Grid", "TILE", "box_grids", "check_limits", "cut", "estimate", "rays"]
+__all__ = ["Grid", "TILES", "box_grids", "check_limits", "cut", "estimate", "rays"]

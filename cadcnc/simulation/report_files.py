@@ -9,7 +9,7 @@ from pathlib import Path
 from ..core.jsonable import plain
 from ..io.output_set import OutputSet
 from ..io.simulation_plot import SUFFIXES, glb_bytes, png_bytes, stl_bytes
-from .stock_mesh import height_field_mesh
+from .stock_mesh import dexel_mesh
 from .stock_report import SimulationReport
 
 
@@ -27,7 +27,7 @@ def render(report: SimulationReport, part, out, title: str = "") -> str | bytes:
     if suffix == ".png":
         return png_bytes(part, s.point, s.left, report.data["gouges"],
                          report.data["threshold_mm"], title)
-    mesh = height_field_mesh(report.stock)
+    mesh = dexel_mesh(report.stock)
     if suffix == ".glb":
         return glb_bytes(part, s.point, s.left, report.gouge_points, mesh,
                          report.data["threshold_mm"])
