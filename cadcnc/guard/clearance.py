@@ -101,6 +101,17 @@ class ClearanceGuard:
         >= 0: clear ("" or the nearest face's name); < 0: a hit, with the detail
         "ball touches face K" or "shank touches face K".
         """
+        return self._margin(p, False)
+
+    def clears(self, p) -> bool:
+        """Whether the tool at ``p`` clears the part (``margin(p) >= 0``), stopping at the
+        first face found to hit: for a yes or no that needs no least margin nor its face
+        (the setups' reach samples)."""
+        return self._margin(p, True)[0] >= 0.0
+
+    def _margin(self, p, first_hit: bool) -> tuple[float, str]:
+        """:meth:`margin`; with ``first_hit`` the first negative margin found instead of
+        the least."""
         self.calls += 1
         p = (float(p[0]), float(p[1]), float(p[2]))
         if not math.isfinite(p[0] + p[1] + p[2]):
@@ -121,6 +132,8 @@ class ClearanceGuard:
                 best = m
                 detail = f"{who} touches face {k}" if m < 0.0 else \
                     (f"{who} nearest face {k}" if who else f"face {k} within reach")
+            if first_hit and best < 0.0:
+                break
         return best, detail
 
     def _broad_phase(self, p) -> None:
