@@ -114,6 +114,12 @@ class ClearanceGuard:
         clearance). For a verdict that needs only the sign."""
         return self._margin(p, True)
 
+    def clears(self, p) -> bool:
+        """Whether the tool at ``p`` clears the part (``margin(p) >= 0``), stopping at the
+        first face found to hit: for a yes or no that needs no least margin nor its face
+        (the setups' reach samples)."""
+        return self._margin(p, True)[0] >= 0.0
+
     def _margin(self, p, stop: bool) -> tuple[float, str, bool]:
         """:meth:`margin`, stopping at the first hit when ``stop`` (:meth:`first_hit`)."""
         self.calls += 1

@@ -159,3 +159,41 @@ def test_setups_give_the_same_bytes_on_two_processes(shared_corner, tmp_path):
         out[jobs] = {p.name: p.read_bytes() for p in d.iterdir()}
     assert sorted(out[1]) == ["P+X.json", "P+X.ngc", "P+Z.json", "P+Z.ngc"]
     assert out[1] == out[2]
+
+
+def test_programs_only_for_the_chosen_setups(shared_corner, monkeypatch):
+    """``auto`` judges the six axes from their samples and computes the programs of the
+    two it chooses only; each candidate's reach is given, from samples, and where a
+    program was computed the samples reach what it reaches."""
+    from dataclasses import replace
+
+    import cadcnc
+    from cadcnc.core.job import PRINCIPAL_AXES, axis_name
+    from cadcnc.ops.pencil import fewest_setups
+
+    part, floor, wall, _ = shared_corner
+    job = Job(Tool(R), 1500.0, 0.004, Pencil([floor, wall]), source=part.source)
+    planned = []
+    real = fewest_setups.operation_of
+
+    def counting(j):
+        planned.append(axis_name(j.axis))
+        return real(j)
+
+    monkeypatch.setattr(fewest_setups, "operation_of", counting)
+    result = fewest_setups.pencil_setups(part, job, "auto")
+    assert sorted(planned) == ["+X", "+Z"]
+    assert [r.setup.name for r in result.candidates if r.computed] == ["+Z", "+X"]
+    assert list(result.reach) == list(fewest_setups.AUTO_ORDER)
+    for r in result.candidates:
+        assert result.reach[r.setup.name] == r.sampled
+        if r.computed:
+            assert r.sampled == r.reached > 0
+    # +Z y 13..25 and +X y 5..17 in closed form: 12 mm of corner, 25 positions each
+    assert abs(result.reach["+Z"] - 12.0 / SPACING - 1) <= 1
+    assert abs(result.reach["+X"] - 12.0 / SPACING - 1) <= 1
+    for name in ("-Z", "-X", "+Y", "-Y"):   # nothing in the samples
+        assert result.reach[name] == 0
+    for name in ("-Z", "+Y"):   # nor in a program: the material, an end wall
+        assert not cadcnc.run(part, replace(job, axis=PRINCIPAL_AXES[name])).cuts
+    assert "from samples; programs computed: +Z +X" in result.summary_lines()[1]

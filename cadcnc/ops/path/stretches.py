@@ -300,14 +300,14 @@ def edge_stretches(feas: Feasibility, shared_edge, edge: int,
     samples: list[Sample] = []
     for s in grid:   # each seeded from the last solved sample: stays on one branch
         last = next((x for x in reversed(samples[-1:]) if x.tangency is not None), None)
-        samples.append(_reseeded(feas, curve, float(s), last))
+        samples.append(reseeded(feas, curve, float(s), last))
     samples = _refine(feas, curve, samples, out)
     out.samples = samples
     out.stretches = _stretches(feas, curve, samples, edge)
     return out
 
 
-def _reseeded(feas: Feasibility, curve: EdgeCurve, s: float, last: Sample | None) -> Sample:
+def reseeded(feas: Feasibility, curve: EdgeCurve, s: float, last: Sample | None) -> Sample:
     """The (quick) sample at ``s`` seeded from ``last``, or from the anchor (see RESEED)."""
     x = sample_at(feas, curve, s, last, quick=True)
     if last is None or x.rule not in RESEED or x.rule == last.rule or not 0 <= s <= curve.length:

@@ -1,7 +1,8 @@
 """The fewest setups: the pencil program of a part from several tool axes (issue 23).
 
-Each candidate axis (the six principal ones, or those given) gets its pencil program in its
-own setup (:mod:`cadcnc.geometry.setup`). What a setup reaches is counted in *positions*:
+Each candidate axis (the six principal ones, or those given) is judged in its own setup
+(:mod:`cadcnc.geometry.setup`) from samples (:mod:`.reach_samples`); only the chosen ones
+get their pencil program (:func:`choose`). What a setup reaches is counted in *positions*:
 the part's concave shared edges (of the selected faces) sampled every SPACING mm along
 their length; a cut point (ball centre, part coordinates) reaches the sample of its corner
 nearest to it (within REACH_RADII R'). A blend corner (two faces sharing no edge) counts
@@ -18,6 +19,7 @@ are listed per corner with each axis's reason. Lengths mm.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
@@ -30,16 +32,19 @@ from ...geometry.edge_curve import EdgeCurve
 from ...geometry.part import CONCAVE, Part
 from ...geometry.setup import Setup, original_part, setup_in, setup_part
 from ...program.linking import order_cuts
-from ...program.program import CutSegment, Program
+from ...program.program import CutSegment, Program, Skipped
 from ...program.transform import in_part_coordinates
 from ..common import safe_height
 from ..entries import entered_program_segments
+from ..path.pair_program import NO_STRETCH
 from ..run import RunOptions, operation_of
 from .pencil_program import CHAIN_GAP
+from .reach_samples import BallSamples, axis_reach, ball_samples, stretch_lines, true_runs
 
 SPACING = 0.5      # mm between two positions along a concave edge
 REACH_RADII = 5.0  # a ball centre farther than this many R' from its corner's edge counts nothing
 VOXEL = 1.0        # mm: the grid of a blend corner's positions
+DENSE = 0.1        # mm between the points keyed along a line of feasible samples (a cut's step)
 AUTO = "auto"
 AUTO_ORDER = ("+Z", "-Z", "+X", "-X", "+Y", "-Y")  # the candidates of AUTO, +Z first on ties
 TRIMMED = "setup boundary"  # the stop reason of a cut trimmed where an earlier setup cut
@@ -47,9 +52,10 @@ TRIMMED = "setup boundary"  # the stop reason of a cut trimmed where an earlier 
 
 @dataclass
 class SetupRun:
-    """One setup's program (work coordinates), its part turned into the setup, and the
-    positions it reaches (``reached``) and cuts (``assigned``: not cut by an earlier
-    setup)."""
+    """One candidate setup: its part turned into the setup, the positions its samples
+    reach (``sampled``, :mod:`.reach_samples`) and, once its program is ``computed`` (work
+    coordinates), the positions the program reaches (``reached``; the samples' until then)
+    and cuts (``assigned``: not cut by an earlier setup)."""
 
     setup: Setup
     part: Part
@@ -57,13 +63,17 @@ class SetupRun:
     reached: int
     assigned: int = 0
     error: str = ""   # why it reaches nothing (its operation refused the part), or ""
+    sampled: int = 0
+    computed: bool = False
+    keys: list = field(default_factory=list, repr=False)   # per cut, per point: position
 
 
 @dataclass
 class SetupsResult:
-    """The setups chosen, in machining order (``runs``), every candidate's reach by name,
-    the positions reachable (``positions``), those no candidate reaches (``unreached``:
-    (faces, count, reasons per axis)), and the subsets checked for the fewest."""
+    """The setups chosen, in machining order (``runs``), every candidate's reach by name
+    (from its samples), the positions reachable (``positions``), those no candidate
+    reaches (``unreached``: (faces, count, reasons per axis)), the subsets checked for the
+    fewest, and every candidate (``candidates``; the chosen ones computed)."""
 
     runs: list[SetupRun]
     reach: dict[str, int]
@@ -75,10 +85,12 @@ class SetupsResult:
     def summary_lines(self) -> list[str]:
         """Sentences for the user: the setups, their cuts and shares, what no axis reaches."""
         n = max(self.positions, 1)
+        computed = " ".join(r.setup.name for r in self.candidates if r.computed) or "none"
         out = [f"setups     {len(self.runs)} of {len(self.reach)} candidate axes reach all "
                f"{self.positions} reachable corner positions ({SPACING:g} mm apart); fewest "
                f"(optimal: every one of {self.subsets_checked} subsets checked)",
-               "reach      " + ", ".join(f"{k} {v}" for k, v in self.reach.items())]
+               "reach      " + ", ".join(f"{k} {v}" for k, v in self.reach.items())
+               + f" (from samples; programs computed: {computed})"]
         for r in self.runs:
             out.append(f"setup {r.setup.name:<4} {len(r.program.cuts)} cuts, "
                        f"{r.program.cut_length:.1f} mm, {r.assigned} positions "
@@ -121,31 +133,20 @@ def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
         parse_setups(setups)
     part = original_part(part)
     samples = _positions(part, job)
-    runs, keys = [], []
     extra = {} if max_cycles is None else {"max_cycles": max_cycles}
     options = RunOptions(progress=progress, processes=processes, **extra)
-    for axis in axes:
-        sub = replace(job, axis=axis, origin=None if axis != job.axis else job.origin)
-        sp = setup_part(part, sub)
-        setup = setup_in(sp) or Setup(np.asarray(axis), np.eye(3), np.zeros(3))
-        try:
-            program = operation_of(sub).plan(sp, sub, options)   # the Pencil's planner
-            error = ""
-        except NothingToCutError as e:
-            program, error = Program(sub), str(e)
-        except CadcncError as e:   # the others may still reach: said per setup
-            if isinstance(e, InputError):
-                raise
-            program, error = Program(sub), f"{type(e).__name__}: {e}"
-        point_keys = _keys(in_part_coordinates(program, setup_in(sp)), samples, job)
-        reached = set().union(*point_keys) if point_keys else set()
-        reached.discard(None)
-        keys.append(point_keys)
-        runs.append(SetupRun(setup, sp, program, len(reached), error=error))
-    reach_sets = [set().union(*k) - {None} if k else set() for k in keys]
-    universe = set().union(*reach_sets)
-    chosen, checked = _fewest(reach_sets, universe)
-    result = SetupsResult([], {r.setup.name: r.reached for r in runs}, len(universe),
+    counts = {pair: {k: len(pts) for k, pts in edges}
+              for pair, edges in _edge_positions(part, job).items()}
+    balls = ball_samples(part, job, counts, SPACING, processes=processes)
+    runs, reach_sets = [], []
+    for n, axis in enumerate(axes):
+        run, keys = _sampled(part, job, axis, samples, balls, options)
+        runs.append(run)
+        reach_sets.append(keys)
+        if progress is not None:
+            progress(n + 1, len(axes), f"reach samples of setup {run.setup.name}")
+    chosen, checked, universe = _chosen(runs, reach_sets, samples, job, options)
+    result = SetupsResult([], {r.setup.name: r.sampled for r in runs}, len(universe),
                           _unreached(samples, universe, runs), checked, runs)
     if not universe:
         why = "; ".join(f"{r.setup.name}: {r.error or 'no cut'}" for r in runs)
@@ -155,10 +156,106 @@ def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
         run = runs[k]
         run.assigned = len(reach_sets[k] - taken)
         if taken:
-            run.program = _trimmed(run, keys[k], taken, overlap)
+            run.program = _trimmed(run, run.keys, taken, overlap)
         taken |= reach_sets[k]
         result.runs.append(run)
     return result
+
+
+def _chosen(runs: list[SetupRun], reach: list[set], samples: dict, job: Job,
+            options: RunOptions) -> tuple[list[int], int, set]:
+    """:func:`choose` on the candidates ``runs``, their samples' ``reach`` (updated), a
+    program computed with :func:`_computed`, a closer look with the stretch search."""
+    def look(k: int, pair: tuple[int, int]) -> set:
+        keys = _line_keys({pair: stretch_lines(runs[k].part, runs[k].program.job, pair,
+                                               max_cycles=options.max_cycles)}, samples, job)
+        runs[k].reached = len({key for key in reach[k] if key[0] != pair} | keys)
+        return keys
+
+    return choose(reach, lambda k: _computed(runs[k], samples, job, options), look)
+
+
+def choose(reach: list[set], compute: Callable[[int], set],
+           look: Callable[[int, tuple], set]) -> tuple[list[int], int, set]:
+    """The fewest setups (:func:`_fewest`) chosen from estimates of each candidate's
+    reach (``reach``: sets of position keys, (pair, index); updated in place), each
+    chosen one then computed (``compute(k)``: the positions its program reaches) until
+    the chosen are all computed. Once some are, a candidate chosen for positions no
+    computed program reaches first has its estimate of those pairs replaced by
+    ``look(k, pair)`` (a closer look; ``compute`` only if it still is chosen).
+
+    Where every estimate holds every position its program reaches (the samples' do but
+    for the cases :mod:`.reach_samples` names), the choice is the one all the programs
+    give: the chosen cover those programs' union with their own, a smaller or
+    higher-scoring subset would cover it with the estimates, and ties fall alike.
+    Returns (chosen, subsets checked, universe)."""
+    computed: set = set()
+    looked: set = set()   # (candidate, pair) looked at closer
+    while True:
+        universe = set().union(*reach)
+        chosen, checked = _fewest(reach, universe)
+        todo = [k for k in chosen if k not in computed]
+        if not todo:
+            return chosen, checked, universe
+        if computed:
+            cut = set().union(*(reach[k] for k in computed))
+            pairs = {(k, key[0]) for k in todo for key in reach[k] - cut} - looked
+            if pairs:
+                for k, pair in sorted(pairs):
+                    reach[k] = {key for key in reach[k] if key[0] != pair} | look(k, pair)
+                looked |= pairs
+                continue
+        for k in todo:
+            reach[k] = compute(k)
+            computed.add(k)
+
+
+def _sub_job(job: Job, axis) -> Job:
+    """``job`` along ``axis`` (its origin kept for its own axis only)."""
+    return replace(job, axis=axis, origin=None if axis != job.axis else job.origin)
+
+
+def _sampled(part: Part, job: Job, axis, samples: dict, balls: BallSamples,
+             options: RunOptions) -> tuple[SetupRun, set]:
+    """The candidate of ``axis`` (not computed) and the positions its samples reach
+    (:mod:`.reach_samples`; ``balls``: the axis-free samples)."""
+    sub = _sub_job(job, axis)
+    sp = setup_part(part, sub)
+    setup = setup_in(sp) or Setup(np.asarray(axis), np.eye(3), np.zeros(3))
+    try:
+        lines = axis_reach(sp, sub, balls, max_cycles=options.max_cycles,
+                           processes=options.processes)
+        error = ""
+    except CadcncError as e:   # the others may still reach: said per setup
+        if isinstance(e, InputError):
+            raise
+        lines, error = {}, f"{type(e).__name__}: {e}"
+    keys = _line_keys(lines, samples, job)
+    blocked = [Skipped(pair, NO_STRETCH, "a third face or the shank is in the way at every "
+                       "reach sample") for pair in {*balls.runs, *(c.faces for c in balls.stepped)}
+               if pair not in lines]
+    run = SetupRun(setup, sp, Program(sub, [], balls.skipped + blocked), len(keys),
+                   error=error, sampled=len(keys))
+    return run, keys
+
+
+def _computed(run: SetupRun, samples: dict, job: Job, options: RunOptions) -> set:
+    """Compute ``run``'s program (into it) and return the positions it reaches."""
+    sub = run.program.job
+    try:
+        program = operation_of(sub).plan(run.part, sub, options)   # the Pencil's planner
+        error = ""
+    except NothingToCutError as e:
+        program, error = Program(sub), str(e)
+    except CadcncError as e:   # the others may still reach: said per setup
+        if isinstance(e, InputError):
+            raise
+        program, error = Program(sub), f"{type(e).__name__}: {e}"
+    run.keys = _keys(in_part_coordinates(program, setup_in(run.part)), samples, job)
+    reached = set().union(*run.keys) if run.keys else set()
+    reached.discard(None)
+    run.program, run.error, run.reached, run.computed = program, error, len(reached), True
+    return reached
 
 
 def _fewest(reach: list[set], universe: set) -> tuple[list[int], int]:
@@ -178,41 +275,68 @@ def _fewest(reach: list[set], universe: set) -> tuple[list[int], int]:
     return [], checked
 
 
-def _positions(part: Part, job: Job) -> dict[tuple[int, int], np.ndarray]:
-    """Per concave pair (i < j) of the selected faces, its edges' samples (M, 3), mm."""
+def _edge_positions(part: Part, job: Job) -> dict[tuple[int, int], list]:
+    """Per concave pair (i < j) of the selected faces, per concave edge (its index among
+    the pair's, as a corner's ``edge``) its positions (M, 3), mm."""
     faces = None if job.operation.faces is None else set(job.operation.faces)
-    out = {}
+    out: dict = {}
     for pair, edges in part.adjacency.items():
         if faces is not None and not set(pair) <= faces:
             continue
-        pts = []
-        for e in edges:
-            if e.edge_class != CONCAVE:
-                continue
+        concave = [e for e in edges if e.edge_class == CONCAVE]
+        for k, e in enumerate(concave):
             curve = EdgeCurve(e)
             n = max(int(np.ceil(curve.length / SPACING)), 1)
-            pts += [curve.point_tangent(s)[0] for s in np.linspace(0.0, curve.length, n + 1)]
-        if pts:
-            out[pair] = np.array(pts)
+            pts = [curve.point_tangent(s)[0] for s in np.linspace(0.0, curve.length, n + 1)]
+            out.setdefault(pair, []).append((k, np.array(pts)))
     return out
+
+
+def _positions(part: Part, job: Job) -> dict[tuple[int, int], np.ndarray]:
+    """Per concave pair (i < j) of the selected faces, its edges' positions (M, 3), mm."""
+    return {pair: np.concatenate([pts for _, pts in edges])
+            for pair, edges in _edge_positions(part, job).items()}
 
 
 def _keys(program: Program, samples: dict, job: Job) -> list[list]:
     """Per cut of ``program`` (part coordinates), per point its position key or None."""
-    reach = REACH_RADII * job.tool.offset
-    out, trees = [], {}
-    for cut in program.cuts:
-        pair = tuple(sorted(cut.path.faces))
-        pts = cut.points
-        if pair in samples:
-            if pair not in trees:
-                trees[pair] = cKDTree(samples[pair])
-            d, near = trees[pair].query(pts)
-            ok = d <= reach
-            out.append([(pair, int(k)) if good else None for k, good in zip(near, ok)])
-        else:   # a blend corner: its ball centres on a grid
-            out.append([(pair, tuple(np.round(p / VOXEL).astype(int))) for p in pts])
+    trees: dict = {}
+    return [_point_keys(tuple(sorted(cut.path.faces)), cut.points, samples, trees, job)
+            for cut in program.cuts]
+
+
+def _line_keys(lines: dict, samples: dict, job: Job) -> set:
+    """The positions the polylines of feasible centres ``lines`` (per pair, part
+    coordinates) reach: their points every DENSE mm keyed as a cut's points."""
+    trees: dict = {}
+    out: set = set()
+    for pair, pair_lines in lines.items():
+        for line in pair_lines:
+            out.update(_point_keys(pair, _dense(line), samples, trees, job))
+    out.discard(None)
     return out
+
+
+def _dense(line: np.ndarray) -> np.ndarray:
+    """``line``'s vertices and points between them at most DENSE mm apart."""
+    pts = [line[:1]]
+    for a, b in zip(line[:-1], line[1:]):
+        n = max(int(np.ceil(np.linalg.norm(b - a) / DENSE)), 1)
+        pts.append(a + np.outer(np.arange(1, n + 1) / n, b - a))
+    return np.concatenate(pts)
+
+
+def _point_keys(pair: tuple[int, int], pts: np.ndarray, samples: dict, trees: dict,
+                job: Job) -> list:
+    """Per point of a cut (or a line of samples) of ``pair``, its position key or None:
+    its corner's nearest position within REACH_RADII R', or on a blend corner its VOXEL."""
+    if pair not in samples:   # a blend corner: its ball centres on a grid
+        return [(pair, tuple(np.round(p / VOXEL).astype(int))) for p in pts]
+    if pair not in trees:
+        trees[pair] = cKDTree(samples[pair])
+    d, near = trees[pair].query(pts)
+    ok = d <= REACH_RADII * job.tool.offset
+    return [(pair, int(k)) if good else None for k, good in zip(near, ok)]
 
 
 def _unreached(samples: dict, universe: set, runs: list[SetupRun]) -> list:
@@ -252,7 +376,7 @@ def _trimmed(run: SetupRun, keys: list[list], taken: set, overlap: float) -> Pro
                                                                 axis=1))])
             near = np.abs(s[:, None] - s[new][None, :]).min(axis=1) <= overlap
             new = new | near
-        for i, j in _runs(new):
+        for i, j in true_runs(new):
             if j - i >= 2:
                 pieces.append(CutSegment(_piece(cut.path, i, j), cut.edge, cut.stretch,
                                          at_limit=True))
@@ -262,12 +386,6 @@ def _trimmed(run: SetupRun, keys: list[list], taken: set, overlap: float) -> Pro
         part, job, pieces, z_safe, join=CHAIN_GAP,
         order=lambda items: order_cuts(items, CHAIN_GAP))
     return Program(job, segments, skipped + unreachable, list(run.program.notes))
-
-
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """[start, end) of every run of True in ``mask``."""
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
-    return list(zip(edges[::2], edges[1::2]))
 
 
 def _piece(path, i: int, j: int):

@@ -102,7 +102,7 @@ def pencil_program(part: Part, job: Job, *, progress: Progress | None = None,
                 progress(done, len(todo), "faces {} {}".format(*todo[k].faces))
                 beat.last = beat.clock()
 
-    portable = (lambda c: c) if processes == 1 else (lambda c: _rail_refs(part, c))
+    portable = (lambda c: c) if processes == 1 else (lambda c: rail_refs(part, c))
     tasks = [(job, [(k, portable(todo[k])) for k in ks], max_cycles)
              for ks in groups.values()]
     sizes = [sum(todo[k].length + search_samples(todo[k].length, tool.offset, todo[k].closed)
@@ -136,7 +136,7 @@ def _pair_corners(part: Part, task, beat=None) -> tuple[list, dict, dict]:
     beat = beat if beat is not None else Heartbeat(None)
     guard, found_pair, out = None, None, []
     for k, corner in corners:
-        corner = _rails_back(part, corner)
+        corner = rails_back(part, corner)
         i, j = corner.faces
         cjob = replace(job, operation=PairPath(faces=(i, j), edge=corner.edge))
         at = f"faces {i} {j}"
@@ -176,7 +176,7 @@ def _pair_corners(part: Part, task, beat=None) -> tuple[list, dict, dict]:
                             for w in why]
             elif corner.kind == BLEND:
                 with stage("interpolation"):
-                    cut = _blend_cut(s1, s2, cjob, corner, guard, max_cycles, steps)
+                    cut = blend_cut(s1, s2, cjob, corner, guard, max_cycles, steps)
                 work["cycles"] += len(cut.points) - 1
                 if len(cut.points) < 2:
                     skipped.append(Skipped((i, j), cut.path.stop_reason, (
@@ -192,9 +192,9 @@ def _pair_corners(part: Part, task, beat=None) -> tuple[list, dict, dict]:
     return out, times, work
 
 
-def _rail_refs(part: Part, corner: Corner) -> Corner:
+def rail_refs(part: Part, corner: Corner) -> Corner:
     """``corner`` with its rails (OCCT edges, which do not pickle) as (faces, index) in
-    the part's adjacency, for a worker to find again (:func:`_rails_back`)."""
+    the part's adjacency, for a worker to find again (:func:`rails_back`)."""
     refs = []
     for rail in corner.rails:
         edges = part.shared_edges(*rail.faces)
@@ -202,8 +202,8 @@ def _rail_refs(part: Part, corner: Corner) -> Corner:
     return replace(corner, rails=tuple(refs))
 
 
-def _rails_back(part: Part, corner: Corner) -> Corner:
-    """``corner`` with rails given by :func:`_rail_refs` found again in ``part``."""
+def rails_back(part: Part, corner: Corner) -> Corner:
+    """``corner`` with rails given by :func:`rail_refs` found again in ``part``."""
     if not corner.rails or not isinstance(corner.rails[0], tuple):
         return corner
     return replace(corner, rails=tuple(part.shared_edges(*faces)[k]
@@ -280,7 +280,7 @@ NOT_REACHABLE = UNREACHABLE
 """The reason of a cut no entry reaches (:mod:`cadcnc.ops.entries`)."""
 
 
-def _blend_cut(s1, s2, job: Job, corner, guard, max_cycles: int, progress) -> CutSegment:
+def blend_cut(s1, s2, job: Job, corner, guard, max_cycles: int, progress) -> CutSegment:
     """The cut bridging a blend: from its first seed to its second (once around when the
     blend is closed), stopped by the guard or a boundary where the ball cannot go on."""
     seeds = corner.seeds
