@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 from OCP.GeomAbs import GeomAbs_BSplineSurface
 from OCP.gp import gp_Pnt, gp_Vec
@@ -32,6 +33,7 @@ from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 
 ROUND_OFF = 1e-12
 """Relative widening of the bounds (floating-point round-off of sums of products)."""
+_jit = numba.njit(cache=True, nogil=True)
 MAX_PATCHES = 20_000
 """More Bezier patches than this: no bound (OCCT decides), to keep the arrays small."""
 
@@ -88,12 +90,14 @@ class SurfaceBound:
         flat = nets.reshape(len(nets), -1, 3)
         self.lo, self.hi = flat.min(axis=1), flat.max(axis=1)
         du, dw = np.diff(nets, axis=1), np.diff(nets, axis=2)
-        self.su = _hull(du, p / hu)
-        self.sw = _hull(dw, q / hw)
-        self.suw = _hull(np.diff(du, axis=2), p * q / (hu * hw))
         zero = (np.zeros_like(self.lo), np.zeros_like(self.lo))
-        self.suu = _hull(np.diff(du, axis=1), p * (p - 1) / hu ** 2) if p > 1 else zero
-        self.sww = _hull(np.diff(dw, axis=2), q * (q - 1) / hw ** 2) if q > 1 else zero
+        parts = [(self.lo, self.hi), _hull(du, p / hu), _hull(dw, q / hw),
+                 _hull(np.diff(du, axis=1), p * (p - 1) / hu ** 2) if p > 1 else zero,
+                 _hull(np.diff(du, axis=2), p * q / (hu * hw)),
+                 _hull(np.diff(dw, axis=2), q * (q - 1) / hw ** 2) if q > 1 else zero]
+        # (P, 12, 3): box low, high, then low and high of S_u, S_w, S_uu, S_uw, S_ww
+        self.bounds = np.ascontiguousarray(np.stack([x for pair in parts for x in pair],
+                                                    axis=1))
 
     @classmethod
     def of(cls, adaptor, surface) -> "SurfaceBound | None":
@@ -121,56 +125,83 @@ class SurfaceBound:
         if not (self.domain[0] <= u0 <= self.domain[1]
                 and self.domain[2] <= w0 <= self.domain[3]):
             return False   # a foot off the patches: their bounds do not reach it
-        p = np.asarray(point, float)
-        gap = np.maximum(np.maximum(self.lo - p, p - self.hi), 0.0)
-        near = np.einsum("ij,ij->i", gap, gap) < floor * floor * (1.0 + ROUND_OFF)
-        if not near.any():
-            return True
-        r = self.rect[near]
-        box = (min(r[:, 0].min(), u0), max(r[:, 1].max(), u0),
-               min(r[:, 2].min(), w0), max(r[:, 3].max(), w0))
-        meets = np.nonzero((self.rect[:, 0] <= box[1]) & (self.rect[:, 1] >= box[0])
-                           & (self.rect[:, 2] <= box[3]) & (self.rect[:, 3] >= box[2]))[0]
-        lam = self._least_eigenvalue(meets, p)
-        if not lam > 0.0:
-            return False
         pnt, du, dw = gp_Pnt(), gp_Vec(), gp_Vec()
         adaptor.D1(u0, w0, pnt, du, dw)
-        e = np.array(pnt.Coord()) - p
-        low = float(e @ e)
-        for x0, lo, hi, grad in ((u0, box[0], box[1], 2.0 * float(e @ du.Coord())),
-                                 (w0, box[2], box[3], 2.0 * float(e @ dw.Coord()))):
-            t = min(max(-grad / lam, lo - x0), hi - x0)
-            low += grad * t + 0.5 * lam * t * t
-        return low * (1.0 - ROUND_OFF) >= floor * floor
-
-    def _least_eigenvalue(self, idx: np.ndarray, p: np.ndarray) -> float:
-        """A lower bound of the least eigenvalue of g's Hessian over the patches ``idx``
-        (interval arithmetic, module doc)."""
-        e = (self.lo[idx] - p, self.hi[idx] - p)
-        su, sw = [(b[0][idx], b[1][idx]) for b in (self.su, self.sw)]
-        a = _square_low(su) + _product(e, (self.suu[0][idx], self.suu[1][idx]))[0]
-        c = _square_low(sw) + _product(e, (self.sww[0][idx], self.sww[1][idx]))[0]
-        b_lo, b_hi = (x + y for x, y in zip(_product(su, sw),
-                                            _product(e, (self.suw[0][idx], self.suw[1][idx]))))
-        a, c = a.sum(axis=1), c.sum(axis=1)
-        beta = np.maximum(np.abs(b_lo.sum(axis=1)), np.abs(b_hi.sum(axis=1)))
-        scale = np.abs(a) + np.abs(c) + beta
-        least = 0.5 * (a + c) - np.sqrt(0.25 * (a - c) ** 2 + beta ** 2) - ROUND_OFF * scale
-        return 2.0 * float(least.min())
+        px, py, pz = (float(c) for c in point)
+        ex, ey, ez = pnt.X() - px, pnt.Y() - py, pnt.Z() - pz
+        return bool(_proof(self.bounds, self.rect, px, py, pz, u0, w0,
+                           ex * ex + ey * ey + ez * ez,
+                           2.0 * (ex * du.X() + ey * du.Y() + ez * du.Z()),
+                           2.0 * (ex * dw.X() + ey * dw.Y() + ez * dw.Z()), floor))
 
 
-def _product(x: tuple, y: tuple) -> tuple[np.ndarray, np.ndarray]:
-    """The interval product of (low, high) arrays, componentwise."""
-    prods = (x[0] * y[0], x[0] * y[1], x[1] * y[0], x[1] * y[1])
-    return (np.minimum(np.minimum(prods[0], prods[1]), np.minimum(prods[2], prods[3])),
-            np.maximum(np.maximum(prods[0], prods[1]), np.maximum(prods[2], prods[3])))
+@_jit
+def _square_low(lo: float, hi: float) -> float:
+    """The least square of the interval [lo, hi]: 0 where it holds 0."""
+    if lo <= 0.0 <= hi:
+        return 0.0
+    return min(lo * lo, hi * hi)
 
 
-def _square_low(x: tuple) -> np.ndarray:
-    """The least square of each interval (low, high): 0 where it holds 0."""
-    lo, hi = x
-    return np.where((lo <= 0.0) & (hi >= 0.0), 0.0, np.minimum(lo * lo, hi * hi))
+@_jit
+def _product(a: float, b: float, c: float, d: float) -> tuple[float, float]:
+    """The interval product [a, b] x [c, d]: (low, high)."""
+    p0, p1, p2, p3 = a * c, a * d, b * c, b * d
+    return min(min(p0, p1), min(p2, p3)), max(max(p0, p1), max(p2, p3))
+
+
+@_jit
+def _least_eigenvalue(b: np.ndarray, i: int, p: np.ndarray) -> float:
+    """A lower bound of the least eigenvalue of the Hessian of |S - p|^2 / 2 over patch
+    ``i`` of the bounds ``b`` (P, 12, 3) (interval arithmetic, module doc)."""
+    a = c = b_lo = b_hi = 0.0
+    for k in range(3):
+        e_lo, e_hi = b[i, 0, k] - p[k], b[i, 1, k] - p[k]
+        a += _square_low(b[i, 2, k], b[i, 3, k]) + _product(e_lo, e_hi, b[i, 6, k],
+                                                            b[i, 7, k])[0]
+        c += _square_low(b[i, 4, k], b[i, 5, k]) + _product(e_lo, e_hi, b[i, 10, k],
+                                                            b[i, 11, k])[0]
+        lo1, hi1 = _product(b[i, 2, k], b[i, 3, k], b[i, 4, k], b[i, 5, k])
+        lo2, hi2 = _product(e_lo, e_hi, b[i, 8, k], b[i, 9, k])
+        b_lo += lo1 + lo2
+        b_hi += hi1 + hi2
+    beta = max(abs(b_lo), abs(b_hi))
+    scale = abs(a) + abs(c) + beta
+    return 0.5 * (a + c) - math.sqrt(0.25 * (a - c) ** 2 + beta * beta) - ROUND_OFF * scale
+
+
+@_jit
+def _proof(b: np.ndarray, rect: np.ndarray, px: float, py: float, pz: float, u0: float,
+           w0: float, g0: float, gu: float, gw: float, floor: float) -> bool:
+    """The proof of :meth:`SurfaceBound.clear` (module doc): ``b`` (P, 12, 3) the patches'
+    boxes and derivative boxes, ``rect`` (P, 4) their (u, w) ranges; g0, (gu, gw) the
+    value and gradient of |S - p|^2 at the foot (u0, w0)."""
+    p = np.array((px, py, pz))
+    near2 = floor * floor * (1.0 + ROUND_OFF)
+    u_lo, u_hi, w_lo, w_hi, near = u0, u0, w0, w0, False
+    for i in range(len(b)):
+        s = 0.0
+        for k in range(3):
+            g = max(b[i, 0, k] - p[k], p[k] - b[i, 1, k], 0.0)
+            s += g * g
+        if s < near2:
+            near = True
+            u_lo, u_hi = min(u_lo, rect[i, 0]), max(u_hi, rect[i, 1])
+            w_lo, w_hi = min(w_lo, rect[i, 2]), max(w_hi, rect[i, 3])
+    if not near:
+        return True
+    lam = math.inf
+    for i in range(len(b)):
+        if rect[i, 0] <= u_hi and rect[i, 1] >= u_lo and rect[i, 2] <= w_hi \
+                and rect[i, 3] >= w_lo:
+            lam = min(lam, 2.0 * _least_eigenvalue(b, i, p))
+    if not lam > 0.0:
+        return False
+    t = min(max(-gu / lam, u_lo - u0), u_hi - u0)
+    low = g0 + gu * t + 0.5 * lam * t * t
+    t = min(max(-gw / lam, w_lo - w0), w_hi - w0)
+    low += gw * t + 0.5 * lam * t * t
+    return low * (1.0 - ROUND_OFF) >= floor * floor
 
 
 def min_distance_bound(bound: SurfaceBound, adaptor, point, u0: float, w0: float,
