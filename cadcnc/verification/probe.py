@@ -32,6 +32,7 @@ from ..core.trim_labels import BOUNDARY, INSIDE, OUTSIDE
 from ..geometry.boxes import optimal_box
 from .box_face import whole_box
 from .face_boundary import FaceEdges
+from .surface_bound import SurfaceBound
 
 _STATES = {TopAbs_IN: INSIDE, TopAbs_ON: BOUNDARY}
 NEWTON_PARAMETER_PRECISION = 1e-12
@@ -86,6 +87,7 @@ class FaceProbe:
         self._edges = None
         self._natural = None
         self._inner = None
+        self._bound = False   # the SurfaceBound, made on first use (None: none applies)
 
     # -- surface -----------------------------------------------------------------------
     def normal(self, u: float, w: float) -> np.ndarray:
@@ -135,6 +137,15 @@ class FaceProbe:
             return None
         u, w = proj.LowerDistanceParameters()
         return u, w, proj.LowerDistance()
+
+    def surface_clear(self, point, u: float, w: float, floor: float) -> bool:
+        """Whether no point of the untrimmed surface lies nearer than ``floor`` (mm) to
+        ``point``, given its foot at (u, w), proven by bounds without OCCT's global search
+        (:mod:`.surface_bound`; False where they cannot say)."""
+        if self._bound is False:
+            self._bound = SurfaceBound.of(self.adaptor, self.surface)
+        return self._bound is not None and self._bound.clear(self.adaptor, point, u, w,
+                                                             floor)
 
     def signed(self, point, u: float, w: float, dist: float) -> float:
         """``dist`` signed by the side of the surface the point is on (+ out of material)."""

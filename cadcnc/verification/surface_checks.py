@@ -85,13 +85,14 @@ def check_surface(probe: FaceProbe, face_no, offset: float, points: np.ndarray,
     the answers are those of the full check (the reference gate's).
     """
     n = len(points)
-    dist, signed, states, exact = [], [], [], {}
+    dist, signed, states, exact, feet = [], [], [], {}, []
     seeds = np.asarray(uw, float).tolist()  # floats: cheaper to OCCT than numpy's
     for k, p in enumerate(np.asarray(points, float).tolist()):
         if tick and k % TICK == 0:
             tick(k, n)
         res = probe.project_seeded(p, *seeds[k]) or probe.project_global(p)
         u, w, d = res
+        feet.append((u, w))
         dist.append(d)
         signed.append(probe.signed(p, u, w, d))
         states.append(probe.state(u, w))
@@ -108,10 +109,18 @@ def check_surface(probe: FaceProbe, face_no, offset: float, points: np.ndarray,
     sample |= {int(np.argmin(fdev)), int(np.argmax(fdev)), int(np.argmin(dev))}
     gain, bad = 0.0, 0
     for k in sorted(sample):
-        g = probe.project_global(points[k])
+        near = dist[k] if k in exact else max(dist[k], abs(fdev[k] + offset))
+        if bounded and probe.surface_clear(points[k], *feet[k], near - 0.5 * tol.noise):
+            # no point of the surface nearer than near - noise / 2: OCCT's global search
+            # would find none nearer, so it could not decide (module doc)
+            g = None
+        else:
+            g = probe.project_global(points[k])
         better = g is not None and g[2] < dist[k] - tol.noise
-        if bounded and (k in exact or _nearer_ruled_out(probe, points[k], g,
-                                                        abs(fdev[k] + offset), tol)):
+        if bounded and (k in exact or (g is None and _edges_clear(
+                probe, points[k], abs(fdev[k] + offset), tol))
+                        or _nearer_ruled_out(probe, points[k], g, abs(fdev[k] + offset),
+                                             tol)):
             sd, ud = exact.get(k, (fdev[k] + offset, abs(fdev[k] + offset)))
         else:
             sd, ud = probe.face_distance(points[k])
@@ -135,6 +144,13 @@ def check_surface(probe: FaceProbe, face_no, offset: float, points: np.ndarray,
         off_face_cycles=cycle_ranges(np.nonzero(gap > tol.off_face)[0]),
         unseeded_checked=len(sample), unseeded_disagreements=bad,
         unseeded_max_gain_mm=float(gain))
+
+
+def _edges_clear(probe: FaceProbe, point, d: float, tol: Tolerances) -> bool:
+    """Whether the face's boundary lies at least ``d`` - noise / 2 from ``point`` (the
+    second half of :func:`_nearer_ruled_out`, its first proven by the surface's bound)."""
+    floor = d - 0.5 * tol.noise
+    return probe.edge_gap(point, floor) >= floor
 
 
 def _nearer_ruled_out(probe: FaceProbe, point, found, d: float, tol: Tolerances) -> bool:

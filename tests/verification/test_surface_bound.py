@@ -1,0 +1,119 @@
+"""The surface bound that stands in for OCCT's global search on the gate's sampled cycles
+(cadcnc/verification/surface_bound.py, issue 37 item 6).
+
+Sound: it never proves a floor above OCCT's global distance (random points about three
+B-spline faces); it refuses a foot that is not the nearest point; and the bounded check
+gives the same answers with it as without it, on a finishing cut of the wave slab with
+its own seeds and with wrong ones (where it must fall back to OCCT and report the
+disagreements).
+"""
+
+from __future__ import annotations
+
+import json
+from functools import cache
+
+import numpy as np
+import pytest
+
+import cadcnc
+from cadcnc.core.job import Job, PairPath, Tool
+from cadcnc.ops.finish.passes import GuidePlane, pass_cuts
+from cadcnc.verification.probe import FaceProbe
+from cadcnc.verification.surface_bound import SurfaceBound, min_distance_bound
+from cadcnc.verification.surface_checks import check_surface
+from helpers.fixtures import FIXTURES
+
+WAVE = json.loads((FIXTURES / "finish_fixtures.json").read_text())["wave"]
+ROUND = 1e-9  # mm: OCCT's distances to their last digits
+
+
+@cache
+def wave_part():
+    return cadcnc.load_step(FIXTURES / WAVE["file"])
+
+
+def _near_points(probe: FaceProbe, count: int, seed: int) -> list[np.ndarray]:
+    """Points 0.3-4 mm from random points of the face's surface, mostly on its outer
+    side (a ball centre's), some inside."""
+    u0, u1, w0, w1 = probe.box
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(count):
+        n = probe.normal(rng.uniform(u0, u1), rng.uniform(w0, w1))
+        side = 1.0 if rng.random() < 0.8 else -1.0
+        out.append(np.array(probe._p.Coord()) + side * rng.uniform(0.3, 4.0) * n)
+    return out
+
+
+@pytest.mark.parametrize("name, face", [("wave", None), ("finish_slab.step", 5),
+                                        ("bspline_boss.step", 4)])
+def test_the_bound_never_exceeds_occts_global_distance(name, face):
+    part = wave_part() if name == "wave" else cadcnc.load_step(FIXTURES / name)
+    probe = FaceProbe(part.face(face or WAVE["top"]).topods)
+    bound = SurfaceBound.of(probe.adaptor, probe.surface)
+    assert bound is not None
+    proven = 0
+    for p in _near_points(probe, 40, 7):
+        u, w, d = probe.project_global(p)
+        floor = min_distance_bound(bound, probe.adaptor, p, u, w, 0.0, 2.0 * d)
+        assert floor <= d + ROUND
+        proven += floor >= d - 1e-6   # mm: proven to within a micron
+    if name == "wave":   # the slab of the gate's pace: every point proven
+        assert proven == 40
+
+
+def test_a_foot_that_is_not_nearest_is_not_proven():
+    """From a point above the wave, a foot on a far crest is farther than the nearest
+    point: the bound must not prove its distance (nor anything above the true one)."""
+    probe = FaceProbe(wave_part().face(WAVE["top"]).topods)
+    bound = SurfaceBound.of(probe.adaptor, probe.surface)
+    p = np.array([0.0, 0.0, 14.0])
+    u, w, d = probe.project_global(p)
+    far = np.array(probe.surface.Value(20.0, 10.0).Coord())
+    assert not bound.clear(probe.adaptor, p, 20.0, 10.0, float(np.linalg.norm(far - p)))
+    assert bound.clear(probe.adaptor, p, u, w, d - 1e-8)   # mm: the noise below the foot
+    assert not bound.clear(probe.adaptor, p, u, w, d + 1e-6)   # mm: above it
+
+
+@cache
+def wave_cut():
+    """One finishing pass across the wave slab (the plane y = 5), its first cut."""
+    job = Job(Tool(3.0), 1500.0, 0.004, PairPath())
+    return pass_cuts(wave_part(), [WAVE["top"]], GuidePlane(0.0, 5.0), job).cuts[0].path
+
+
+def _misled(probe: FaceProbe) -> None:
+    """Make the probe's seeded search answer with a foot 12 mm along u of the right one
+    (what seeds that steer OCCT's local search to another critical point would give)."""
+    right = probe.project_seeded
+
+    def wrong(point, u0, w0):
+        u, w, _ = right(point, u0, w0)
+        u = u + 12.0 if u + 12.0 < probe.box[1] else u - 12.0
+        return u, w, float(np.linalg.norm(np.array(probe.surface.Value(u, w).Coord())
+                                          - np.asarray(point)))
+    probe.project_seeded = wrong
+
+
+@pytest.mark.parametrize("wrong", [False, True])
+def test_the_bounded_check_answers_as_without_the_bound(wrong, monkeypatch):
+    tp = wave_cut()
+    tol = wave_part().tol
+
+    def check():
+        probe = FaceProbe(wave_part().face(WAVE["top"]).topods, tol)
+        if wrong:
+            _misled(probe)
+        return check_surface(probe, WAVE["top"], 3.0, tp.points, tp.uv[:, 0], 64, tol,
+                             bounded=True)
+
+    with_bound = check()
+    monkeypatch.setattr(FaceProbe, "surface_clear", lambda self, *a: False)
+    without = check()
+    for field in ("deviation", "face_deviation"):
+        np.testing.assert_array_equal(getattr(with_bound, field), getattr(without, field))
+    assert with_bound.states == without.states
+    assert (with_bound.unseeded_disagreements, with_bound.unseeded_max_gain_mm) == \
+        (without.unseeded_disagreements, without.unseeded_max_gain_mm)
+    assert (with_bound.unseeded_disagreements > 0) == wrong
