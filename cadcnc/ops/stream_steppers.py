@@ -2,7 +2,8 @@
 
 :func:`stepper_factory` is the OCCT side of :func:`cadcnc.controller.stream.stream_program`:
 for cut k it builds a fresh stepper on the same two surfaces (a pair's two faces, or a
-finishing pass's face and its vertical guide plane, recovered from the cut's own points),
+finishing pass's face and its guide plane, vertical for a raster pass, horizontal for a
+waterline loop, recovered from the cut's own points),
 from the cut's first point and contact parameters, landing on its last point, at the
 machine's period, without record, guard or boundary rule (the cut was checked when
 computed, and the stream is gated again). A convex roll-over arc (a closed form, no
@@ -18,6 +19,7 @@ import numpy as np
 
 from ..interp.compiled import new_stepper
 from ..interp.stepper import Tangency
+from .finish.loops import Level
 from .finish.pass_setup import GUIDE_MARGIN, guide_face
 from .finish.passes import GuidePlane
 
@@ -44,6 +46,19 @@ def guide_plane_of(path) -> GuidePlane | None:
     return GuidePlane(angle, float(path.points[0] @ normal))
 
 
+LEVEL_TOL = 1e-6   # mm: a waterline cut's centres at one height (a landing ends within nm)
+
+
+def level_of(path) -> Level | None:
+    """The horizontal guide plane of a waterline cut (its centres at one height, the
+    guide's parameters their x and y, as :func:`~.finish.loops.level_cuts` builds it),
+    else None (a raster pass: :func:`guide_plane_of`)."""
+    pts, guide = path.points, path.uv[:, 1]
+    if np.ptp(pts[:, 2]) > LEVEL_TOL or np.abs(guide - pts[:, :2]).max() > LEVEL_TOL:
+        return None
+    return Level(float(pts[0, 2]))
+
+
 def stepper_factory(part):
     """``steppers(cut_index, segment, period)`` for the cuts of programs on ``part``."""
     lo, hi = part.bounding_box()
@@ -57,7 +72,7 @@ def stepper_factory(part):
         job = replace(path.job, period=period)
         s1 = part.face(i)
         if j is None:
-            plane = guide_plane_of(path)
+            plane = level_of(path) or guide_plane_of(path)
             if plane is None:
                 return None
             s2 = guide_face(plane, size, job)
