@@ -6,17 +6,14 @@ that takes such hits finds the same stretches and refusals as with exact clearan
 from __future__ import annotations
 
 import json
-from dataclasses import replace
 
 import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.core.job import Tool
 from cadcnc.guard.clearance import ClearanceGuard
-from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.stretches import pair_stretches
-from helpers.fixtures import FIXTURES
+from helpers.fixtures import FIXTURES, stretch_pair_job
 
 SIDECAR = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
 TOL = 1e-6   # mm: the guard's hit tolerance in these tests
@@ -94,12 +91,7 @@ def test_the_first_hit_is_a_face_that_cuts_in():
 @pytest.mark.parametrize("name", ["shelf", "slot"] + [
     pytest.param(n, marks=pytest.mark.slow) for n in ("pocket", "sloped", "undercut", "boss")])
 def test_quick_samples_find_the_same_stretches(name, monkeypatch):
-    facts = SIDECAR[name]
-    part = cadcnc.load_step(FIXTURES / facts["file"])
-    i, j = facts["pair"]
-    s1, s2, job = pair_job(part.face(i), part.face(j), radius=facts["radius"],
-                           feed=1500.0, period=0.004)
-    job = replace(job, tool=Tool(facts["radius"], 0.0, facts["shank"]))
+    s1, s2, job = stretch_pair_job(name)
     proofs = []   # (a proof per call: True when it took a hit without OCCT)
     prove = ClearanceGuard.proven_hit
 

@@ -38,3 +38,23 @@ def fixture_path(name: str, i: int, j: int, *, radius: float = 3.0, feed: float 
         _paths[key] = intersection_path(part.face(i), part.face(j), radius=radius,
                                         feed=feed, period=period, **kwargs)
     return _paths[key]
+
+
+STRETCH_SIDECAR = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
+
+
+def stretch_pair_job(name: str):
+    """(s1, s2, job) of a stretch fixture's pair: its ball radius and shank length, feed
+    1500 mm/min, period 4 ms (a fresh part each call: guards built on it start empty)."""
+    from dataclasses import replace
+
+    import cadcnc
+    from cadcnc.core.job import Tool
+    from cadcnc.ops.path.pair_path import pair_job
+
+    facts = STRETCH_SIDECAR[name]
+    part = cadcnc.load_step(FIXTURES / facts["file"])
+    i, j = facts["pair"]
+    s1, s2, job = pair_job(part.face(i), part.face(j), radius=facts["radius"],
+                           feed=1500.0, period=0.004)
+    return s1, s2, replace(job, tool=Tool(facts["radius"], 0.0, facts["shank"]))

@@ -22,10 +22,9 @@ from cadcnc.core.errors import EXIT_NOTHING, NothingToCutError
 from cadcnc.core.job import Tool
 from cadcnc.core.tolerances import DEFAULT
 from cadcnc.guard import guard_for
-from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.stretch_paths import nearest_start, stretch_paths
 from cadcnc.ops.path.stretches import COLLISION, REASONS, Feasibility, pair_stretches
-from helpers.fixtures import FIXTURES
+from helpers.fixtures import FIXTURES, stretch_pair_job
 
 SIDECAR = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
 UM = 1e-6
@@ -36,12 +35,7 @@ _cache: dict = {}
 def setup(name):
     """(s1, s2, job, per-edge stretches) of a fixture's pair, computed once."""
     if name not in _cache:
-        facts = SIDECAR[name]
-        part = cadcnc.load_step(FIXTURES / facts["file"])
-        i, j = facts["pair"]
-        s1, s2, job = pair_job(part.face(i), part.face(j), radius=facts["radius"],
-                               feed=1500.0, period=0.004)
-        job = replace(job, tool=Tool(facts["radius"], 0.0, facts["shank"]))
+        s1, s2, job = stretch_pair_job(name)
         _cache[name] = (s1, s2, job, pair_stretches(s1, s2, job))
     return _cache[name]
 
