@@ -212,7 +212,24 @@ def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
     V, A, J = _limits(machine, derate)
     # a short run: the acceleration a jerk ramp up and down over its length reaches
     A = np.minimum(A, np.cbrt(J * J * run.length))
-    return _plan_share(run, machine, (V, A, J), CORIOLIS_SHARE)
+    plan = _plan_share(run, machine, (V, A, J), CORIOLIS_SHARE)
+    even = _even_ratio(run, A, J)
+    if even is None:
+        return plan
+    other = _plan_share(run, machine, (V, even, J), CORIOLIS_SHARE)
+    return other if other.duration < plan.duration else plan
+
+
+def _even_ratio(run: Run, A: np.ndarray, J: np.ndarray) -> np.ndarray | None:
+    """(3,) the accelerations with no moving axis asking for a longer jerk ramp than the
+    quickest one (A_i <= J_i min_k A_k / J_k), or None where they already do. The window
+    serves every axis at once, so an axis with more acceleration than that lengthens it:
+    planned both ways, the faster kept, a looser acceleration limit never slows a run."""
+    moving = np.max(np.abs(run.T), axis=0) > 0.0
+    if not moving.any():
+        return None
+    even = np.minimum(A, J * float(np.min((A / J)[moving])))
+    return None if np.array_equal(even[moving], A[moving]) else even
 
 
 def _constant_run(first: int, piece: Piece, machine: Machine) -> tuple[Run, Profile]:
