@@ -48,6 +48,7 @@ and the kernel's step landing within a few nm of the plan."""
 CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most (0.5 and 0.75 were slower or equal
                         # on every run of the three programs: the window grows instead)
 D_SHARE = 0.25          # of J_i: D_i v^3 at most
+SHARE_STEP, SHARE_STEPS = 0.025, 3   # the Coriolis share searched per curved run
 WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window grown
 FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
 TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
@@ -212,12 +213,32 @@ def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
     V, A, J = _limits(machine, derate)
     # a short run: the acceleration a jerk ramp up and down over its length reaches
     A = np.minimum(A, np.cbrt(J * J * run.length))
-    plan = _plan_share(run, machine, (V, A, J), CORIOLIS_SHARE)
+    plan = _best_share(run, machine, (V, A, J))
     even = _even_ratio(run, A, J)
     if even is None:
         return plan
-    other = _plan_share(run, machine, (V, even, J), CORIOLIS_SHARE)
+    other = _best_share(run, machine, (V, even, J))
     return other if other.duration < plan.duration else plan
+
+
+def _best_share(run: Run, machine: Machine, limits) -> Profile:
+    """The run planned at CORIOLIS_SHARE; where the curvature terms lengthened its window
+    past the first one, the share moved by SHARE_STEP while that shortens the run (a larger
+    share lets the feed change faster on a curve but asks for a longer window)."""
+    plan = _plan_share(run, machine, limits, CORIOLIS_SHARE)
+    if plan.window <= _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9):
+        return plan
+    for step in (-SHARE_STEP, SHARE_STEP):
+        share, best = CORIOLIS_SHARE, plan
+        for _ in range(SHARE_STEPS):
+            share += step
+            other = _plan_share(run, machine, limits, share)
+            if other.duration >= best.duration:
+                break
+            best = other
+        if best is not plan:
+            return best
+    return plan
 
 
 def _even_ratio(run: Run, A: np.ndarray, J: np.ndarray) -> np.ndarray | None:
