@@ -226,7 +226,7 @@ def _best_share(run: Run, machine: Machine, limits) -> Profile:
     past the first one, the share moved by SHARE_STEP while that shortens the run (a larger
     share lets the feed change faster on a curve but asks for a longer window)."""
     plan = _plan_share(run, machine, limits, CORIOLIS_SHARE)
-    if plan.window <= _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9):
+    if plan.window <= _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9):  # round-off
         return plan
     for step in (-SHARE_STEP, SHARE_STEP):
         share, best = CORIOLIS_SHARE, plan
