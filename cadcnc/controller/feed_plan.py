@@ -48,6 +48,7 @@ and the kernel's step landing within a few nm of the plan."""
 CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most (0.5 and 0.75 were slower or equal
                         # on every run of the three programs: the window grows instead)
 D_SHARE = 0.25          # of J_i: D_i v^3 at most
+SHARE_STEP, SHARE_STEPS = 0.025, 3   # the Coriolis share searched per curved run
 WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window grown
 FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
 TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
@@ -212,7 +213,44 @@ def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
     V, A, J = _limits(machine, derate)
     # a short run: the acceleration a jerk ramp up and down over its length reaches
     A = np.minimum(A, np.cbrt(J * J * run.length))
-    return _plan_share(run, machine, (V, A, J), CORIOLIS_SHARE)
+    plan = _best_share(run, machine, (V, A, J))
+    even = _even_ratio(run, A, J)
+    if even is None:
+        return plan
+    other = _best_share(run, machine, (V, even, J))
+    return other if other.duration < plan.duration else plan
+
+
+def _best_share(run: Run, machine: Machine, limits) -> Profile:
+    """The run planned at CORIOLIS_SHARE; where the curvature terms lengthened its window
+    past the first one, the share moved by SHARE_STEP while that shortens the run (a larger
+    share lets the feed change faster on a curve but asks for a longer window)."""
+    plan = _plan_share(run, machine, limits, CORIOLIS_SHARE)
+    if plan.window <= _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9):
+        return plan
+    for step in (-SHARE_STEP, SHARE_STEP):
+        share, best = CORIOLIS_SHARE, plan
+        for _ in range(SHARE_STEPS):
+            share += step
+            other = _plan_share(run, machine, limits, share)
+            if other.duration >= best.duration:
+                break
+            best = other
+        if best is not plan:
+            return best
+    return plan
+
+
+def _even_ratio(run: Run, A: np.ndarray, J: np.ndarray) -> np.ndarray | None:
+    """(3,) the accelerations with no moving axis asking for a longer jerk ramp than the
+    quickest one (A_i <= J_i min_k A_k / J_k), or None where they already do. The window
+    serves every axis at once, so an axis with more acceleration than that lengthens it:
+    planned both ways, the faster kept, a looser acceleration limit never slows a run."""
+    moving = np.max(np.abs(run.T), axis=0) > 0.0
+    if not moving.any():
+        return None
+    even = np.minimum(A, J * float(np.min((A / J)[moving])))
+    return None if np.array_equal(even[moving], A[moving]) else even
 
 
 def _constant_run(first: int, piece: Piece, machine: Machine) -> tuple[Run, Profile]:

@@ -87,9 +87,6 @@ def test_a_looser_limit_is_never_slower(program, limit):
         stream = stream_program(prog, m, stepper_factory(part), feed=FAST)
         assert (_shares(stream.positions, m) <= 1.0 + SLACK).all()
         periods.append(stream.periods)
-    if periods[1] > periods[0] and limit == "max_acceleration":
-        pytest.xfail(f"known (issue 35 open): the finish's periods {periods} as Z's "
-                     "acceleration grows (the averaging window grows with it)")
     assert all(b <= a for a, b in zip(periods, periods[1:])), periods
 
 
