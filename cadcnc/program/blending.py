@@ -30,7 +30,7 @@ BLEND_SHARE = 0.4     # a blend takes at most this share of each leg it shortens
 MIN_BLEND = 0.01      # mm: a corner whose blend would be smaller keeps its exact stop
 MIN_TURN = 1e-9       # rad: a smaller turn is no corner (collinear moves pass as they are)
 MAX_TURN = math.radians(170.0)   # rad: a sharper turn (a reversal) keeps its exact stop
-SAMPLE = 0.01         # mm: the largest chord between a blend's samples
+SAMPLE = 0.05         # mm: the largest chord between a blend's samples
 MIN_SAMPLES = 33      # samples of a blend at least (the planner's curvature sees the curve)
 SPACING = (1.0, 0.6, 0.4)   # the control points' distances from the corner, share of d
 """Of the quintics whose control points lie on the legs, the one (in steps of 0.1 d) whose
