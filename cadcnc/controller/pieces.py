@@ -116,7 +116,7 @@ def pieces_of(program: Program, machine: Machine, feed: float | None = None, *,
     """The program's pieces in machining order. ``feed`` (mm/min) replaces the program's
     feed for cuts and the links' feed moves; rapids go as fast as the axes allow.
     ``blend`` (mm): the corners of the links whose segment index is in ``rounded`` are
-    rounded within it (:func:`rounded_link`; which links: :mod:`.blends`)."""
+    rounded within it (:func:`rounded_link`; which links: :mod:`.link_blends`)."""
     feed = program.job.feed if feed is None else check_number("feed", feed, "mm/min")
     blend = check_number("blend", blend, "mm", allow_zero=True)
     pieces: list[Piece] = []

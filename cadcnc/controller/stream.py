@@ -25,8 +25,8 @@ from ..core.tolerances import STREAM_END
 from ..interp.cycle import CLOSED, END
 from ..interp.planned_follow import follow
 from ..program.program import Program
-from .blends import stream_pieces
 from .feed_plan import MAX_PERIODS, FeedPlan, PlanError, plan_feed
+from .link_blends import stream_pieces
 from .machine import AXES, Machine
 from .pieces import Piece, programmed_time
 
@@ -243,7 +243,7 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
     stream whose finite differences break a limit is planned again with that limit
     lowered by as much (REPLANS times at most), then refused (PlanError). ``blend`` (mm)
     rounds the corners of the links that pay for it within it, but not of the segments
-    in ``exact`` (:func:`.blends.stream_pieces`); a blend is positioned on its samples by
+    in ``exact`` (:func:`.link_blends.stream_pieces`); a blend is positioned on its samples by
     the Hermite."""
     pieces = stream_pieces(program, machine, feed, blend, exact)
     derate = np.ones(3)

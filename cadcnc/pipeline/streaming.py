@@ -16,20 +16,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..controller.blends import stream_pieces
 from ..controller.feed_plan import plan_feed
 from ..controller.hal import HalError, hal_available, run_hal_loop
 from ..controller.hal import summary as hal_summary
+from ..controller.link_blends import stream_pieces
 from ..controller.stream import stream_program, stream_text
 from ..core.errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL, InputError
-from ..core.tolerances import DEFAULT
+from ..core.tolerances import DEFAULT, STREAM_BLEND
 from ..core.units import check_number
 from ..core.work_limits import MAX_STREAM_PERIODS, Ticker, refuse_over, sigterm_as_interrupt
 from ..geometry.part import load_step
 from ..io.output_set import OutputSet
 from ..io.program_json import read_program
 from ..ops.stream_steppers import stepper_factory
-from ..program.blending import DEFAULT_BLEND
 from ..verification import gate_program
 from ..verification.stream_check import check_program_on_part, check_stream
 
@@ -70,7 +69,7 @@ def stream_saved(program_file, part_file, machine, outputs, *, ini=None, toleran
 
 def stream_to(program, part, machine, outputs, *, feed=None, planned=True, tolerances=None,
               allow_gouge=False, hal=False, say=None, inputs=(),
-              max_periods=MAX_STREAM_PERIODS, blend=DEFAULT_BLEND) -> StreamRun:
+              max_periods=MAX_STREAM_PERIODS, blend=STREAM_BLEND) -> StreamRun:
     """Stream ``program`` on ``part`` to ``machine`` and write it to ``outputs`` (a list
     of paths, .npy / .txt); optionally execute it in HAL (module doc). ``say``: progress
     on stderr (a heartbeat at least every 5 s), or None; SIGTERM counts as Ctrl-C.

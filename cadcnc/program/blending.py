@@ -22,10 +22,6 @@ import numpy as np
 
 from .program import LinkSegment
 
-DEFAULT_BLEND = 10.0
-"""mm: the stream's default (``--blend``). Measured on the default machine
-(docs/controller.md): links rounded within 1 or 5 mm never planned faster there; within
-10 to 20 mm the tall ones do."""
 BLEND_SHARE = 0.4     # a blend takes at most this share of each leg it shortens
 MIN_BLEND = 0.01      # mm: a corner whose blend would be smaller keeps its exact stop
 MIN_TURN = 1e-9       # rad: a smaller turn is no corner (collinear moves pass as they are)
