@@ -1,8 +1,8 @@
 """A program cut into the pieces the feed planner plans one by one (no OCCT).
 
 A piece is one cut (the kernel's points, which the stream re-interpolates), one
-straight move of a link, or one rounded corner of a link (``--blend``: its samples). Pieces are grouped into runs that stop only at corners
-(:mod:`.runs`). Arrays: ``points`` (n, 3) mm, ``s`` (n,) arc length (chord sum) from the
+straight move of a link, or one rounded corner of a link (``--blend``: its samples).
+Pieces are grouped into runs that stop only at corners (:mod:`.runs`). Arrays: ``points`` (n, 3) mm, ``s`` (n,) arc length (chord sum) from the
 piece's start, mm; speeds mm/s.
 """
 
