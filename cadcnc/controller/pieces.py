@@ -2,8 +2,8 @@
 
 A piece is one cut (the kernel's points, which the stream re-interpolates), one
 straight move of a link, or one rounded corner of a link (``--blend``: its samples).
-Pieces are grouped into runs that stop only at corners (:mod:`.runs`). Arrays: ``points`` (n, 3) mm, ``s`` (n,) arc length (chord sum) from the
-piece's start, mm; speeds mm/s.
+Pieces are grouped into runs that stop only at corners (:mod:`.runs`). Arrays: ``points``
+(n, 3) mm, ``s`` (n,) arc length (chord sum) from the piece's start, mm; speeds mm/s.
 """
 
 from __future__ import annotations
