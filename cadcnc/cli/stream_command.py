@@ -5,7 +5,7 @@ printing of a stream for the operations' ``--stream OUT``."""
 from __future__ import annotations
 
 from cadcnc.core.errors import InputError
-from cadcnc.core.units import parse_feed
+from cadcnc.core.units import check_number, parse_feed
 from cadcnc.pipeline.streaming import StreamRun, stream_saved
 
 from .feedback import say_error
@@ -23,9 +23,19 @@ def stream(args) -> int:
                        say=None if args.quiet else say_error, ini=args.machine,
                        feed=None if args.feed is None else parse_feed(args.feed),
                        planned=not args.constant_feed, allow_gouge=args.allow_gouge,
-                       hal=args.hal, max_periods=args.max_periods)
+                       hal=args.hal, max_periods=args.max_periods,
+                       blend=parse_blend(args.blend))
     print_stream(run, str(args.program), args.quiet)
     return run.code
+
+
+def parse_blend(text: str) -> float:
+    """``--blend MM`` as a number >= 0 (InputError otherwise: negative, NaN, not a number)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputError(f"--blend must be a number >= 0 mm, got {text!r}") from None
+    return check_number("--blend", value, "mm", allow_zero=True)
 
 
 def print_stream(run: StreamRun, name: str, quiet: bool) -> None:

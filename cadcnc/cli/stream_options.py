@@ -17,6 +17,7 @@ underrun within the program), 130 Ctrl-C (HAL unloaded).
 
 from __future__ import annotations
 
+from cadcnc.core.tolerances import STREAM_BLEND
 from cadcnc.core.work_limits import MAX_STREAM_PERIODS
 
 
@@ -42,6 +43,11 @@ def add_parser(add, flip, gouge) -> None:
     p.add_argument("--feed", metavar="F", help="replace the program's feed, mm/min")
     p.add_argument("--constant-feed", action="store_true",
                    help="stream at the programmed feed ignoring the limits (a comparison)")
+    p.add_argument("--blend", metavar="MM", default=str(STREAM_BLEND),
+                   help="round each link's corners within MM where that streams faster "
+                        f"(default {STREAM_BLEND:g}; 0: exact stops as programmed); cuts, "
+                        "and the corners where a link meets a cut, are never rounded; a "
+                        "rounded link the gate refuses keeps its exact corners")
     p.add_argument("--part", metavar="PART.step",
                    help="the part (default: the STEP file recorded in the program)")
     p.add_argument("--hal", action="store_true",

@@ -1,9 +1,9 @@
 """A program cut into the pieces the feed planner plans one by one (no OCCT).
 
-A piece is one cut (the kernel's points, which the stream re-interpolates) or one
-straight move of a link. Pieces are grouped into runs that stop only at corners
-(:mod:`.runs`). Arrays: ``points`` (n, 3) mm, ``s`` (n,) arc length (chord sum) from the
-piece's start, mm; speeds mm/s.
+A piece is one cut (the kernel's points, which the stream re-interpolates), one
+straight move of a link, or one rounded corner of a link (``--blend``: its samples).
+Pieces are grouped into runs that stop only at corners (:mod:`.runs`). Arrays: ``points``
+(n, 3) mm, ``s`` (n,) arc length (chord sum) from the piece's start, mm; speeds mm/s.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ import numpy as np
 
 from ..core.job import check_number
 from ..interp.cycle import MAX_TURN
+from ..program.blending import blend_sizes, round_link
 from ..program.program import Program
 from .machine import Machine
 
@@ -110,10 +111,14 @@ def _step_caps(seg, machine: Machine, mask: np.ndarray,
     return ACCURACY_SHARE * limit / machine.period
 
 
-def pieces_of(program: Program, machine: Machine, feed: float | None = None) -> list[Piece]:
+def pieces_of(program: Program, machine: Machine, feed: float | None = None, *,
+              blend: float = 0.0, rounded: frozenset[int] = frozenset()) -> list[Piece]:
     """The program's pieces in machining order. ``feed`` (mm/min) replaces the program's
-    feed for cuts and the links' feed moves; rapids go as fast as the axes allow."""
+    feed for cuts and the links' feed moves; rapids go as fast as the axes allow.
+    ``blend`` (mm): the corners of the links whose segment index is in ``rounded`` are
+    rounded within it (:func:`rounded_link`; which links: :mod:`.link_blends`)."""
     feed = program.job.feed if feed is None else check_number("feed", feed, "mm/min")
+    blend = check_number("blend", blend, "mm", allow_zero=True)
     pieces: list[Piece] = []
     cut = 0
     for k, seg in enumerate(program.segments):
@@ -124,13 +129,38 @@ def pieces_of(program: Program, machine: Machine, feed: float | None = None) -> 
                 pieces.append(Piece(pts, s, feed / 60.0, k, cut, caps, kappa))
             cut += 1
             continue
-        moves = np.asarray(seg.points, dtype=float)
-        lengths = np.linalg.norm(np.diff(moves, axis=0), axis=1).tolist()
-        for m, (h, rapid) in enumerate(zip(lengths, seg.rapid)):
-            if h > DUPLICATE:   # a straight move: its chord is its arc
-                pieces.append(Piece(moves[m:m + 2].copy(), np.array([0.0, h]),
-                                    math.inf if rapid else feed / 60.0, k))
+        if k in rounded:
+            pieces += rounded_link(seg, blend, feed / 60.0, k)
+            continue
+        pieces += link_pieces(seg, feed / 60.0, k)
     return pieces
+
+
+def link_pieces(link, feed: float, segment: int) -> list[Piece]:
+    """The pieces of a link as programmed: one per straight move (its chord is its arc),
+    rapids unbounded, feed moves at ``feed`` mm/s."""
+    moves = np.asarray(link.points, dtype=float)
+    lengths = np.linalg.norm(np.diff(moves, axis=0), axis=1).tolist()
+    return [Piece(moves[m:m + 2].copy(), np.array([0.0, h]),
+                  math.inf if rapid else feed, segment)
+            for m, (h, rapid) in enumerate(zip(lengths, link.rapid)) if h > DUPLICATE]
+
+
+def rounded_link(link, blend: float, feed: float, segment: int) -> list[Piece]:
+    """The pieces of a link (segment index ``segment``) with its corners rounded within
+    ``blend`` mm (:func:`round_link`): straight moves and blends (a blend's samples, their
+    arc length and curvature), at ``feed`` (mm/s) unless between two rapids."""
+    out = []
+    for move in round_link(link, blend_sizes(np.asarray(link.points, float), blend)):
+        cap = math.inf if move.rapid else feed
+        if not move.curved:
+            h = float(np.linalg.norm(move.points[1] - move.points[0]))
+            if h > DUPLICATE:
+                out.append(Piece(move.points, np.array([0.0, h]), cap, segment))
+            continue
+        pts, s, kappa, _ = _distinct(move.points)
+        out.append(Piece(pts, s, cap, segment, kappa=kappa))
+    return out
 
 
 def programmed_time(pieces: list[Piece], machine: Machine) -> float:

@@ -26,8 +26,9 @@ from ..interp.cycle import CLOSED, END
 from ..interp.planned_follow import follow
 from ..program.program import Program
 from .feed_plan import MAX_PERIODS, FeedPlan, PlanError, plan_feed
+from .link_blends import stream_pieces
 from .machine import AXES, Machine
-from .pieces import Piece, pieces_of, programmed_time
+from .pieces import Piece, programmed_time
 
 StepperFactory = Callable[[int, object, float], object]
 """steppers(cut_index, cut_segment, period) -> a fresh stepper from the cut's first point
@@ -77,6 +78,12 @@ class Stream:
             peak = np.abs(d).max(axis=0) if len(d) else np.zeros(3)
             out[name] = tuple(float(p / q) for p, q in zip(peak, lim))
         return out
+
+    @property
+    def rounded(self) -> frozenset[int]:
+        """Segment indices of the links streamed with rounded corners."""
+        return frozenset(p.segment for p in self.plan.pieces
+                         if p.cut is None and len(p.points) > 2)
 
     def segment_moves(self, program: Program) -> list[np.ndarray]:
         """Per program segment, the streamed positions inside it, led by the row before
@@ -225,7 +232,8 @@ def _cut_rows(stepper, piece: Piece, s: np.ndarray, what: str, done: int, total:
 
 def stream_program(program: Program, machine: Machine, steppers: StepperFactory | None = None,
                    *, feed: float | None = None, planned: bool = True,
-                   max_periods: int = MAX_PERIODS, progress: Progress | None = None) -> Stream:
+                   max_periods: int = MAX_PERIODS, progress: Progress | None = None,
+                   blend: float = 0.0, exact: frozenset[int] = frozenset()) -> Stream:
     """Every period's position of ``program`` on ``machine`` (see the module doc).
 
     ``feed`` (mm/min) replaces the program's feed; ``planned=False`` streams at the
@@ -233,8 +241,11 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
     ``max_periods`` periods is refused before any position is computed (InputError);
     ``progress(done, total, "periods")`` hears of the work at least every CHUNK periods. A planned
     stream whose finite differences break a limit is planned again with that limit
-    lowered by as much (REPLANS times at most), then refused (PlanError)."""
-    pieces = pieces_of(program, machine, feed)
+    lowered by as much (REPLANS times at most), then refused (PlanError). ``blend`` (mm)
+    rounds the corners of the links that pay for it within it, but not of the segments
+    in ``exact`` (:func:`.link_blends.stream_pieces`); a blend is positioned on its samples by
+    the Hermite."""
+    pieces = stream_pieces(program, machine, feed, blend, exact)
     derate = np.ones(3)
     for _ in range(REPLANS + 1):
         stream = _stream(program, machine, pieces, steppers, planned, derate, max_periods,
@@ -263,8 +274,8 @@ def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
     kernel = hermite = 0
     for j, piece in enumerate(pieces):
         sel = np.flatnonzero(rows == j)
-        if piece.cut is None:
-            positions[sel] = _line(piece, s[sel])
+        if piece.cut is None:   # a link's straight move, or a blend by its samples
+            positions[sel] = (_line if len(piece.points) == 2 else _hermite)(piece, s[sel])
             continue
         stepper = None if steppers is None else steppers(piece.cut, cuts[piece.cut],
                                                          machine.period)

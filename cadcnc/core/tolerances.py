@@ -24,6 +24,10 @@ CONFUSION = 1e-7
 VERTICAL = 1e-12
 """|1 - |d_z|| of a unit direction below this: the direction is vertical (round-off of a
 unit vector's z; the guard's walls and shank rule, waterline's horizontal planes)."""
+STREAM_BLEND = 10.0
+"""mm: the stream's default ``--blend`` (a link's corners rounded within it where that
+plans faster). Measured on the default machine (docs/controller.md): links rounded within
+1 or 5 mm never planned faster there; within 10 to 20 mm the tall ones do."""
 
 
 @dataclass(frozen=True)

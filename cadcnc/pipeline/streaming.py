@@ -19,10 +19,11 @@ import numpy as np
 from ..controller.feed_plan import plan_feed
 from ..controller.hal import HalError, hal_available, run_hal_loop
 from ..controller.hal import summary as hal_summary
-from ..controller.pieces import pieces_of
+from ..controller.link_blends import stream_pieces
 from ..controller.stream import stream_program, stream_text
 from ..core.errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL, InputError
-from ..core.tolerances import DEFAULT
+from ..core.tolerances import DEFAULT, STREAM_BLEND
+from ..core.units import check_number
 from ..core.work_limits import MAX_STREAM_PERIODS, Ticker, refuse_over, sigterm_as_interrupt
 from ..geometry.part import load_step
 from ..io.output_set import OutputSet
@@ -68,11 +69,14 @@ def stream_saved(program_file, part_file, machine, outputs, *, ini=None, toleran
 
 def stream_to(program, part, machine, outputs, *, feed=None, planned=True, tolerances=None,
               allow_gouge=False, hal=False, say=None, inputs=(),
-              max_periods=MAX_STREAM_PERIODS) -> StreamRun:
+              max_periods=MAX_STREAM_PERIODS, blend=STREAM_BLEND) -> StreamRun:
     """Stream ``program`` on ``part`` to ``machine`` and write it to ``outputs`` (a list
     of paths, .npy / .txt); optionally execute it in HAL (module doc). ``say``: progress
     on stderr (a heartbeat at least every 5 s), or None; SIGTERM counts as Ctrl-C.
+    ``blend`` (mm): the links' corners rounded within it where that is faster (0: exact
+    stops; a rounded link the gate refuses keeps its exact corners).
     Raises the library's errors (InputError, GeometryError, HalError ...)."""
+    blend = check_number("blend", blend, "mm", allow_zero=True)
     if hal:
         missing = hal_available()
         if missing:
@@ -81,26 +85,37 @@ def stream_to(program, part, machine, outputs, *, feed=None, planned=True, toler
     with sigterm_as_interrupt(), Ticker(say, "cadcnc: stream") as tick:
         return _stream(program, part, machine, list(outputs), tick, feed=feed,
                        planned=planned, tolerances=tolerances, allow_gouge=allow_gouge,
-                       hal=hal, say=say, inputs=inputs, max_periods=max_periods)
+                       hal=hal, say=say, inputs=inputs, max_periods=max_periods,
+                       blend=blend)
 
 
 def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, allow_gouge,
-            hal, say, inputs, max_periods) -> StreamRun:
+            hal, say, inputs, max_periods, blend) -> StreamRun:
     """:func:`stream_to` inside its heartbeat and SIGTERM handler."""
     outputs = OutputSet(outs, SUFFIXES, inputs=inputs) if outs else None
-    tick.stage = "planning the feed"
-    stream = _planned_stream(program, machine, stepper_factory(part), tick, feed=feed,
-                             planned=planned, max_periods=max_periods, say=say)
-    tick.stage = "checking the stream against the machine's limits"
-    contents = _contents(stream.positions, outputs)
-    problems = _limits_broken(program, machine, stream.positions, contents)
-    if problems:
-        return StreamRun(EXIT_GOUGE, [f"cadcnc: stream: {line}" for line in problems[:8]] + [
-            "cadcnc: stream: over the machine's limits: nothing written"
-            + (" or executed" if hal else "") + " (exit 5)"])
-    tick.stage = "gating the stream against the part"
-    gate = gate_program(program, part, tolerances or DEFAULT,
-                        moves=stream.segment_moves(program))
+    exact: frozenset[int] = frozenset()
+    while True:   # a rounded link the gate refuses: streamed again with exact corners
+        tick.stage = "planning the feed"
+        stream = _planned_stream(program, machine, stepper_factory(part), tick, feed=feed,
+                                 planned=planned, max_periods=max_periods, say=say,
+                                 blend=blend if planned else 0.0, exact=exact)
+        tick.stage = "checking the stream against the machine's limits"
+        contents = _contents(stream.positions, outputs)
+        problems = _limits_broken(program, machine, stream.positions, contents)
+        if problems:
+            return StreamRun(EXIT_GOUGE, [f"cadcnc: stream: {line}" for line in problems[:8]]
+                             + ["cadcnc: stream: over the machine's limits: nothing written"
+                                + (" or executed" if hal else "") + " (exit 5)"])
+        tick.stage = "gating the stream against the part"
+        gate = gate_program(program, part, tolerances or DEFAULT,
+                            moves=stream.segment_moves(program))
+        refused = _refused_links(program, gate) & stream.rounded - exact
+        if gate.ok or not refused:
+            break
+        exact |= refused
+        if say is not None:
+            say(f"cadcnc: stream: the gate refused {len(refused)} rounded link(s): "
+                "streamed again with their exact corners")
     if not gate.ok and not allow_gouge:
         return StreamRun(EXIT_GOUGE, [f"cadcnc: stream: {gate.message}; nothing written "
                                       "(--allow-gouge writes it)"])
@@ -123,10 +138,29 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
     return done
 
 
-def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_periods, say):
+def _refused_links(program, gate) -> frozenset[int]:
+    """Segment indices of the links the gate found failing: those before each cut whose
+    link moves fail, and the final retract when the last cut's do (as the gate assigns
+    them: :func:`cadcnc.verification.program_gate.cut_moves`)."""
+    out, before, cut = set(), [], 0
+    for k, seg in enumerate(program.segments):
+        if seg.kind == "link":
+            before.append(k)
+            continue
+        if cut < len(gate.link_failed) and gate.link_failed[cut]:
+            out.update(before)
+        before, cut = [], cut + 1
+    if before and gate.link_failed and gate.link_failed[-1]:
+        out.update(before)
+    return frozenset(out)
+
+
+def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_periods, say,
+                    blend=0.0, exact=frozenset()):
     """The stream, its periods estimated and bounded before the positions are computed,
     progress reported (the plan is made once here to count the periods first)."""
-    total = plan_feed(pieces_of(program, machine, feed), machine, planned).periods
+    pieces = stream_pieces(program, machine, feed, blend, exact)
+    total = plan_feed(pieces, machine, planned).periods
     refuse_over("the stream", total, max_periods, "servo periods",
                 "raise the feed or the machine's limits, or give --max-periods N "
                 "(each 24 bytes in memory)")
@@ -139,7 +173,8 @@ def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_peri
         tick.stage = f"streaming: {done}/{total} {what}"
 
     return stream_program(program, machine, steppers, feed=feed, planned=planned,
-                          max_periods=max_periods, progress=progress)
+                          max_periods=max_periods, progress=progress, blend=blend,
+                          exact=exact)
 
 
 def _contents(positions, outputs) -> dict:

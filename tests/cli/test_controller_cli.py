@@ -125,3 +125,28 @@ def test_an_operation_streams_its_verified_program(tmp_path):
     rows, program = np.load(npy), read_program(prog)
     np.testing.assert_allclose(rows[0], program.segments[0].points[0], atol=1e-9)
     np.testing.assert_allclose(rows[-1], program.segments[-1].points[-1], atol=1e-9)
+
+
+@pytest.mark.parametrize("bad", ["-1", "nan", "inf", "1mm"])
+def test_a_bad_blend_is_exit_2_without_traceback(program, tmp_path, bad):
+    out = tmp_path / "s.npy"
+    run = cadcnc_cli("stream", program, "-o", out, f"--blend={bad}")
+    assert run.returncode == 2 and "--blend" in run.stderr, run.stderr
+    assert "Traceback" not in run.stderr and not out.exists()
+
+
+def test_blend_zero_streams_the_exact_corners(program, tmp_path):
+    """``--blend 0``: the stream of the program's own moves, as the library streams it
+    without blending."""
+    import cadcnc
+    from cadcnc.controller import Machine, stream_program
+    from cadcnc.io.program_json import read_program
+    from cadcnc.ops.stream_steppers import stepper_factory
+
+    out = tmp_path / "s.npy"
+    run = cadcnc_cli("stream", program, "-o", out, "--feed", "10000", "--blend", "0", "-q")
+    assert run.returncode == 0, run.stderr
+    prog = read_program(program)
+    part = cadcnc.load_step(prog.job.source)
+    exact = stream_program(prog, Machine.default(), stepper_factory(part), feed=10_000.0)
+    assert np.load(out).tobytes() == exact.positions.tobytes()
