@@ -22,7 +22,7 @@ import numpy as np
 from numba import njit, prange
 
 from .sweep_bounds import misses, misses_box
-from .tool_sweep import swept_ray
+from .tool_sweep import RAD, band_row, capsule_of, swept_ray
 
 # rays a tile's side, per grid (X, Y, Z): across a +Z program's tool a larger tile meets
 # fewer tile-move pairs (the benchmark's Y grid: 0.87 of the CPU at 64 against 32); along it
@@ -182,6 +182,8 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, table, bound
             ne0, ne1 = np.inf, -np.inf
             for a in range(max(u0, rng[m, 0]), min(u1, rng[m, 1]) + 1):
                 o[u] = lo[u] + (a + 0.5) * res
+                o[v], o[k] = lo[v], lo[k]
+                row, s = band_row(o[0], o[1], o[2], k, v, c)
                 for b in range(max(v0, rng[m, 2]), min(v1, rng[m, 3]) + 1):
                     r = a * nv + b
                     n = cnt[r]
@@ -194,8 +196,11 @@ def cut_tiles(k, lo, res, nu, nv, tiles, start, moves, rng, p0, p1, table, bound
                     o[v] = lo[v] + (b + 0.5) * res
                     if misses(bm, o[u], o[v], e0, e1):
                         continue
-                    o[k] = lo[k]
-                    ta, tb = swept_ray(o[0], o[1], o[2], k, c, e0, e1)
+                    if row:     # the same as swept_ray, its band segment once a row
+                        ta, tb = capsule_of(o[0], o[1], o[2], k, s[0], s[1], s[2], s[3], s[4],
+                                            s[5], s[6], s[7], s[8], s[9], s[10], c[RAD])
+                    else:
+                        ta, tb = swept_ray(o[0], o[1], o[2], k, c, e0, e1)
                     if ta >= tb or tb <= e0 or ta >= e1:
                         continue       # (no material met: subtract would change nothing)
                     n2, overlap, first = subtract(iv, r, n, ta, tb, kmax)

@@ -23,7 +23,7 @@ from .tool_sweep import CONSTANTS, move_table
 K0 = 4                    # intervals a ray holds at first (grown on demand)
 BYTES_PER_RAY = 80        # K0 intervals (float32 pairs), counts, extents, initial stock, part crossings
 BYTES_PER_MOVE = 8 * (CONSTANTS + BOUNDS)   # a move's constants and bounds (float64 rows)
-NS_PER_EVALUATION = 20.0  # ns of one core per ray a move's box covers (benchmarks/simulation: 19)
+NS_PER_EVALUATION = 20.0  # ns of one core per ray a move's box covers (benchmarks/simulation: 17)
 MAX_MEMORY = 6e9          # bytes one simulation may hold
 MAX_SECONDS = 1800.0      # estimated seconds of cutting one simulation may take
 

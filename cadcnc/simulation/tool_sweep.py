@@ -125,6 +125,7 @@ BOTTOM, TOP, SIDE0, SIDE1, ONE = 24, 24 + SEG, 24 + 2 * SEG, 24 + 3 * SEG, 24 + 
 G, H, GE, HVE, SN, GK, HK, NK = 79, 82, 85, 86, 87, 88, 91, 94
 CONSTANTS = 97
 GENERAL, CAPSULE = 0.0, 1.0    # KIND: the general sweep, or the capsule ONE alone
+NO_SEGMENT = (0.0,) * SEG      # band_row's segment when it has none
 
 
 @njit(cache=True, error_model="numpy")
@@ -209,6 +210,35 @@ def swept_tool(o0, o1, o2, k, p00, p01, p02, p10, p11, p12, ax0, ax1, ax2, r, le
 
 
 @njit(cache=True, error_model="numpy")
+def _in_band(h, hv, length):
+    """Whether height h (mm above p0 along the axis) lies in the shank's band: above both
+    centres (0 and hv) and below the lower one's shank top."""
+    return h > min(0.0, hv) and max(0.0, hv) <= h <= min(0.0, hv) + length
+
+
+@njit(cache=True, error_model="numpy")
+def band_row(o0, o1, o2, k, v, c):
+    """For the row of rays o + t e_k through o (3 coordinates) whose coordinate ``v`` alone
+    varies: (True, the band segment's 11 floats: ends a, b, then :func:`segment`'s) when
+    :func:`swept_ray` meets every one of them as the capsule of that one segment with the
+    same bits (a general move, its axis across k and v, the row at a height h != 0 in the
+    shank's band: h sums the terms of k and v, both +-0, and the row's own), else (False,
+    zeros). Rows of the Y grid under a +Z axis: the segment once a row, not once a ray."""
+    ak, av = c[AX + k], c[AX + v]
+    if c[KIND] == CAPSULE or ak != 0.0 or av != 0.0:
+        return False, NO_SEGMENT
+    p00, p01, p02, p10, p11, p12 = c[P0], c[P0 + 1], c[P0 + 2], c[P1], c[P1 + 1], c[P1 + 2]
+    ax0, ax1, ax2 = c[AX], c[AX + 1], c[AX + 2]
+    hv = c[HV]
+    h = (o0 - p00) * ax0 + (o1 - p01) * ax1 + (o2 - p02) * ax2
+    if h == 0.0 or not _in_band(h, hv, c[LEN]):
+        return False, NO_SEGMENT
+    a0, a1, a2 = p00 + h * ax0, p01 + h * ax1, p02 + h * ax2
+    b0, b1, b2 = p10 + (h - hv) * ax0, p11 + (h - hv) * ax1, p12 + (h - hv) * ax2
+    return True, (a0, a1, a2, b0, b1, b2) + segment(a0, a1, a2, b0, b1, b2)
+
+
+@njit(cache=True, error_model="numpy")
 def swept_ray(o0, o1, o2, k, c, tmin, tmax):
     """:func:`swept_tool` of the move whose :func:`move_constants` are ``c``."""
     r, length = c[RAD], c[LEN]
@@ -223,7 +253,7 @@ def swept_ray(o0, o1, o2, k, c, tmin, tmax):
         # vertical segment of the parallelogram spans its height h): the 2-D stadium of the
         # moved segment at h alone, which holds the bottom edge's balls' slice (not computed)
         h = (o0 - p00) * ax0 + (o1 - p01) * ax1 + (o2 - p02) * ax2
-        if h > min(0.0, hv) and max(0.0, hv) <= h <= min(0.0, hv) + length:
+        if _in_band(h, hv, length):
             return capsule(o0, o1, o2, k, p00 + h * ax0, p01 + h * ax1,
                            p02 + h * ax2, p10 + (h - hv) * ax0,
                            p11 + (h - hv) * ax1, p12 + (h - hv) * ax2, r)
