@@ -21,6 +21,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from .machine import Machine
 from .pieces import Piece
@@ -165,18 +166,23 @@ def _piece_grid(piece: Piece, machine: Machine):
     return piece.s[keep], T[keep], K[keep], D[keep], jump[keep], cap[keep]
 
 
+@njit(cache=True)
 def _knots(s: np.ndarray) -> np.ndarray:
     """Indices of the points kept as knots: none closer than MIN_KNOT to the one before
     (a cut's last step may be a few nm: from rest to rest over it takes no finite time
-    on the grid), the first and the last always."""
-    keep = [0]
-    for i in range(1, len(s) - 1):
-        if s[i] - s[keep[-1]] >= MIN_KNOT:
-            keep.append(i)
-    if len(keep) > 1 and s[-1] - s[keep[-1]] < MIN_KNOT:
-        keep.pop()
-    keep.append(len(s) - 1)
-    return np.asarray(keep)
+    on the grid), the first and the last always (compiled: a cut has thousands)."""
+    n = len(s)
+    keep = np.empty(max(n, 2), dtype=np.int64)
+    keep[0] = 0
+    m = 1
+    for i in range(1, n - 1):
+        if s[i] - s[keep[m - 1]] >= MIN_KNOT:
+            keep[m] = i
+            m += 1
+    if m > 1 and s[n - 1] - s[keep[m - 1]] < MIN_KNOT:
+        m -= 1
+    keep[m] = n - 1
+    return keep[:m + 1].copy()
 
 
 def _run(first: int, pieces: list[Piece], machine: Machine, joins: list) -> Run:

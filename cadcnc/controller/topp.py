@@ -10,7 +10,8 @@ path's derivatives anywhere the smoothed motion can be when it is there):
     w <= wl                          (every speed limit: feed, velocity, jerk terms)
 
 A backward pass finds the largest speed from which the rest of the run can still stop in
-time (the feasible speeds at a point form an interval from 0: a bisection finds its top);
+time (the feasible speeds at a point form an interval from 0: :func:`.knot.largest`
+finds its top in closed form);
 a forward pass then accelerates as hard as the constraints and that speed allow. The
 result is the time-optimal profile on the grid (the reachability analysis of TOPP-RA,
 Pham & Pham 2018, with the constraints above). Lengths mm, speeds mm/s, times s.
@@ -23,56 +24,7 @@ import math
 import numpy as np
 from numba import njit
 
-BISECTIONS = 40   # the top of a point's feasible speeds to 2^-40 of its bracket
-
-
-@njit(cache=True, error_model="numpy")
-def _coefficients(k: int, h: float, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs) -> float:
-    """Knot k's acceleration constraints cu u + cw w <= rhs (24, into the buffers) for
-    the speed w at its start, and its Coriolis bound: |u| <= returned / sqrt(w)."""
-    n = 0
-    for e in range(2):
-        j = k + e
-        reach = 2.0 * h if e == 1 else 0.0
-        for i in range(3):
-            for s1 in (-1.0, 1.0):
-                kw = s1 * Kc[j, i] + Kr[j, i]
-                for s2 in (-1.0, 1.0):
-                    cu[n] = s1 * Tc[j, i] + s2 * Tr[j, i] + kw * reach
-                    cw[n] = kw
-                    rhs[n] = A[i]
-                    n += 1
-    c = math.inf
-    for i in range(3):
-        km = max(Kmax[k, i], Kmax[k + 1, i])
-        if km > 0.0:
-            c = min(c, C[i] / (3.0 * km))
-    return c
-
-
-@njit(cache=True, error_model="numpy")
-def _bounds(w: float, h: float, cu, cw, rhs, coriolis: float) -> tuple:
-    """(lo, hi): the tangential accelerations feasible from speed w on a knot of length
-    h > 0 with the constraints of :func:`_coefficients` (lo > hi: none)."""
-    lo, hi = -w / (2.0 * h), math.inf
-    for j in range(len(cu)):
-        r = rhs[j] - cw[j] * w
-        if cu[j] > 0.0:
-            hi = min(hi, r / cu[j])
-        elif cu[j] < 0.0:
-            lo = max(lo, r / cu[j])
-        elif r < 0.0:
-            return 1.0, -1.0
-    if w > 0.0 and coriolis < math.inf:
-        c = coriolis / math.sqrt(w)
-        lo, hi = max(lo, -c), min(hi, c)
-    return lo, hi
-
-
-@njit(cache=True, error_model="numpy")
-def _feasible(w, h, w_next, cu, cw, rhs, coriolis) -> bool:
-    lo, hi = _bounds(w, h, cu, cw, rhs, coriolis)
-    return lo <= hi and w + 2.0 * h * lo <= w_next + 1e-12 * w   # (w - w: round-off)
+from .knot import ROWS, bounds, coefficients, feasible, largest
 
 
 @njit(cache=True, error_model="numpy")
@@ -80,7 +32,8 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
     """(w (n,), u (n - 1,)): the time-optimal squared speeds from rest at s[0] to rest at
     s[-1] and the accelerations between (knots of length 0, a join, keep the speed)."""
     n = len(s)
-    cu, cw, rhs = np.empty(24), np.empty(24), np.empty(24)
+    cu, cw, rhs = np.empty(ROWS), np.empty(ROWS), np.empty(ROWS)
+    buf = np.empty((4, ROWS + 1))   # largest's: the affine bounds on u
     wb = np.empty(n)
     wb[n - 1] = 0.0
     for k in range(n - 2, -1, -1):
@@ -89,18 +42,11 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
         if h <= 0.0:
             wb[k] = min(top, wb[k + 1])
             continue
-        cor = _coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
-        if _feasible(top, h, wb[k + 1], cu, cw, rhs, cor):
+        cor = coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
+        if feasible(top, h, wb[k + 1], cu, cw, rhs, cor):
             wb[k] = top
-            continue
-        a, b = 0.0, min(top, wb[k + 1] + 2.0 * h * np.max(np.abs(A)) * 1e3)
-        for _ in range(BISECTIONS):
-            m = 0.5 * (a + b)
-            if _feasible(m, h, wb[k + 1], cu, cw, rhs, cor):
-                a = m
-            else:
-                b = m
-        wb[k] = a
+        else:
+            wb[k] = largest(top, h, wb[k + 1], cu, cw, rhs, cor, buf)
     w = np.empty(n)
     u = np.zeros(n - 1)
     w[0] = 0.0
@@ -109,8 +55,8 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
         if h <= 0.0:
             w[k + 1] = min(w[k], wb[k + 1])
             continue
-        cor = _coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
-        lo, hi = _bounds(w[k], h, cu, cw, rhs, cor)
+        cor = coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
+        lo, hi = bounds(w[k], h, cu, cw, rhs, cor)
         x = min(hi, (wb[k + 1] - w[k]) / (2.0 * h))
         x = max(x, lo)
         u[k] = x

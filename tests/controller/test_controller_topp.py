@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from cadcnc.controller import topp
+from cadcnc.controller import knot, runs, topp
 
 
 def _line(L: float, n: int, v: float, a: float):
@@ -85,3 +85,58 @@ def test_a_straight_move_is_within_2_percent_of_ruckig(L):
     piece = Piece(np.array([[0.0, 0.0, 0.0], [L, 0.0, 0.0]]), np.array([0.0, L]), math.inf, 0)
     planned = plan_run(runs_of([piece], m)[0], m).duration
     assert traj.duration * (1 - 1e-6) <= planned <= 1.02 * traj.duration
+
+
+def _bisected(top, h, w_next, cu, cw, rhs, cor) -> float:
+    """The top of the feasible speeds from 0 by bisection of the predicate alone."""
+    a, b = 0.0, top
+    for _ in range(200):
+        m = 0.5 * (a + b)
+        if knot.feasible(m, h, w_next, cu, cw, rhs, cor):
+            a = m
+        else:
+            b = m
+    return a
+
+
+def test_the_closed_form_largest_speed_is_the_bisected_one():
+    """Random curved knots (curvature, its box, the Coriolis term binding or not): the
+    closed form is feasible and equals the bisection of the feasibility test."""
+    rng = np.random.default_rng(7)
+    cu, cw, rhs = (np.empty(knot.ROWS) for _ in range(3))
+    buf = np.empty((4, knot.ROWS + 1))
+    A, checked = np.array([1000.0, 800.0, 500.0]), 0
+    for _ in range(400):
+        T = rng.normal(size=(2, 3))
+        T /= np.linalg.norm(T, axis=1)[:, None]
+        Kc = rng.normal(scale=0.3, size=(2, 3))
+        Kr, Tr = np.abs(rng.normal(scale=0.02, size=(2, 3))), np.full((2, 3), 0.01)
+        Kmax = np.abs(Kc) + Kr
+        C = np.full(3, rng.choice([math.inf, 5_000.0, 500.0]))
+        h, w_next = rng.uniform(0.01, 1.0), rng.uniform(0.0, 2e4)
+        cor = knot.coefficients(0, h, T, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
+        top = 1e6
+        if knot.feasible(top, h, w_next, cu, cw, rhs, cor):
+            continue
+        got = knot.largest(top, h, w_next, cu, cw, rhs, cor, buf)
+        ref = _bisected(top, h, w_next, cu, cw, rhs, cor)
+        assert knot.feasible(got, h, w_next, cu, cw, rhs, cor)
+        assert got == pytest.approx(ref, rel=1e-9, abs=1e-9)
+        checked += 1
+    assert checked > 200
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 50, 2000])
+def test_knots_keep_the_ends_and_no_step_below_min_knot(n):
+    """The ends kept; kept knots at least MIN_KNOT apart (the last excepted); a point
+    dropped only within MIN_KNOT of the knot before it, or (one) of the end."""
+    rng = np.random.default_rng(n)
+    s = np.cumsum(np.r_[0.0, rng.exponential(runs.MIN_KNOT, n - 1)])
+    keep = runs._knots(s)
+    assert keep[0] == 0 and keep[-1] == n - 1
+    assert n == 1 or (np.diff(keep) > 0).all()
+    assert (np.diff(s[keep[:-1]]) >= runs.MIN_KNOT).all()
+    dropped = np.setdiff1d(np.arange(n), keep)
+    far = dropped[s[dropped] - s[keep[np.searchsorted(keep, dropped) - 1]] >= runs.MIN_KNOT]
+    assert len(far) <= 1 and (s[-1] - s[far] < runs.MIN_KNOT).all()
+    assert n < 50 or len(dropped) > 0   # the sample has points to drop
