@@ -52,7 +52,7 @@ from benchmarks.controller.linuxcnc_baseline import violations
 from benchmarks.controller.stream_cost import programs
 from cadcnc.controller import Machine, stream_program
 from cadcnc.controller.hal import HalError, run_hal_loop
-from cadcnc.controller.hal.linuxcnc_sim import run_ngc
+from cadcnc.controller.hal.linuxcnc_sim import SAMPLE_DEPTH, run_ngc
 from cadcnc.io.gcode import simplify
 from cadcnc.io.program_gcode import program_ngc
 from cadcnc.ops.stream_steppers import stepper_factory
@@ -216,29 +216,38 @@ def run_all(out: Path, machines: list[str], only: list[str] | None = None,
             base = {"program": name, "machine": mname, "feed": FEED, "bound_s": bound,
                     "last_full_s": full, "last_half_a_s": trapezoid(L, v, a / 2)}
             h = run_hal_loop(s.positions, m, limits="machine")
-            cases = [("stream", h.executed, {"clipped": h.clipped, "underruns": h.underruns,
-                                             "planned_s": s.cycle_time,
-                                             "own_max_mm": float(own.max()),
-                                             "own_p99_mm": float(np.percentile(own, 99))})]
-            texts = [(f"LinuxCNC P{p:g}", ngc_text(program, FEED, p)) for p in PS]
-            texts.append(("LinuxCNC equal", dense_ngc(program, part, ref, m, FEED)))
-            for method, text in texts:
-                ngc = out / f"{tag}_{mname}_{method.split()[1]}.ngc"
-                ngc.write_text(text)
-                try:
-                    r = run_ngc(ngc, m, timeout=600 + text.count("\n") / 200)  # ~1 line/ms
-                except HalError as e:   # recorded, not hidden: the row says why
-                    print(f"  {method} failed: {e}", flush=True)
-                    rows.append({**base, "method": method, "error": str(e).splitlines()[0]})
-                    continue
-                cases.append((method, r.positions, {"error": r.error,
-                                                    "lines": text.count("\n")}))
-            for method, pos, extra in cases:
+
+            def keep(method: str, pos: np.ndarray, extra: dict) -> None:
+                """Measure one run and save it at once (a later run may fail or hang)."""
                 np.save(out / f"{tag}_{mname}_{method.replace(' ', '_')}.npy", pos)
                 row = {**base, "method": method, **measure(pos, first, ref, m, last), **extra}
                 rows.append(row)
                 print(line(row), flush=True)
-            (out / "results.json").write_text(json.dumps(rows, indent=1))
+                (out / "results.json").write_text(json.dumps(rows, indent=1))
+
+            keep("stream", h.executed, {"clipped": h.clipped, "underruns": h.underruns,
+                                        "planned_s": s.cycle_time,
+                                        "own_max_mm": float(own.max()),
+                                        "own_p99_mm": float(np.percentile(own, 99))})
+            texts = [(f"LinuxCNC P{p:g}", lambda p=p: ngc_text(program, FEED, p)) for p in PS]
+            texts.append(("LinuxCNC equal", lambda: dense_ngc(program, part, ref, m, FEED)))
+            for method, make in texts:
+                text = make()
+                n = text.count("\n")
+                ngc = out / f"{tag}_{mname}_{method.split()[1]}.ngc"
+                ngc.write_text(text)
+                try:
+                    if n > SAMPLE_DEPTH:   # about a line a period: more than the sampler holds
+                        raise HalError(f"{n} lines: LinuxCNC runs about one a period, past "
+                                       f"the sampler's {SAMPLE_DEPTH} periods; not run")
+                    r = run_ngc(ngc, m, timeout=600 + n / 200)
+                except HalError as e:   # recorded, not hidden: the row says why
+                    print(f"  {method} failed: {e}", flush=True)
+                    rows.append({**base, "method": method, "error": str(e).splitlines()[0],
+                                 "lines": n})
+                    (out / "results.json").write_text(json.dumps(rows, indent=1))
+                    continue
+                keep(method, r.positions, {"error": r.error, "lines": n})
     return rows
 
 
