@@ -6,6 +6,7 @@ import os
 import sys
 
 from cadcnc.core.errors import EXIT_INTERRUPTED
+from cadcnc.core.interrupts import ctrl_c_interrupts
 
 from .commands import load
 
@@ -19,6 +20,7 @@ def main(argv: list[str] | None = None) -> int:
     freeing OCCT and numba objects: a Ctrl-C in that window killed the finished process by
     the signal (exit -2) instead of leaving its exit code.
     """
+    ctrl_c_interrupts()   # not lost inside numba's compiler callbacks
     try:
         code = load("cadcnc.cli.app:main")(argv)   # Ctrl-C while it loads is caught
     except KeyboardInterrupt:  # during start-up or argument parsing

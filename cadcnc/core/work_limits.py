@@ -19,6 +19,7 @@ import time
 from typing import Callable
 
 from .errors import InputError
+from .interrupts import interrupt
 
 MAX_CYCLES = 5_000_000
 """Interpolation cycles one command may run in all (``--max-cycles``): about 500 m of path
@@ -99,10 +100,6 @@ class Ticker:
             self._thread.join()
 
 
-def _interrupt(signum, frame):
-    raise KeyboardInterrupt
-
-
 @contextlib.contextmanager
 def sigterm_as_interrupt():
     """While the block runs, SIGTERM raises KeyboardInterrupt in the main thread (the
@@ -110,7 +107,7 @@ def sigterm_as_interrupt():
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGTERM, _interrupt)
+    previous = signal.signal(signal.SIGTERM, interrupt)
     try:
         yield
     finally:
