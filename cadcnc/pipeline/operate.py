@@ -103,7 +103,6 @@ def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progr
             raise
         raise NothingToCutError(f"{what}: {e}") from None
     t_cut = time.monotonic() - t0
-    open_shared(part)  # the cut-back step and the program gate share their work
     program, verdict = settled_and_judged(program, part, job, step, what, settings,
                                           gate_progress=gate_progress)
     return Outcome(part, program, verdict, t_cut, time.monotonic() - t0 - t_cut, what)
@@ -114,7 +113,9 @@ def settled_and_judged(program: Program, part: Part, job: Job, step, what: str,
     """``program`` with its gouging cuts cut back (pencil, finish: :func:`settle`) and its
     :class:`Verdict` (:func:`judge`), as ``settings`` ask; ``job`` gives the links' safe
     height; ``step`` and ``what`` name the run in messages. NothingToCutError when no cut
-    is left."""
+    is left. The cut-back step and the program gate share their work on ``part``
+    (:func:`~cadcnc.verification.gate_cache.open_shared`: kept on it from now on)."""
+    open_shared(part)
     join = cut_back_gap(job)
     if join is not None:
         program = settle(program, part, safe_height(part, job), join, f"{step}: {what}",

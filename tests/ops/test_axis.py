@@ -164,3 +164,42 @@ def test_turned_part_keeps_face_numbers(part):
             assert abs(distance(f0.topods, q) - distance(f1.topods, s.to_setup(q))) < 1e-7
     lo, hi = turned.bounding_box()
     assert abs(hi[2]) < 1e-6   # work zero on the top seen along the axis
+
+
+def test_setup_top_measured_once_per_axis(monkeypatch):
+    """A setup's work zero (the top of the turned part) is measured once per axis: every
+    gate of a setup's cut asks for the setup again (``resolve_part``) and gets the same
+    turned part and setup without another optimal box; another axis is measured anew."""
+    import cadcnc
+    from cadcnc.geometry import setup as setup_module
+    from cadcnc.verification.surface_checks import resolve_part
+
+    fresh = cadcnc.load_step(STEP)   # nothing measured on it yet
+    boxes = []
+    real = setup_module.optimal_box
+
+    def counted(*args, **kwargs):
+        boxes.append(args)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(setup_module, "optimal_box", counted)
+    job = cadcnc.Job(cadcnc.Tool(R), 1500, 0.004, cadcnc.Pencil(), axis=(1, 0, 0))
+    turned = setup_module.setup_part(fresh, job)
+    first = setup_module.setup_in(turned)
+    assert len(boxes) == 1
+
+    class Toolpath:   # what resolve_part reads of a cut's path
+        pass
+
+    path = Toolpath()
+    path.job = job
+    for _ in range(3):
+        assert resolve_part(path, turned) is turned
+    again = setup_module.setup_of(fresh, job.axis)
+    assert np.array_equal(again.origin, first.origin)
+    assert np.array_equal(again.rotation, first.rotation)
+    assert len(boxes) == 1
+    again.origin[0] += 1.0   # a caller's change to its setup leaves the kept top alone
+    assert np.array_equal(setup_module.setup_of(fresh, job.axis).origin, first.origin)
+    other = setup_module.setup_of(fresh, (0, -1, 0))
+    assert len(boxes) == 2 and not np.allclose(other.origin, first.origin)

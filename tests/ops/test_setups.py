@@ -197,3 +197,31 @@ def test_programs_only_for_the_chosen_setups(shared_corner, monkeypatch):
     for name in ("-Z", "+Y"):   # nor in a program: the material, an end wall
         assert not cadcnc.run(part, replace(job, axis=PRINCIPAL_AXES[name])).cuts
     assert "from samples; programs computed: +Z +X" in result.summary_lines()[1]
+
+
+def test_chosen_setups_gates_share_their_work(shared_corner, monkeypatch):
+    """Each chosen setup's cut-back step and program gate share one gate cache on its
+    turned part (as a single-setup command's do): made once per part and tolerances,
+    not once per cut and gate; the verdicts pass."""
+    from collections import Counter
+
+    from cadcnc.pipeline.operate import Settings
+    from cadcnc.pipeline.setup_programs import run_setups
+    from cadcnc.verification import gate_cache
+
+    _, floor, wall, step = shared_corner
+    job = Job(Tool(R), 1500.0, 0.004, Pencil([floor, wall]), source=str(step))
+    made = []
+    real = gate_cache.GateCache.__init__
+
+    def counting(self, part, tol):
+        made.append((id(part), tol))
+        real(self, part, tol)
+
+    monkeypatch.setattr(gate_cache.GateCache, "__init__", counting)
+    run = run_setups(step, job, "auto", 0.0, [], Settings())
+    assert [p.setup.name for p in run.programs] == ["+Z", "+X"]
+    assert all(p.verdict.gate.ok for p in run.programs)
+    parts = {id(r.part) for r in run.result.runs}
+    assert len(parts) == 2 and {p for p, _ in made} == parts
+    assert set(Counter(made).values()) == {1}
