@@ -109,8 +109,8 @@ def measure(pos, first, ref: PathReference, m: Machine, last) -> dict:
     a, b = last
     ab = b - a
     t = np.clip(((run - a) @ ab) / (ab @ ab), 0, 1)
-    off = np.linalg.norm(run - (a + t[:, None] * ab), axis=1) > 1e-3
-    on_last = len(run) - 1 - int(np.flatnonzero(off)[-1])
+    off = np.flatnonzero(np.linalg.norm(run - (a + t[:, None] * ab), axis=1) > 1e-3)
+    on_last = len(run) - 1 - (int(off[-1]) if len(off) else 0)   # all on it: a one-line run
     out = {"cycle_time_s": (end - start) * m.period, "last_s": on_last * m.period,
            "contour_max_mm": float(err.max()),
            "contour_p99_mm": float(np.percentile(err, 99))}
