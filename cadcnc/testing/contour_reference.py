@@ -157,11 +157,13 @@ class Offsets:
         # past an end (its foot on the polyline would lie beyond it): that end's distance;
         # a closed corner path (a loop: first point = last) has no end to pass
         closed = np.linalg.norm(self.pts[0] - self.pts[-1]) <= 1e-6   # mm: Tolerances.closed
-        ends = () if closed else ((self.pts[0], self.pts[1]), (self.pts[-1], self.pts[-2]))
-        for end, nxt in ends:
-            past = (p - end) @ (end - nxt) > 0
+        last = len(self.pts) - 1
+        ends = () if closed else ((0, 1), (last, last - 1))
+        for at, nxt in ends:   # its foot beyond this end: the nearest point is this end
+            end = self.pts[at]
+            past = (p - end) @ (end - self.pts[nxt]) > 0
             _, k = self._tree.query(p[past])
-            sel = np.flatnonzero(past)[(k == 0) | (k == len(self.pts) - 1)]
+            sel = np.flatnonzero(past)[k == at]
             out[sel] = np.maximum(out[sel], np.linalg.norm(p[sel] - end, axis=1))
         return out
 

@@ -137,3 +137,21 @@ def test_a_finishing_pass_on_a_free_form_face_is_measured_on_its_offset_and_plan
         assert np.allclose(ref.distance(pts + UM * ref.n), UM, rtol=0, atol=1e-9)
         q = ref.on_path(pts[len(pts) // 2] + np.array([2e-3, -1e-3, 3e-3]))
         assert ref.distance(q)[0] < 1e-12
+
+
+def test_an_open_loop_s_start_is_not_measured_past_its_other_end():
+    """A waterline loop that stops short of closing (300° here): its first point lies
+    ahead of its last along the last tangent, yet is on the path (it was measured at
+    the gap between the ends, 40 mm on the slab's waterline); a point past an end still
+    counts its distance to that end."""
+    import cadquery as cq
+
+    top = cq.Workplane().box(100, 100, 10).faces(">Z").val().wrapped   # z = 5
+    R = 3.0
+    t = np.radians(np.linspace(0.0, 300.0, 301))
+    pts = np.c_[10 * np.cos(t), 10 * np.sin(t), np.full_like(t, 5.0 + R)]
+    ref = Offsets([top], (R,), pts)
+    assert ref.distance(pts[[0, 150, -1]]).max() < 1e-9
+    tangent = (pts[-1] - pts[-2]) / np.linalg.norm(pts[-1] - pts[-2])
+    beyond = pts[-1] + 0.5 * tangent
+    assert abs(ref.distance(beyond)[0] - 0.5) < 1e-9
