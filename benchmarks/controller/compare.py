@@ -12,11 +12,14 @@ PCNC 770) and a high-speed mill (``high_speed_mill``). Per machine and program:
   there as the stream does) at ``G64 P`` for P in PS, run by LinuxCNC 2.9 headless
   (``run_ngc``: trapezoidal planner, same v and a, no jerk limit), sampled per period;
 - ``LinuxCNC equal``: G-code dense enough for the stream's accuracy: lines by their ends,
-  arcs and corner paths as polylines within EQUAL_TOL of the exact path (arcs from their
-  fitted circle; corner paths from the kernel re-run at 2.5 µm steps, Douglas-Peucker,
-  points off the offset surfaces moved onto them; passes on free-form faces the same
-  kernel points as they are, so their own error stays in), 7 decimals, at ``G64 P``
-  EQUAL_TOL; LinuxCNC's timeout grows with the lines (it runs about one a period).
+  arcs and corner paths as polylines within half the equal tolerance of the exact path
+  (arcs from their fitted circle; corner paths from the kernel re-run at 2.5 µm steps,
+  Douglas-Peucker, points off the offset surfaces moved onto them; passes on free-form
+  faces the kernel's points at 2.5 µm steps, so their own error stays in), 7 decimals,
+  at ``G64 P`` half of it. The equal tolerance is the stream's own measured true contour
+  error (its planned rows against their pieces), at least EQUAL_TOL: LinuxCNC gets the
+  stream's error, not less. LinuxCNC's timeout grows with the lines (it runs about one
+  a period).
 
 Measured on the sampled positions, all the same way:
 
@@ -63,7 +66,8 @@ QUANTUM = 1e-9          # mm: the samples' resolution
 FEED = 10_000.0         # mm/min
 PS = (0.0001, 0.01)     # mm: LinuxCNC on the program's own G-code
 NGC_TOLERANCE = 1e-5    # mm: cadcnc's writer with --tolerance 0.00001 (6 decimals)
-EQUAL_TOL = 1e-6        # mm: the dense G-code's polyline and its P
+EQUAL_TOL = 1e-6        # mm: the least equal tolerance (the dense G-code: its polyline
+                        # within half, and P half)
 DENSE_PERIOD, DENSE_FEED = 5e-5, 3000.0   # s, mm/min: the kernel's 2.5 µm steps
 
 
@@ -128,10 +132,10 @@ def ngc_text(program, feed: float, p: float) -> str:
     return re.sub(r"^(G0 X[^\n]*)$", r"\1\nG4 P0.001", text, count=1, flags=re.MULTILINE)
 
 
-def dense_cut(piece, ref, program, part, machine: Machine) -> np.ndarray:
-    """(n, 3) a cut's points within EQUAL_TOL of its exact path (see the module doc)."""
+def dense_cut(piece, ref, program, part, machine: Machine, tol: float) -> np.ndarray:
+    """(n, 3) a cut's points within ``tol`` mm of its exact path (see the module doc)."""
     if isinstance(ref, Arc):
-        h = 2 * math.acos(1 - EQUAL_TOL / ref.r)   # rad per chord: sag = EQUAL_TOL
+        h = 2 * math.acos(1 - tol / ref.r)   # rad per chord: sag = tol
         t = np.linspace(0, ref.span, math.ceil(ref.span / h) + 1)
         return ref.c + ref.r * (np.cos(t)[:, None] * ref.e1 + np.sin(t)[:, None] * ref.e2)
     if not isinstance(ref, Offsets):
@@ -139,23 +143,25 @@ def dense_cut(piece, ref, program, part, machine: Machine) -> np.ndarray:
     one = replace(program, segments=[program.cuts[piece.cut]])
     fine = stream_program(one, replace(machine, period=DENSE_PERIOD), stepper_factory(part),
                           feed=DENSE_FEED, planned=False).positions
-    pts = fine[simplify(fine, EQUAL_TOL / 2)]
+    pts = fine[simplify(fine, tol / 2)]
     if isinstance(ref, Guided):   # a pass on a free-form face: the kernel's points as they
         return pts                # are (each moved by Newton on OCCT would take hours)
-    off = ref.distance(pts) > EQUAL_TOL / 4   # the kernel's few points off its path
+    off = ref.distance(pts) > tol / 4   # the kernel's few points off its path
     if off.any():
         pts[off] = [ref.on_path(p) for p in pts[off]]
     return pts
 
 
-def dense_ngc(program, part, ref: PathReference, machine: Machine, feed: float) -> str:
-    """G-code at the stream's accuracy: cuts by ``dense_cut``, links' moves as written
-    (G0 for a rapid), every feed ``feed``, ``G64 P`` EQUAL_TOL, 7 decimals."""
+def dense_ngc(program, part, ref: PathReference, machine: Machine, feed: float,
+              tol: float = EQUAL_TOL) -> str:
+    """G-code within ``tol`` mm of the exact path: cuts by ``dense_cut`` within half of it,
+    links' moves as written (G0 for a rapid), every feed ``feed``, ``G64 P`` half of it,
+    7 decimals."""
     xyz = lambda p: "X{:.7f} Y{:.7f} Z{:.7f}".format(*p)
     first = program.segments[0].points[0]
-    lines = ["%", "G17 G21 G40 G90 G94", f"G64 P{EQUAL_TOL:.7f}", f"G0 Z{first[2]:.7f}",
+    lines = ["%", "G17 G21 G40 G90 G94", f"G64 P{tol / 2:.7f}", f"G0 Z{first[2]:.7f}",
              f"G0 X{first[0]:.7f} Y{first[1]:.7f}", "G4 P0.001", f"F{feed:.3f}"]
-    dense = {pc.cut: dense_cut(pc, r, program, part, machine)
+    dense = {pc.cut: dense_cut(pc, r, program, part, machine, tol / 2)
              for pc, r in zip(ref.pieces, ref.refs) if pc.cut is not None}
     k = 0
     for seg in program.segments:
@@ -230,7 +236,10 @@ def run_all(out: Path, machines: list[str], only: list[str] | None = None,
                                         "own_max_mm": float(own.max()),
                                         "own_p99_mm": float(np.percentile(own, 99))})
             texts = [(f"LinuxCNC P{p:g}", lambda p=p: ngc_text(program, FEED, p)) for p in PS]
-            texts.append(("LinuxCNC equal", lambda: dense_ngc(program, part, ref, m, FEED)))
+            equal = max(EQUAL_TOL, float(own.max()))   # the stream's own error
+            base["equal_tol_mm"] = equal
+            texts.append(("LinuxCNC equal", lambda: dense_ngc(program, part, ref, m, FEED,
+                                                              equal)))
             for method, make in texts:
                 text = make()
                 n = text.count("\n")
