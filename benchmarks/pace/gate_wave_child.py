@@ -1,6 +1,7 @@
 """``python benchmarks/pace/gate_wave_child.py STEP FACE``, run with ``PYTHONPATH`` a
 checkout (this one or the previous code's): the computation and the gate of ``cadcnc
-finish STEP --faces FACE --radius 3 --stepover 1`` at one process, as the CLI runs them,
+finish STEP --faces FACE --radius 3 --stepover 1`` at one process, as the CLI runs them
+(the gate: ``settled_and_judged``, the cut-back and the program gate),
 each in CPU seconds of this process; prints one JSON line (points, compute_cpu_s,
 gate_cpu_s, the cuts' verdicts and the G-code's SHA-256). Imports only what both
 checkouts have."""
@@ -16,12 +17,7 @@ import cadcnc
 from cadcnc.core.job import Job, Raster, Tool
 from cadcnc.io.gcode import blend_for
 from cadcnc.io.outputs import render
-from cadcnc.io.program_gcode import program_written_moves
-from cadcnc.ops.common import safe_height
-from cadcnc.ops.run import cut_back_gap
-from cadcnc.verification import gate_program
-from cadcnc.verification.cut_back import cut_back
-from cadcnc.verification.gate_cache import shared_gates
+from cadcnc.pipeline.operate import Settings, settled_and_judged
 
 
 def main(path: str, face: int) -> None:
@@ -32,10 +28,9 @@ def main(path: str, face: int) -> None:
     program = cadcnc.run(part, job, processes=1)
     c1 = time.process_time()
     gcode = dict(tolerance=None, tool_tip=False, blend=blend_for(job.tolerances.gouge))
-    with shared_gates(part):
-        back = cut_back(program, part, safe_height(part, job), cut_back_gap(job), jobs=1)
-        result = gate_program(back, part, moves=program_written_moves(back, **gcode),
-                              blend_mm=gcode["blend"], jobs=1)
+    back, verdict = settled_and_judged(program, part, job, "finish", "finish",
+                                       Settings(gcode=gcode, processes=1))
+    result = verdict.gate
     c2 = time.process_time()
     text = render(back, "p.ngc", part, "", **gcode)
     print(json.dumps({

@@ -113,19 +113,28 @@ def settled_and_judged(program: Program, part: Part, job: Job, step, what: str,
     """``program`` with its gouging cuts cut back (pencil, finish: :func:`settle`) and its
     :class:`Verdict` (:func:`judge`), as ``settings`` ask; ``job`` gives the links' safe
     height; ``step`` and ``what`` name the run in messages. NothingToCutError when no cut
-    is left. The cut-back step and the program gate share their work on ``part``
-    (:func:`~cadcnc.verification.gate_cache.open_shared`: kept on it from now on)."""
+    is left. The program gate runs first: when every written move passes, no cut gouges
+    and there is nothing to cut back (the cut-back's own gate is spared); otherwise the
+    gouging cuts are cut back and the program gated again. Both share their work on
+    ``part`` (:func:`~cadcnc.verification.gate_cache.open_shared`: kept on it from now on)."""
     open_shared(part)
     join = cut_back_gap(job)
+    if join is None and not program.cuts:
+        raise NothingToCutError(f"{step}: {what}: nothing to cut")
+
+    def judged(program: Program) -> Verdict:
+        return judge(program, part, f"cadcnc: {what}", gcode=settings.gcode,
+                     allow_partial=settings.allow_partial, allow_gouge=settings.allow_gouge,
+                     progress=gate_progress, processes=settings.processes)
+
+    if join is not None and program.cuts and not settings.allow_gouge:
+        verdict = judged(program)
+        if verdict.gate is not None and verdict.gate.ok:
+            return program, verdict
     if join is not None:
         program = settle(program, part, safe_height(part, job), join, f"{step}: {what}",
                          settings.allow_gouge, processes=settings.processes)
-    elif not program.cuts:
-        raise NothingToCutError(f"{step}: {what}: nothing to cut")
-    verdict = judge(program, part, f"cadcnc: {what}", gcode=settings.gcode,
-                    allow_partial=settings.allow_partial, allow_gouge=settings.allow_gouge,
-                    progress=gate_progress, processes=settings.processes)
-    return program, verdict
+    return program, judged(program)
 
 
 def rendered(outcome: Outcome, outputs, what: str, settings: Settings) -> dict:

@@ -38,3 +38,37 @@ def test_a_clear_program_is_left_as_it_is():
                                   period=0.004, start=(10.0, 8.0, 11.0), end=(30.0, 8.0, 11.0))
     prog = Program(tp.job, linked([CutSegment(tp)], 60.0), [])
     assert cut_back(prog, part, 60.0) is prog
+
+
+def _pocket_program(end_x: float):
+    """stretch_pocket's floor-wall corner from x = 10 to ``end_x`` (past 32 it gouges the
+    end wall), as a program of one cut with the pencil's cut-back gap."""
+    from dataclasses import replace
+
+    from cadcnc.core.job import Pencil
+
+    part = cadcnc.load_step(FIXTURES / "stretch_pocket.step")
+    tp = intersection_path(part.face(11), part.face(8), radius=3.0, feed=1500.0,
+                           period=0.004, start=(10.0, 8.0, 11.0), end=(end_x, 8.0, 11.0))
+    job = replace(tp.job, operation=Pencil())
+    return part, job, Program(job, linked([CutSegment(tp)], 60.0), [])
+
+
+def test_the_pipeline_gates_a_clear_program_once(monkeypatch):
+    """A program whose written moves all pass is not cut back: the cut-back's own gate
+    is not run, and the program and verdict are those of the gate alone; a gouging one
+    is cut back and gated again, its verdict passing."""
+    from cadcnc.pipeline import operate
+
+    settled = []
+    real = operate.settle
+    monkeypatch.setattr(operate, "settle", lambda *a, **k: settled.append(1) or real(*a, **k))
+    part, job, prog = _pocket_program(30.0)
+    out, verdict = operate.settled_and_judged(prog, part, job, "pencil", "pencil",
+                                              operate.Settings())
+    assert out is prog and verdict.gate.ok and verdict.code == 0 and not settled
+    part, job, prog = _pocket_program(34.0)
+    out, verdict = operate.settled_and_judged(prog, part, job, "pencil", "pencil",
+                                              operate.Settings())
+    assert settled == [1] and out is not prog and verdict.gate.ok
+    assert out.cuts[0].points[-1][0] <= 32.0 + 1e-6 and out.skipped[0].reason == GOUGE
