@@ -233,7 +233,8 @@ def _cut_rows(stepper, piece: Piece, s: np.ndarray, what: str, done: int, total:
 def stream_program(program: Program, machine: Machine, steppers: StepperFactory | None = None,
                    *, feed: float | None = None, planned: bool = True,
                    max_periods: int = MAX_PERIODS, progress: Progress | None = None,
-                   blend: float = 0.0, exact: frozenset[int] = frozenset()) -> Stream:
+                   blend: float = 0.0, exact: frozenset[int] = frozenset(),
+                   on_plan: Callable[[FeedPlan], None] | None = None) -> Stream:
     """Every period's position of ``program`` on ``machine`` (see the module doc).
 
     ``feed`` (mm/min) replaces the program's feed; ``planned=False`` streams at the
@@ -244,12 +245,13 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
     lowered by as much (REPLANS times at most), then refused (PlanError). ``blend`` (mm)
     rounds the corners of the links that pay for it within it, but not of the segments
     in ``exact`` (:func:`.link_blends.stream_pieces`); a blend is positioned on its samples by
-    the Hermite."""
+    the Hermite. ``on_plan(plan)`` hears of each plan before its positions are computed
+    (to count, bound or announce the periods; a replan is heard again)."""
     pieces = stream_pieces(program, machine, feed, blend, exact)
     derate = np.ones(3)
     for _ in range(REPLANS + 1):
         stream = _stream(program, machine, pieces, steppers, planned, derate, max_periods,
-                         progress)
+                         progress, on_plan)
         if not planned:
             return stream
         over = _over(stream.positions, machine)
@@ -264,9 +266,11 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
 
 
 def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
-            progress) -> Stream:
+            progress, on_plan=None) -> Stream:
     """One plan (limits scaled by ``derate``) and its positions."""
     plan = plan_feed(pieces, machine, planned, tuple(derate))
+    if on_plan is not None:
+        on_plan(plan)
     rows, s = plan.targets(max_periods)
     total = len(s) - 1   # periods: the rows after the start
     positions = np.empty((len(s), 3))

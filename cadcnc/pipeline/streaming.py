@@ -16,10 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..controller.feed_plan import plan_feed
 from ..controller.hal import HalError, hal_available, run_hal_loop
 from ..controller.hal import summary as hal_summary
-from ..controller.link_blends import stream_pieces
 from ..controller.stream import stream_program, stream_text
 from ..core.errors import EXIT_GOUGE, EXIT_OK, EXIT_PARTIAL, InputError
 from ..core.tolerances import DEFAULT, STREAM_BLEND
@@ -157,24 +155,25 @@ def _refused_links(program, gate) -> frozenset[int]:
 
 def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_periods, say,
                     blend=0.0, exact=frozenset()):
-    """The stream, its periods estimated and bounded before the positions are computed,
-    progress reported (the plan is made once here to count the periods first)."""
-    pieces = stream_pieces(program, machine, feed, blend, exact)
-    total = plan_feed(pieces, machine, planned).periods
-    refuse_over("the stream", total, max_periods, "servo periods",
-                "raise the feed or the machine's limits, or give --max-periods N "
-                "(each 24 bytes in memory)")
-    if say is not None:
-        say(f"cadcnc: stream: {total} periods of {machine.period * 1e3:g} ms "
-            f"(cycle {total * machine.period:.3f} s) to compute")
-    tick.stage = f"streaming {total} periods"
+    """The stream, its periods counted and bounded from its plan before the positions are
+    computed (``stream_program``'s ``on_plan``), progress reported."""
+
+    def counted(plan) -> None:
+        total = plan.periods
+        refuse_over("the stream", total, max_periods, "servo periods",
+                    "raise the feed or the machine's limits, or give --max-periods N "
+                    "(each 24 bytes in memory)")
+        if say is not None:
+            say(f"cadcnc: stream: {total} periods of {machine.period * 1e3:g} ms "
+                f"(cycle {total * machine.period:.3f} s) to compute")
+        tick.stage = f"streaming {total} periods"
 
     def progress(done: int, total: int, what: str) -> None:
         tick.stage = f"streaming: {done}/{total} {what}"
 
     return stream_program(program, machine, steppers, feed=feed, planned=planned,
                           max_periods=max_periods, progress=progress, blend=blend,
-                          exact=exact)
+                          exact=exact, on_plan=counted)
 
 
 def _contents(positions, outputs) -> dict:

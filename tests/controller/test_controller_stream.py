@@ -214,3 +214,26 @@ def test_the_accuracy_rule_shortens_the_steps_the_plan_commands(fast_program):
     assert compiled.accuracy_cycles == python.accuracy_cycles
     assert (compiled.accuracy_cycles > 0) == (cut.path.accuracy_cycles > 0)   # pencil: none
     assert np.abs(out - np.array(ref)).max() <= 1e-12
+
+
+def test_on_plan_hears_the_plan_before_any_position():
+    """``on_plan`` gets the plan the stream is made of (the pipeline counts and bounds the
+    periods from it: one plan, not two), before the kernel computes a position: raising
+    there stops the stream with no stepper made."""
+    part, program = _corner()
+    heard, made = [], []
+
+    def steppers(k, seg, period):
+        made.append(k)
+        return stepper_factory(part)(k, seg, period)
+
+    s = stream_program(program, Machine.default(), steppers, on_plan=heard.append)
+    assert heard and heard[-1] is s.plan and heard[-1].periods == s.periods
+    made.clear()
+
+    def refuse(plan):
+        raise RuntimeError(f"{plan.periods} periods")
+
+    with pytest.raises(RuntimeError, match=f"{s.periods} periods"):
+        stream_program(program, Machine.default(), steppers, on_plan=refuse)
+    assert made == []
