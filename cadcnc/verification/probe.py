@@ -138,6 +138,14 @@ class FaceProbe:
         u, w = proj.LowerDistanceParameters()
         return u, w, proj.LowerDistance()
 
+    def surface_floor(self, points) -> np.ndarray | None:
+        """(M,) lower bounds (mm) of the points' (M, 3) distances to the face (to its whole
+        surface: the Bezier patches' boxes, :meth:`.SurfaceBound.floor`), or None where
+        no bound applies."""
+        if self._bound is False:
+            self._bound = SurfaceBound.of(self.adaptor, self.surface)
+        return None if self._bound is None else self._bound.floor(points)
+
     def surface_clear(self, point, u: float, w: float, floor: float) -> bool:
         """Whether no point of the untrimmed surface lies nearer than ``floor`` (mm) to
         ``point``, given its foot at (u, w), proven by bounds without OCCT's global search

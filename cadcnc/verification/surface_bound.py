@@ -116,6 +116,13 @@ class SurfaceBound:
             return None
         return None if net is None else cls(*net)
 
+    def floor(self, points: np.ndarray) -> np.ndarray:
+        """(M,) a lower bound (mm) of each point's (M, 3) distance to the surface: its
+        distance to the nearest patch's box (each patch lies in the box of its control
+        points), less the round-off of the boxes."""
+        points = np.ascontiguousarray(points, dtype=float).reshape(-1, 3)
+        return _box_floor(self.lo, self.hi, points, ROUND_OFF)
+
     def clear(self, adaptor, point, u0: float, w0: float, floor: float) -> bool:
         """Whether no point of the surface lies nearer than ``floor`` (mm) to ``point``,
         given a point of the surface at (u0, w0) (the foot; module doc). False: not
@@ -133,6 +140,26 @@ class SurfaceBound:
                            ex * ex + ey * ey + ez * ez,
                            2.0 * (ex * du.X() + ey * du.Y() + ez * du.Z()),
                            2.0 * (ex * dw.X() + ey * dw.Y() + ez * dw.Z()), floor))
+
+
+@_jit
+def _box_floor(lo: np.ndarray, hi: np.ndarray, points: np.ndarray, rel: float) -> np.ndarray:
+    """(M,) each point's distance to the nearest of the boxes [lo, hi] (P, 3), less
+    ``rel`` times the coordinates' size (:meth:`SurfaceBound.floor`)."""
+    out = np.empty(len(points))
+    for m in range(len(points)):
+        best, size = np.inf, 1.0
+        for i in range(3):
+            size = max(size, abs(points[m, i]))
+        for k in range(len(lo)):
+            g2 = 0.0
+            for i in range(3):
+                g = max(lo[k, i] - points[m, i], points[m, i] - hi[k, i], 0.0)
+                g2 += g * g
+            if g2 < best:
+                best = g2
+        out[m] = max(math.sqrt(best) - rel * size * 4.0, 0.0)
+    return out
 
 
 @_jit

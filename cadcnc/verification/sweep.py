@@ -125,14 +125,72 @@ class Polyline:
         """(need (N,), near_seg (N-1,)): the distance each point must be proven to keep,
         and the moves the box ``box`` (N,) distances cannot prove."""
         n, length = len(self.points), self.length
-        need = np.full(n, self.ball + self.hit if self.hit is not None else 0.0)
         near_seg = np.zeros(max(n - 1, 0), bool)
         if self.clearance is not None and n > 1:
             near_seg = ~(segment_lower_bound(box[:-1], box[1:], length) >= self.clearance)
-            ends = np.where(near_seg, end_distance_for(self.clearance, length), 0.0)
+        return self._need(near_seg), near_seg
+
+    def _need(self, near_seg: np.ndarray) -> np.ndarray:
+        """(N,) the distance each point must be proven to keep: its own, and at the ends
+        of the moves ``near_seg`` (N-1,) the one that proves the move by its ends."""
+        n = len(self.points)
+        need = np.full(n, self.ball + self.hit if self.hit is not None else 0.0)
+        if self.clearance is not None and n > 1:
+            ends = np.where(near_seg, end_distance_for(self.clearance, self.length), 0.0)
             need[:-1] = np.maximum(need[:-1], ends)
             need[1:] = np.maximum(need[1:], ends)
-        return need, near_seg
+        return need
+
+    def _proven(self, k: int, lb: np.ndarray, near_seg: np.ndarray, need: np.ndarray):
+        """(near_seg, need, inner) without the moves the bounds already prove: the surface's
+        patch boxes raise ``lb`` where it falls short (in place), then a move whose ends'
+        ``lb`` prove it (one end near the face, the other far enough: the symmetric
+        ``need`` asks both to be far) or the anchors it passes (:meth:`_inner`) is proven
+        without any distance."""
+        short = np.nonzero(lb < need)[0]
+        if len(short):
+            floor = self.faces.probe(k).surface_floor(self.points[short])
+            if floor is not None:
+                lb[short] = np.maximum(lb[short], floor)
+        if self.clearance is None or not near_seg.any():
+            return near_seg, need, None
+        c = self.clearance
+        ends = segment_lower_bound(lb[:-1], lb[1:], self.length) >= c
+        inner = self._inner(k, lb, near_seg & ~ends)
+        proven = (ends | (inner >= c)) & near_seg
+        if not proven.any():
+            return near_seg, need, inner
+        near_seg = near_seg & ~proven
+        return near_seg, self._need(near_seg), inner
+
+    def _inner(self, k: int, lb: np.ndarray, near_seg: np.ndarray) -> np.ndarray:
+        """(N-1,) a lower bound of each move's distance to face k from the anchors it
+        passes (0 where none is known): the anchor points matched between its ends (the
+        centres a written move stands for) at their feet on the move, each at its known
+        distance less its offset from the move (Lipschitz), and the convexity bound on
+        each piece between feet (:func:`segment_lower_bound`, ends at ``lb``). Only for
+        the moves ``near_seg`` that their ends' ``lb`` leave unproven."""
+        out = np.zeros(len(self.length))
+        if self.anchors is None or self.clearance is None:
+            return out
+        match, where, dists = self.anchors
+        if k not in dists:
+            return out
+        known, pts, c = dists[k], self.points, self.clearance
+        ends = segment_lower_bound(lb[:-1], lb[1:], self.length)
+        for s in np.nonzero(near_seg & ~(ends >= c) & (np.diff(match) >= 2))[0]:
+            idx = np.arange(match[s] + 1, match[s + 1])
+            idx = idx[np.isfinite(known[idx])]
+            a, ab, L = pts[s], pts[s + 1] - pts[s], self.length[s]
+            if not len(idx) or not L > 0.0:
+                continue
+            t = np.clip((where[idx] - a) @ ab / (L * L), 0.0, 1.0)
+            e = known[idx] - np.linalg.norm(where[idx] - (a + t[:, None] * ab), axis=1)
+            order = np.argsort(t, kind="stable")
+            t = np.r_[0.0, t[order], 1.0]
+            e = np.maximum(np.r_[lb[s], e[order], lb[s + 1]], 0.0)
+            out[s] = float(segment_lower_bound(e[:-1], e[1:], np.diff(t) * L).min())
+        return out
 
     def _face(self, k: int) -> None:
         pts, n = self.points, len(self.points)
@@ -146,6 +204,7 @@ class Polyline:
                 return
             box = np.maximum(box, point_box_distance(pts, *self.faces.box(k)))
         need, near_seg = self._reach(box)
+        inner = None
         if k in self.known:
             d, sd = (np.array(a, float) for a in self.known[k])
             have = np.ones(n, bool)
@@ -154,6 +213,7 @@ class Polyline:
             d, sd, have = np.full(n, np.inf), np.full(n, np.inf), np.zeros(n, bool)
             lb, ub = box.copy(), np.full(n, np.inf)
             self._anchor(k, lb, ub)
+            near_seg, need, inner = self._proven(k, lb, near_seg, need)
             self._points(k, d, sd, have, lb, need)
         self.d_lb = np.minimum(self.d_lb, np.where(have, d, lb))
         closer = have & (d < self.d_up)
@@ -162,7 +222,7 @@ class Polyline:
             self.samples[k] = (np.nonzero(have)[0], d[have], sd[have])
         if self.clearance is not None and n > 1:
             self._moves(k, d, sd, have, lb, np.minimum(ub, np.where(have, d, np.inf)),
-                        near_seg)
+                        near_seg, inner)
 
     def _anchor(self, k, lb, ub) -> None:
         """Lower and upper bounds from distances known at nearby points (Lipschitz)."""
@@ -204,11 +264,14 @@ class Polyline:
                     i = stop
 
     # -- moves -------------------------------------------------------------------------
-    def _moves(self, k, d, sd, have, lb, ub, near_seg) -> None:
-        """Bound every move's distance to face k; refine the ones not proven."""
+    def _moves(self, k, d, sd, have, lb, ub, near_seg, inner=None) -> None:
+        """Bound every move's distance to face k (``inner``: the bounds from the anchors
+        the moves pass, :meth:`_inner`); refine the ones not proven."""
         c, length, pts = self.clearance, self.length, self.points
         low = np.where(have, d, lb)
         seg_lb = segment_lower_bound(low[:-1], low[1:], length)
+        if inner is not None:
+            seg_lb = np.maximum(seg_lb, inner)
         meas = np.minimum(ub[:-1], ub[1:])
         exact = np.zeros(len(length), bool)
         probe = self.faces.probe(k)

@@ -117,3 +117,56 @@ def test_the_bounded_check_answers_as_without_the_bound(wrong, monkeypatch):
     assert (with_bound.unseeded_disagreements, with_bound.unseeded_max_gain_mm) == \
         (without.unseeded_disagreements, without.unseeded_max_gain_mm)
     assert (with_bound.unseeded_disagreements > 0) == wrong
+
+
+@pytest.mark.parametrize("name, face", [("wave", None), ("finish_slab.step", 5),
+                                        ("bspline_boss.step", 4)])
+def test_the_patch_boxes_floor_never_exceeds_occts_distance(name, face):
+    """``SurfaceBound.floor`` (the nearest Bezier patch's box) is a lower bound of the
+    distance to the face, which OCCT measures (DistShapeShape), near the face and up to
+    20 mm above it; well above the face it is within a patch's height of it."""
+    part = wave_part() if name == "wave" else cadcnc.load_step(FIXTURES / name)
+    probe = FaceProbe(part.face(face or WAVE["top"]).topods)
+    points = _near_points(probe, 30, 11)
+    rng = np.random.default_rng(3)
+    u0, u1, w0, w1 = probe.box
+    for _ in range(30):   # higher along the normal, as a link's points are
+        n = probe.normal(rng.uniform(u0, u1), rng.uniform(w0, w1))
+        points.append(np.array(probe._p.Coord()) + rng.uniform(4.0, 20.0) * n)
+    floor = probe.surface_floor(np.array(points))
+    exact = np.array([probe.face_distance(p)[1] for p in points])
+    assert (floor <= exact + ROUND).all(), (floor - exact).max()
+    if name == "wave":   # 2 mm patches of a gentle wave: the boxes are tight
+        assert (exact[30:] - floor[30:]).max() < 1.0
+
+
+def test_moves_proven_by_their_bounds_need_fewer_distances_and_keep_the_verdict(
+        monkeypatch):
+    """The wave's finish (stepover 10) gated as written: with the patch boxes' floor and
+    moves proven by their ends' bounds, one end near the face and the other far
+    (``Polyline._proven``), the verdicts are those of the gate without them, with fewer
+    point-to-face distances. A cut's depth is the deepest measured (a lower bound of the
+    true deepest): with fewer measurements it is no deeper; the proven bound of every
+    move's depth stays within the allowance."""
+    from cadcnc.io.gcode import blend_for
+    from cadcnc.ops.finish.shortcut import finish
+    from cadcnc.verification import sweep
+    from cadcnc.verification.written_gate import gate_written
+
+    part = wave_part()
+    program = finish(part, [WAVE["top"]], radius=3.0, stepover=10.0)
+    gcode = dict(tolerance=None, tool_tip=False, blend=blend_for(program.job.tolerances.gouge))
+
+    def run():
+        gate = gate_written(program, part, gcode)
+        evaluated = sum(r.sweep.distances_evaluated for r in gate.results)
+        assert all(r.sweep.depth_bound_mm <= r.sweep.allowance_mm for r in gate.results)
+        return [r.ok for r in gate.results], [r.depth_mm for r in gate.results], evaluated
+
+    now = run()
+    monkeypatch.setattr(sweep.Polyline, "_proven",
+                        lambda self, k, lb, near_seg, need: (near_seg, need, None))
+    before = run()
+    assert now[0] == before[0] and all(now[0])
+    assert all(a <= b + 1e-12 for a, b in zip(now[1], before[1]))
+    assert now[2] < before[2]
