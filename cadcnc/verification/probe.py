@@ -138,22 +138,25 @@ class FaceProbe:
         u, w = proj.LowerDistanceParameters()
         return u, w, proj.LowerDistance()
 
+    def _surface_bound(self) -> SurfaceBound | None:
+        """The face's :class:`.SurfaceBound` (made on first use), or None."""
+        if self._bound is False:
+            self._bound = SurfaceBound.of(self.adaptor, self.surface)
+        return self._bound
+
     def surface_floor(self, points) -> np.ndarray | None:
         """(M,) lower bounds (mm) of the points' (M, 3) distances to the face (to its whole
         surface: the Bezier patches' boxes, :meth:`.SurfaceBound.floor`), or None where
         no bound applies."""
-        if self._bound is False:
-            self._bound = SurfaceBound.of(self.adaptor, self.surface)
-        return None if self._bound is None else self._bound.floor(points)
+        bound = self._surface_bound()
+        return None if bound is None else bound.floor(points)
 
     def surface_clear(self, point, u: float, w: float, floor: float) -> bool:
         """Whether no point of the untrimmed surface lies nearer than ``floor`` (mm) to
         ``point``, given its foot at (u, w), proven by bounds without OCCT's global search
         (:mod:`.surface_bound`; False where they cannot say)."""
-        if self._bound is False:
-            self._bound = SurfaceBound.of(self.adaptor, self.surface)
-        return self._bound is not None and self._bound.clear(self.adaptor, point, u, w,
-                                                             floor)
+        bound = self._surface_bound()
+        return bound is not None and bound.clear(self.adaptor, point, u, w, floor)
 
     def signed(self, point, u: float, w: float, dist: float) -> float:
         """``dist`` signed by the side of the surface the point is on (+ out of material)."""

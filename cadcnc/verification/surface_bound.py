@@ -144,8 +144,9 @@ class SurfaceBound:
 
 @_jit
 def _box_floor(lo: np.ndarray, hi: np.ndarray, points: np.ndarray, rel: float) -> np.ndarray:
-    """(M,) each point's distance to the nearest of the boxes [lo, hi] (P, 3), less
-    ``rel`` times the coordinates' size (:meth:`SurfaceBound.floor`)."""
+    """(M,) each point's distance to the nearest of the boxes [lo, hi] (P, 3), less four
+    times ``rel`` times the coordinates' size (the round-off of the boxes and of the
+    distance; :meth:`SurfaceBound.floor`)."""
     out = np.empty(len(points))
     for m in range(len(points)):
         best, size = np.inf, 1.0

@@ -169,16 +169,15 @@ class Polyline:
         centres a written move stands for) at their feet on the move, each at its known
         distance less its offset from the move (Lipschitz), and the convexity bound on
         each piece between feet (:func:`segment_lower_bound`, ends at ``lb``). Only for
-        the moves ``near_seg`` that their ends' ``lb`` leave unproven."""
+        the moves ``near_seg`` (those their ends' ``lb`` leave unproven)."""
         out = np.zeros(len(self.length))
-        if self.anchors is None or self.clearance is None:
+        if self.anchors is None:
             return out
         match, where, dists = self.anchors
         if k not in dists:
             return out
-        known, pts, c = dists[k], self.points, self.clearance
-        ends = segment_lower_bound(lb[:-1], lb[1:], self.length)
-        for s in np.nonzero(near_seg & ~(ends >= c) & (np.diff(match) >= 2))[0]:
+        known, pts = dists[k], self.points
+        for s in np.nonzero(near_seg & (np.diff(match) >= 2))[0]:
             idx = np.arange(match[s] + 1, match[s + 1])
             idx = idx[np.isfinite(known[idx])]
             a, ab, L = pts[s], pts[s + 1] - pts[s], self.length[s]
