@@ -69,11 +69,12 @@ class Stopwatch:
     run is timed; a wrapper costs about 0.3 µs a call): where cadcnc's time goes."""
 
     WATCHED = [("cadcnc.ops.finish.raster", "plan_for_job", "planning (planes, face sampling)"),
-               ("cadcnc.ops.finish.raster", "uncut_report", "uncut report"),
+               ("cadcnc.ops.finish.raster", "measured_rows", "uncut report (cut points' tree)"),
+               ("cadcnc.ops.finish.raster", "uncut_from_rows", "uncut report (areas, reasons)"),
                ("cadcnc.ops.finish.uncut", "_reasons",
                 "of which reasons (guard on samples)"),
-               ("cadcnc.ops.finish.raster", "entered_program_segments",
-                "entries and links (zigzag links verified)"),
+               ("cadcnc.ops.finish.raster", "entered_items", "entries"),
+               ("cadcnc.ops.finish.raster", "linked", "links (zigzag links verified)"),
                ("cadcnc.guard.stay_down", "witness",
                 "of which stay-down witnesses (refutations)"),
                ("cadcnc.guard.moves", "MoveClearance.distance",

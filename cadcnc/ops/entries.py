@@ -239,6 +239,17 @@ def entered_program_segments(part, job: Job, cuts: list[CutSegment], z_safe: flo
     then ordered by ``order(items)`` when given, and linked), the cuts skipped, and the
     note on entries (:func:`entered`, with ``tick``). ``processes``: processes looking for
     the cuts' entries (None: every core); the answer does not depend on it."""
+    items, skipped, notes = entered_items(part, job, cuts, z_safe, tick, processes)
+    if order is not None:
+        items = order(items)
+    return linked(items, z_safe, join=join, stay_down=stay_down), skipped, notes
+
+
+def entered_items(part, job: Job, cuts: list[CutSegment], z_safe: float, tick=None,
+                  processes: int | None = 1) -> tuple[list, list[Skipped], list[str]]:
+    """Each of ``cuts`` as it is entered (:func:`entered`: the items
+    :func:`~cadcnc.program.linking.linked` links), the cuts skipped and the note on
+    entries; ``processes`` look for the entries (None: every core; the same answer)."""
     access, plans = Access(part, job, z_safe), None
     if check_jobs(processes) > 1 and len(cuts) > 1:
         seen = [0]
@@ -250,10 +261,7 @@ def entered_program_segments(part, job: Job, cuts: list[CutSegment], z_safe: flo
 
         plans = on_workers(_plan_task, [(job, z_safe, cut) for cut in cuts], part, processes,
                            told, "the entry of cut")
-    items, skipped, notes = entered(cuts, access, tick, plans)
-    if order is not None:
-        items = order(items)
-    return linked(items, z_safe, join=join, stay_down=stay_down), skipped, notes
+    return entered(cuts, access, tick, plans)
 
 
 def _plan_task(part, task, beat=None) -> tuple:

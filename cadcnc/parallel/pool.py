@@ -301,8 +301,12 @@ def _pools() -> Iterator[Pools]:
 def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: int | None,
                 build: Callable, build_args: Callable[[], tuple],
                 on_result: Callable[[int, Any], None] | None = None,
-                what: str = "task", numbers: Sequence[int] | None = None) -> list:
+                what: str = "task", numbers: Sequence[int] | None = None,
+                meanwhile: Callable[[], None] | None = None) -> list:
     """``[fn(part, t) for t in tasks]``, on ``jobs`` processes (module doc).
+
+    ``meanwhile()``: work of the caller's own, run in this process while the workers
+    run the tasks (before them with one process); results are taken after it returns.
 
     ``fn`` must be a module-level function (it is pickled by name); ``build(*build_args())``
     rebuilds ``part`` in a worker (``build_args`` is called only when a pool starts).
@@ -313,6 +317,8 @@ def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: i
     tasks = list(tasks)
     jobs = min(check_jobs(jobs), max(len(tasks), 1))
     if jobs == 1:
+        if meanwhile is not None:
+            meanwhile()
         out = []
         for k, t in enumerate(tasks):
             out.append(fn(part, t))
@@ -320,18 +326,21 @@ def map_ordered(fn: Callable[[Any, Any], Any], tasks: Sequence, *, part, jobs: i
                 on_result(k, out[-1])
         return out
     with _pools() as pools, pools.busy(part):
-        return _run(pools, fn, tasks, part, jobs, build, build_args, on_result, what, numbers)
+        return _run(pools, fn, tasks, part, jobs, build, build_args, on_result, what, numbers,
+                    meanwhile)
 
 
 def _run(pools: Pools, fn: Callable, tasks: list, part, jobs: int, build: Callable,
          build_args: Callable[[], tuple], on_result, what: str,
-         numbers: Sequence[int] | None) -> list:
+         numbers: Sequence[int] | None, meanwhile: Callable[[], None] | None) -> list:
     """:func:`map_ordered` on the pool of ``part`` in ``pools``."""
     pool = pools.get(part, jobs, build, build_args)
     futures = {}
     try:
         with _ctrl_c_deferred():  # the pool starts its workers here: all or none registered
             futures = {pool.submit(_call, fn, t): k for k, t in enumerate(tasks)}
+        if meanwhile is not None:
+            meanwhile()
         out: list = [None] * len(tasks)
         pending = set(futures)
         while pending:

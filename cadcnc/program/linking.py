@@ -163,6 +163,11 @@ def linked(cuts: list, z_safe: float, approach_mm: float = APPROACH,
     return out
 
 
+def linked_cuts(items: list) -> list[CutSegment]:
+    """The cuts of :func:`linked` ``(items, ...)``, in its order (known before linking)."""
+    return [s for item in items for s in _visit(item).cuts]
+
+
 def _chains(starts: np.ndarray, ends: np.ndarray, join: float) -> list[list[int]]:
     """Cut indices grouped into chains (a cut starting within ``join`` mm of another's end
     follows it; among several, the nearest not yet taken), heads in index order first.

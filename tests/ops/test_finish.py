@@ -13,7 +13,7 @@ from cadcnc.guard.moves import MoveClearance
 from cadcnc.ops.finish.plan import centre_chord, plan_planes, sample_faces
 from cadcnc.ops.finish.raster import plan_for_job
 from cadcnc.ops.finish.shortcut import finish
-from cadcnc.ops.finish.uncut import uncut_report
+from cadcnc.ops.finish.uncut import measured_rows, uncut_report, uncut_tasks
 from cadcnc.verification import gate_program
 from cadcnc.verification.probe import shape_distances
 from helpers.fixtures import FIXTURES
@@ -180,6 +180,22 @@ def test_boss_is_left_where_the_ball_cannot_reach():
     assert 20.0 < rep.unmachined_area < math.pi * (7 ** 2 - 4 ** 2) * 1.1
     assert any(s.reason == "unreachable" and "in the way" in s.detail for s in prog.skipped)
     assert any(s.reason == "collision" for s in prog.skipped)  # the passes' own records
+
+
+def test_the_uncut_report_does_not_depend_on_blocks_or_processes():
+    """The samples measured in one block here, in three blocks here, and in two blocks on
+    two worker processes: the same leftovers, scallops and report."""
+    part, prog, _ = run("boss", [6])
+    plan, samples = plan_for_job(part, prog.job)
+    points = [c.points for c in prog.cuts]
+    rows = [measured_rows(None, t) for t in uncut_tasks(points, prog.job, samples, plan, 1)]
+    three = [measured_rows(None, t) for t in uncut_tasks(points, prog.job, samples, plan, 3)]
+    assert len(rows) == 1 and len(three) == 3
+    for one, split in zip(rows[0], (np.concatenate(x) for x in zip(*three))):
+        assert np.array_equal(one, split, equal_nan=True)
+    here, there = uncut_report(prog, part, samples, plan), uncut_report(prog, part, samples,
+                                                                        plan, jobs=2)
+    assert here == there and here.notes() == there.notes() and here.unmachined
 
 
 def test_cylinder_lower_half_is_unreachable_and_scallop_reported():

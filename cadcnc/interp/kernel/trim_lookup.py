@@ -117,3 +117,17 @@ def lookup(codes: np.ndarray, fine: np.ndarray, u0: float, w0: float, du: float,
     a = min(max(int(math.floor((x - i) * ru)), 0), ru - 1)
     b = min(max(int(math.floor((y - j) * rw)), 0), rw - 1)
     return int(fine[k + 2 + a * rw + b])
+
+
+@_jit
+def lookup_grid(codes: np.ndarray, fine: np.ndarray, u0: float, w0: float, du: float,
+                dw: float, nu: int, nw: int, window: np.ndarray, us: np.ndarray,
+                ws: np.ndarray, out: np.ndarray) -> None:
+    """``out[a, b]`` = the label of (``us[a]``, ``ws[b]``) (``lookup``), each wrapped first
+    into ``window`` (u start, u period, w start, w period; period 0: not periodic).
+    ``out``: (len(us), len(ws)) int64; a sampling grid's labels in one call."""
+    for a in range(len(us)):
+        u = wrap(us[a], window[0], window[1])
+        for b in range(len(ws)):
+            out[a, b] = lookup(codes, fine, u0, w0, du, dw, nu, nw, u,
+                               wrap(ws[b], window[2], window[3]))

@@ -26,15 +26,16 @@ from ...core.progress import Progress
 from ...core.work_limits import MAX_PLANES, Heartbeat
 from ...geometry.part import Part
 from ...parallel.pool import check_jobs
-from ...parallel.tasks import on_workers
+from ...parallel.tasks import beside, on_workers
+from ...program.linking import linked, linked_cuts
 from ...program.program import CutSegment, Program, Skipped
 from ..common import FINISH_JOIN as JOIN
 from ..common import safe_height
-from ..entries import entered_program_segments
+from ..entries import entered_items
 from .pass_setup import pass_setup
 from .passes import GuidePlane, PassResult, pass_cuts
 from .plan import MAX_SAMPLES, centre_chord, plan_planes, sample_faces
-from .uncut import uncut_report
+from .uncut import measured_rows, uncut_from_rows, uncut_tasks
 from .waterline import stay_down_links
 
 SAMPLES_PER_SPACING = 4
@@ -78,11 +79,18 @@ def raster_program(part: Part, job: Job, *, progress: Progress | None = None,
         skipped += res.skipped
         work["cycles"] += res.cycles
     stay_down = stay_down_links(part, job) if pattern == "zigzag" else None
-    segments, unreachable, notes = entered_program_segments(
-        part, job, cuts, safe_height(part, job), join=JOIN, stay_down=stay_down,
-        tick=lambda k, n: beat.beat(f"entries: {k} of {n} cuts"), processes=processes)
+    z_safe = safe_height(part, job)
+    items, unreachable, notes = entered_items(
+        part, job, cuts, z_safe, tick=lambda k, n: beat.beat(f"entries: {k} of {n} cuts"),
+        processes=processes)
+    # the uncut report needs only the cut points: measured on the workers while this
+    # process links the cuts
+    tasks = uncut_tasks([c.points for c in linked_cuts(items)], job, samples, plan,
+                        check_jobs(processes))
+    segments, rows = beside(lambda: linked(items, z_safe, join=JOIN, stay_down=stay_down),
+                            measured_rows, tasks, part, processes, "the uncut report's block")
     program = Program(job, segments, skipped + unreachable, notes)
-    report = uncut_report(program, part, samples, plan, check_jobs(processes))
+    report = uncut_from_rows(rows, job, part, samples, plan)
     program.skipped += report.skipped()
     program.notes += report.notes()
     return program

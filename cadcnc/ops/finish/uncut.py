@@ -33,6 +33,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...guard.clearance import ClearanceGuard
+from ...parallel.tasks import on_workers
 from ...program.program import Skipped
 from .plan import across, centre_chord, stepover_scallop
 
@@ -109,32 +110,57 @@ def scallop_limit(job) -> float:
 def uncut_report(program, part, samples, plan, jobs: int = 1) -> UncutReport:
     """What ``program``'s cuts left on ``samples`` of its faces (see the module doc);
     ``plan`` the :class:`~cadcnc.ops.finish.plan.PlanePlan` they came from; ``jobs``
-    threads query the cut points' k-d tree (the same answers)."""
-    job = program.job
-    radius, allowance, r1 = job.tool.radius, job.tool.allowance, job.tool.offset
+    processes measure the samples (the same answers)."""
+    tasks = uncut_tasks([c.points for c in program.cuts], program.job, samples, plan, jobs)
+    rows = on_workers(measured_rows, tasks, part, jobs, what="the uncut report's block")
+    return uncut_from_rows(rows, program.job, part, samples, plan)
+
+
+def uncut_tasks(cut_points: list[np.ndarray], job, samples, plan, blocks: int) -> list[tuple]:
+    """The tasks of :func:`measured_rows`: ``samples`` in ``blocks`` runs of rows, each
+    with every cut point ((M_k, 3) ball centres, mm, in program order) and the planes'
+    normal (``plan``) and the samples' curvature across the passes; none without cuts."""
+    if not cut_points:
+        return []
+    pts, nrm, tool = np.vstack(cut_points), samples.normals, job.tool
+    q = samples.points + tool.offset * nrm
+    base = samples.points + tool.allowance * nrm
+    k, _ = across(samples, plan.normal)
+    edges = np.linspace(0, len(q), max(1, min(blocks, len(q))) + 1).astype(int)
+    return [(pts, q[a:b], base[a:b], nrm[a:b], k[a:b], plan.normal, tool.radius,
+             tool.allowance, tool.offset) for a, b in zip(edges[:-1], edges[1:])]
+
+
+def measured_rows(part, task, beat=None) -> tuple[np.ndarray, np.ndarray]:
+    """(leftover, scallop: NaN where a side has no pass), each (N,), of one block of
+    :func:`uncut_tasks` (an :func:`~cadcnc.parallel.tasks.on_workers` task; the part is
+    not used): the cut points' k-d tree asked for the NEIGHBOURS nearest within R' of
+    each ideal centre."""
+    pts, q, base, nrm, k, n, radius, allowance, r1 = task
+    tree, kk = cKDTree(pts), min(NEIGHBOURS, len(pts))
+    leftover, chord, ok = np.empty(len(q)), np.zeros(len(q)), np.zeros(len(q), dtype=bool)
+    for a in range(0, len(q), CHUNK):   # rows are independent; a chunk stays in cache
+        b = slice(a, a + CHUNK)
+        dist, idx = tree.query(q[b], k=kk, distance_upper_bound=r1)
+        dist, idx = dist.reshape(len(q[b]), -1), idx.reshape(len(q[b]), -1)
+        found = np.isfinite(dist)
+        c = np.take(pts, np.where(found, idx, 0), axis=0)              # (n, K, 3)
+        leftover[b] = _leftover(c, found, base[b], nrm[b], radius)
+        chord[b], ok[b] = _chords(c, dist, q[b], nrm[b], n)
+    # elementwise: one bisection over every row (fewer, longer array operations)
+    return leftover, np.where(ok, _scallop_of_chord(chord, k, radius, allowance), np.nan)
+
+
+def uncut_from_rows(rows: list[tuple], job, part, samples, plan) -> UncutReport:
+    """The report of ``samples`` from the :func:`measured_rows` of its blocks, in order
+    (none: no cut, every sample left over); ``plan`` the planes' PlanePlan."""
     limit = scallop_limit(job)
     threshold = UNMACHINED * limit
-    nrm, n = samples.normals, plan.normal
-    q = samples.points + r1 * nrm
-    cuts = [c.points for c in program.cuts]
+    n = plan.normal
     leftover = np.full(len(samples), np.inf)
     scallop = np.full(len(samples), np.nan)
-    if cuts:
-        pts = np.vstack(cuts)
-        tree, kk = cKDTree(pts), min(NEIGHBOURS, len(pts))
-        k, _ = across(samples, n)
-        base = samples.points + allowance * nrm
-        chord, ok = np.zeros(len(q)), np.zeros(len(q), dtype=bool)
-        for a in range(0, len(q), CHUNK):   # rows are independent; a chunk stays in cache
-            b = slice(a, a + CHUNK)
-            dist, idx = tree.query(q[b], k=kk, distance_upper_bound=r1, workers=jobs)
-            dist, idx = dist.reshape(len(q[b]), -1), idx.reshape(len(q[b]), -1)
-            found = np.isfinite(dist)
-            c = np.take(pts, np.where(found, idx, 0), axis=0)              # (n, K, 3)
-            leftover[b] = _leftover(c, found, base[b], nrm[b], radius)
-            chord[b], ok[b] = _chords(c, dist, q[b], nrm[b], n)
-        # elementwise: one bisection over every row (fewer, longer array operations)
-        scallop = np.where(ok, _scallop_of_chord(chord, k, radius, allowance), np.nan)
+    if rows:
+        leftover, scallop = (np.concatenate(x) for x in zip(*rows))
     reason = np.array(plan.reason, dtype=object)
     machined = (leftover <= threshold) & (reason == "")
     area = samples.areas
@@ -144,6 +170,7 @@ def uncut_report(program, part, samples, plan, jobs: int = 1) -> UncutReport:
                          float(area[machined & (cusp > limit + CUSP_SLACK)].sum()),
                          n_samples=len(samples), spacing=samples.spacing)
     left = ~machined
+    q = samples.points + job.tool.offset * samples.normals
     why = _reasons(reason, left, samples, q, part, job, n)
     for face in np.unique(samples.faces[left]):
         for r in np.unique(why[left & (samples.faces == face)]):
