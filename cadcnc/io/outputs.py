@@ -17,7 +17,7 @@ from pathlib import Path
 from ..core.errors import OutputError
 from ..geometry.setup import job_setup
 from ..parallel.pool import check_jobs
-from ..parallel.tasks import on_workers
+from ..parallel.tasks import beside
 from ..program.program import Program
 from ..program.transform import in_part_coordinates
 from .output_set import check_destination
@@ -68,38 +68,73 @@ def render(program: Program, out, part=None, title: str = "", **gcode) -> str | 
 def render_all(program: Program, outs, part=None, title: str = "", jobs: int | None = 1,
                **gcode) -> dict:
     """``{out: content}`` of every output in ``outs``, as :func:`render` makes each. With
-    ``jobs`` > 1 and the ``part``, on worker processes at once: each JSON in runs of
-    segments, every other output whole (its G-code, its pictures); the same bytes."""
+    ``jobs`` > 1 and the ``part``, on worker processes at once (:class:`RenderPieces`):
+    each JSON in runs of segments, the pictures whole, the G-code and CSV here
+    meanwhile; the same bytes."""
     outs = list(outs)
     n = check_jobs(jobs)
     if n == 1 or part is None or not outs:
         return {out: render(program, out, part, title, **gcode) for out in outs}
-    setup = job_setup(program.job, part)
-    tasks: list[tuple] = []
-    where: dict = {}   # out -> (head, tail, its first task, how many), tail None: whole
-    for out in outs:
-        if Path(out).suffix.lower() == ".json":
-            head, tail, runs = json_pieces(program, setup, n)
-            where[out] = (head, tail, len(tasks), len(runs))
-            tasks += [("runs", run) for run in runs]
-        else:
-            check_output(out)   # an unknown suffix refused here, not in a worker
-            where[out] = ("", None, len(tasks), 1)
-            tasks.append(("whole", program, out, title, gcode))
-    done = on_workers(_render_task, tasks, part, jobs, what="writing outputs",
-                      sizes=[_size(t) for t in tasks]) if tasks else []
-    contents = {}
-    for out, (head, tail, first, count) in where.items():
-        if tail is None:
-            contents[out] = done[first]
-        else:
-            contents[out] = join_pieces(head, tail, done[first:first + count]) \
-                if count else head
-    return contents
+    pieces = RenderPieces(program, outs, part, title, n, gcode)
+    here, done = beside(pieces.here, render_piece, pieces.tasks, part, jobs,
+                        "writing outputs", pieces.sizes)
+    return pieces.joined(here, done)
 
 
-def _render_task(part, task, beat=None):
-    """One piece of :func:`render_all` (an on_workers task, on the worker's part)."""
+LOCAL = (".ngc", ".csv")
+"""Outputs :class:`RenderPieces` makes in the caller's process: quick to make from the
+program, which a worker would first have to be sent whole."""
+
+
+class RenderPieces:
+    """:func:`render_all`'s work on ``jobs`` processes: every JSON in runs of segments
+    and every picture whole as worker ``tasks`` (:func:`render_piece` each), the LOCAL
+    outputs by :meth:`here` in this process meanwhile; :meth:`joined` makes ``{out:
+    content}`` of the two, in the order of ``outs``."""
+
+    def __init__(self, program: Program, outs, part, title: str, jobs: int, gcode: dict):
+        setup = job_setup(program.job, part)
+        self.tasks: list[tuple] = []
+        self._where: dict = {}   # out -> (head, tail, first task, how many); tail None: whole
+        self._local: list = []
+        self._args = program, part, title, gcode
+        for out in outs:
+            kind = check_output(out)   # an unknown suffix refused here, not in a worker
+            if f".{kind}" in LOCAL:
+                self._where[out] = None
+                self._local.append(out)
+            elif kind == "json":
+                head, tail, runs = json_pieces(program, setup, jobs)
+                self._where[out] = (head, tail, len(self.tasks), len(runs))
+                self.tasks += [("runs", run) for run in runs]
+            else:
+                self._where[out] = ("", None, len(self.tasks), 1)
+                self.tasks.append(("whole", program, out, title, gcode))
+        self.sizes = [_size(t) for t in self.tasks]
+
+    def here(self) -> dict:
+        """``{out: content}`` of the LOCAL outputs, made in this process."""
+        program, part, title, gcode = self._args
+        return {out: render(program, out, part, title, **gcode) for out in self._local}
+
+    def joined(self, here: dict, done: list) -> dict:
+        """``{out: content}`` from :meth:`here`'s outputs and the tasks' results ``done``."""
+        contents = {}
+        for out, where in self._where.items():
+            if where is None:
+                contents[out] = here[out]
+                continue
+            head, tail, first, count = where
+            if tail is None:
+                contents[out] = done[first]
+            else:
+                contents[out] = join_pieces(head, tail, done[first:first + count]) \
+                    if count else head
+        return contents
+
+
+def render_piece(part, task, beat=None):
+    """One task of :class:`RenderPieces` (an on_workers task, on the worker's part)."""
     if task[0] == "runs":
         return segments_text(task[1])
     _, program, out, title, gcode = task

@@ -27,6 +27,7 @@ entry is skipped as UNREACHABLE, naming its start and the face in the way. Lengt
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -130,10 +131,24 @@ def _retrace(path, lo: int, hi: int, reverse: bool) -> LinkSegment:
     return LinkSegment(pts, np.zeros(len(pts) - 1, dtype=bool))
 
 
-def _entry(cut: CutSegment, access: Access) -> tuple[int, np.ndarray | None, str]:
+class Outline(NamedTuple):
+    """What the entry of a cut depends on: its points ((N, 3) mm), its faces and its
+    length (mm); a worker's task is this, not the whole cut."""
+
+    points: np.ndarray
+    faces: tuple
+    length: float
+
+
+def outline(cut: CutSegment) -> Outline:
+    """The :class:`Outline` of ``cut``."""
+    return Outline(cut.points, cut.path.faces, cut.length)
+
+
+def _entry(cut: Outline, access: Access) -> tuple[int, np.ndarray | None, str]:
     """(index, side point or None, "") of where ``cut`` is entered; (-1, None, why) when
     nowhere is clear."""
-    pts, faces = cut.points, cut.path.faces
+    pts, faces = cut.points, cut.faces
     n = len(pts) - 1
     first, why = access.plunge(faces, pts[0])
     if first:
@@ -154,7 +169,7 @@ def _entry(cut: CutSegment, access: Access) -> tuple[int, np.ndarray | None, str
                       f"({', '.join(SIDE_NAMES)}) at its height: blocked too")
 
 
-def entry_plan(cut: CutSegment, access: Access) -> tuple[int, np.ndarray | None, str, bool]:
+def entry_plan(cut: Outline, access: Access) -> tuple[int, np.ndarray | None, str, bool]:
     """Where ``cut`` is entered and whether the tool leaves straight up: (index, side
     point or None, why not, out) as :func:`_entry` gives them, ``out`` whether the plunge
     from the last point cut is clear (asked only when it decides the :class:`Visit`).
@@ -164,7 +179,7 @@ def entry_plan(cut: CutSegment, access: Access) -> tuple[int, np.ndarray | None,
         return k, side, why, False
     n = len(cut.points) - 1
     last = n if k == 0 else 0
-    out = side is None and (last == k or access.plunge(cut.path.faces, cut.points[last])[0])
+    out = side is None and (last == k or access.plunge(cut.faces, cut.points[last])[0])
     return k, side, why, out
 
 
@@ -172,7 +187,7 @@ def visit_for(cut: CutSegment, access: Access, plan=None) -> Visit | Skipped:
     """The :class:`Visit` that enters, cuts and leaves ``cut`` (module doc), or its
     :class:`Skipped` (UNREACHABLE) when no entry is clear; ``plan``: its
     :func:`entry_plan` when already known."""
-    k, side, why, out = entry_plan(cut, access) if plan is None else plan
+    k, side, why, out = entry_plan(outline(cut), access) if plan is None else plan
     path, n = cut.path, len(cut.points) - 1
     if k < 0:
         return Skipped(path.faces, UNREACHABLE, f"cut of {path.length:.3f} mm: {why}",
@@ -259,8 +274,8 @@ def entered_items(part, job: Job, cuts: list[CutSegment], z_safe: float, tick=No
             if tick is not None:
                 tick(seen[0], len(cuts))
 
-        plans = on_workers(_plan_task, [(job, z_safe, cut) for cut in cuts], part, processes,
-                           told, "the entry of cut")
+        plans = on_workers(_plan_task, [(job, z_safe, outline(cut)) for cut in cuts], part,
+                           processes, told, "the entry of cut")
     return entered(cuts, access, tick, plans)
 
 

@@ -48,10 +48,12 @@ def on_workers(fn: Callable, tasks: Sequence, part, jobs: int | None,
 
 
 def beside(here: Callable[[], T], fn: Callable, tasks: Sequence, part, jobs: int | None,
-           what: str = "task") -> tuple[T, list]:
-    """``(here(), on_workers(fn, tasks, part, jobs))``: two independent pieces of work at
-    once, ``here()`` in this process while the workers run the tasks (with ``jobs`` 1,
-    or one task, one after the other). Neither may depend on the other."""
+           what: str = "task", sizes: Sequence[float] | None = None) -> tuple[T, list]:
+    """``(here(), on_workers(fn, tasks, part, jobs, sizes=sizes))``: two independent
+    pieces of work at once, ``here()`` in this process while the workers run the tasks
+    (with ``jobs`` 1, or one task, one after the other). Neither may depend on the
+    other; ``here()`` may hand the same workers tasks of its own (they queue behind)."""
     box: list = []
-    out = on_workers(fn, tasks, part, jobs, what=what, meanwhile=lambda: box.append(here()))
+    out = on_workers(fn, tasks, part, jobs, what=what, sizes=sizes,
+                     meanwhile=lambda: box.append(here()))
     return box[0], out

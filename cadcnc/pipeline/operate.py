@@ -18,9 +18,11 @@ from ..core.job import Job
 from ..core.work_limits import MAX_CYCLES
 from ..geometry.part import Part, load_step
 from ..geometry.setup import setup_in, setup_part
-from ..io.outputs import render_all
+from ..io.outputs import RenderPieces, render_all, render_piece
 from ..ops.common import safe_height
 from ..ops.run import cut_back_gap
+from ..parallel.pool import check_jobs
+from ..parallel.tasks import beside
 from ..program.program import Program
 from ..verification.gate_cache import open_shared
 from .exit_policy import Verdict, judge, settle
@@ -55,6 +57,8 @@ class Outcome:
     seconds_computed: float
     seconds_gated: float
     what: str
+    contents: dict | None = None
+    """The outputs asked of :func:`operate`, rendered beside the gate (None: not made)."""
 
 
 MAX_ORIGIN_OFFSET = 10_000.0
@@ -79,11 +83,14 @@ def check_origin(part: Part, job: Job, step) -> None:
 
 
 def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progress=None,
-            times: dict | None = None, gate_progress=None) -> Outcome:
+            times: dict | None = None, gate_progress=None, outputs=()) -> Outcome:
     """Run ``job`` on the STEP file ``step`` and judge it (module doc). ``what``: the
     command's name in messages ("pencil"); ``progress`` and ``times``: as
     :func:`~cadcnc.pipeline.program_plan.plan`; ``gate_progress``: the gate's ``(done, total, stage)`` callback.
-    Raises the library's errors (bad face number, nothing to cut, ...)."""
+    ``outputs``: files the caller will write (by suffix): with more than one process
+    they are rendered on the workers while this process gates the program
+    (``Outcome.contents``; :func:`rendered` gives them). Raises the library's errors
+    (bad face number, nothing to cut, ...)."""
     if settings.max_cycles < 1:
         raise InputError(f"--max-cycles must be at least 1, got {settings.max_cycles}")
     t0 = time.monotonic()
@@ -103,9 +110,10 @@ def operate(step, job: Job, what: str, settings: Settings = Settings(), *, progr
             raise
         raise NothingToCutError(f"{what}: {e}") from None
     t_cut = time.monotonic() - t0
-    program, verdict = settled_and_judged(program, part, job, step, what, settings,
-                                          gate_progress=gate_progress)
-    return Outcome(part, program, verdict, t_cut, time.monotonic() - t0 - t_cut, what)
+    program, verdict, contents = _settled(program, part, job, step, what, settings,
+                                          gate_progress, list(outputs))
+    return Outcome(part, program, verdict, t_cut, time.monotonic() - t0 - t_cut, what,
+                   contents)
 
 
 def settled_and_judged(program: Program, part: Part, job: Job, step, what: str,
@@ -117,30 +125,62 @@ def settled_and_judged(program: Program, part: Part, job: Job, step, what: str,
     and there is nothing to cut back (the cut-back's own gate is spared); otherwise the
     gouging cuts are cut back and the program gated again. Both share their work on
     ``part`` (:func:`~cadcnc.verification.gate_cache.open_shared`: kept on it from now on)."""
+    program, verdict, _ = _settled(program, part, job, step, what, settings, gate_progress)
+    return program, verdict
+
+
+def _settled(program: Program, part: Part, job: Job, step, what: str, settings: Settings,
+             gate_progress=None, outputs: list | None = None
+             ) -> tuple[Program, Verdict, dict | None]:
+    """:func:`settled_and_judged`, and the contents of ``outputs`` when they were
+    rendered on the workers beside the gate of the program returned (else None)."""
     open_shared(part)
     join = cut_back_gap(job)
     if join is None and not program.cuts:
         raise NothingToCutError(f"{step}: {what}: nothing to cut")
+    jobs = check_jobs(settings.processes)
 
-    def judged(program: Program) -> Verdict:
-        return judge(program, part, f"cadcnc: {what}", gcode=settings.gcode,
-                     allow_partial=settings.allow_partial, allow_gouge=settings.allow_gouge,
-                     progress=gate_progress, processes=settings.processes)
+    def judged(program: Program) -> tuple[Verdict, dict | None]:
+        def verdict() -> Verdict:
+            return judge(program, part, f"cadcnc: {what}", gcode=settings.gcode,
+                         allow_partial=settings.allow_partial,
+                         allow_gouge=settings.allow_gouge, progress=gate_progress,
+                         processes=settings.processes)
+
+        if not outputs or jobs == 1:
+            return verdict(), None
+        pieces = RenderPieces(program, outputs, part, _title(program, what), jobs,
+                              settings.gcode or {})
+        # this process makes its outputs first: the workers have the JSON to make before
+        # the gate's tasks reach them
+        (here, found), done = beside(lambda: (pieces.here(), verdict()), render_piece,
+                                     pieces.tasks, part, jobs, "writing outputs",
+                                     pieces.sizes)
+        return found, pieces.joined(here, done)
 
     if join is not None and program.cuts and not settings.allow_gouge:
-        verdict = judged(program)
+        verdict, contents = judged(program)
         if verdict.gate is not None and verdict.gate.ok:
-            return program, verdict
+            return program, verdict, contents
     if join is not None:
         program = settle(program, part, safe_height(part, job), join, f"{step}: {what}",
                          settings.allow_gouge, processes=settings.processes)
-    return program, judged(program)
+    return (program, *judged(program))
+
+
+def _title(program: Program, what: str) -> str:
+    """The outputs' title: the operation, the ball and the part's file name."""
+    job = program.job
+    return f"{what} R {job.tool.radius:g} of {Path(job.source or '').name}"
 
 
 def rendered(outcome: Outcome, outputs, what: str, settings: Settings) -> dict:
     """``{output: bytes or str}`` of every output, by its suffix, titled by the operation,
-    the ball and the part's file name."""
-    job = outcome.program.job
-    title = f"{what} R {job.tool.radius:g} of {Path(job.source or '').name}"
-    return render_all(outcome.program, outputs, outcome.part, title, settings.processes,
-                      **(settings.gcode or {}))
+    the ball and the part's file name (those :func:`operate` rendered beside the gate,
+    when it was given the same ``outputs``)."""
+    outputs = list(outputs)
+    made = outcome.contents
+    if made is not None and list(made) == outputs and what == outcome.what:
+        return made
+    return render_all(outcome.program, outputs, outcome.part, _title(outcome.program, what),
+                      settings.processes, **(settings.gcode or {}))

@@ -58,7 +58,7 @@ def _run(step, job, what, outputs, settings, stream, *, progress, times, gate_pr
     for out in stream.outputs if stream is not None else ():
         check_destination(out, STREAM_SUFFIXES, [step])
     done = operate(step, job, what, settings, progress=progress, times=times,
-                   gate_progress=gate_progress)
+                   gate_progress=gate_progress, outputs=outputs)
     run = OperationRun(done, code=done.verdict.code)
     if done.verdict.write:
         written.write(rendered(done, outputs, done.what, settings))

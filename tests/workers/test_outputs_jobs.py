@@ -14,7 +14,8 @@ from cadcnc.geometry.setup import setup_part
 from cadcnc.io.gcode import blend_for
 from cadcnc.io.outputs import render, render_all
 from cadcnc.io.program_json import RUNS_PER_JOB, _runs
-from cadcnc.parallel.pool import START_ENV
+from cadcnc.parallel.pool import START_ENV, kept_pools
+from cadcnc.pipeline.operate import Settings, operate, rendered
 from helpers.fixtures import FIXTURES
 
 
@@ -55,3 +56,25 @@ def test_every_output_made_on_two_processes_is_the_same_bytes(programs, monkeypa
     assert one["p.ngc"] == render(program, "p.ngc", part, "slot", **gcode)
     with pytest.raises(OutputError, match="unknown output format"):
         render_all(program, ["p.json", "p.txt"], part, "slot", 2)
+
+
+def test_outputs_rendered_beside_the_gate_are_those_written_after_it(tmp_path, monkeypatch):
+    """``operate`` given the outputs at two processes renders them on the workers while
+    it gates (``Outcome.contents``): the bytes ``render_all`` makes of the judged program
+    afterwards, which ``rendered`` then hands back without rendering again; at one
+    process nothing is made ahead."""
+    monkeypatch.setenv(START_ENV, "fork")
+    step = FIXTURES / "step_slot.step"
+    job = cadcnc.Job(cadcnc.Tool(3.0), 1500, 0.004, cadcnc.Pencil(), source=str(step))
+    outs = [str(tmp_path / "p.json"), str(tmp_path / "p.ngc")]
+    gcode = dict(blend=blend_for(job.tolerances.gouge), tolerance=None, tool_tip=False)
+    two = Settings(gcode=gcode, processes=2)
+    with kept_pools():
+        done = operate(step, job, "pencil", two, outputs=outs)
+        assert done.verdict.write and done.contents is not None and list(done.contents) == outs
+        again = render_all(done.program, outs, done.part, f"pencil R 3 of {step.name}",
+                           **gcode)
+        assert done.contents == again
+        assert rendered(done, outs, done.what, two) is done.contents
+    one = operate(step, job, "pencil", Settings(gcode=gcode, processes=1), outputs=outs)
+    assert one.contents is None and rendered(one, outs, one.what, two) == again
