@@ -124,6 +124,14 @@ class FaceSurface:
             return INSIDE
         return BOUNDARY if state == TopAbs_ON else OUTSIDE
 
+    def classify_grid(self, us, ws) -> np.ndarray:
+        """(len(us), len(ws)) object array: :meth:`classify` of every node of the grid
+        ``us`` x ``ws``, read from the kernel's trim grid where the face has one (the same
+        answers, FClass2d asked only in its MIXED cells), else node by node."""
+        if self.kernel:
+            return self.kernel[1].classify_grid(us, ws)
+        return np.array([[self.classify(u, w) for w in ws] for u in us], dtype=object)
+
     def contains(self, u: float, w: float) -> bool:
         """True for points inside the trimmed face or on its boundary."""
         return self.classify(u, w) != OUTSIDE

@@ -11,7 +11,6 @@ import pytest
 
 import cadcnc
 from cadcnc.geometry.trim_grid import TrimGrid
-from cadcnc.ops.finish import plan
 
 FIXTURES = Path(__file__).resolve().parents[2] / "fixtures"
 CASES = ["finish_hole", "six_pockets", "thin_ring", "finish_wave", "dome_pole"]
@@ -21,7 +20,7 @@ CASES = ["finish_hole", "six_pockets", "thin_ring", "finish_wave", "dome_pole"]
 def test_grid_nodes_agree_with_fclass2d(name):
     """Every face: a 61 x 47 grid over the face's (u, w) box enlarged 3 % each side, so
     that nodes fall inside, outside and beside every trim: 0 disagreements, and the
-    sampler's classification (``plan._classified``) is the same."""
+    face's own ``classify_grid`` (the sampler's) is the same."""
     part = cadcnc.load_step(FIXTURES / f"{name}.step")
     checked = outside = 0
     for face in part.faces:
@@ -35,7 +34,7 @@ def test_grid_nodes_agree_with_fclass2d(name):
         bad = [(face.number, a, b, expected[a, b], got[a, b])
                for a, b in zip(*np.nonzero(got != expected))]
         assert bad == [], bad[:5]
-        assert (plan._classified(face, us, ws) == expected).all()
+        assert (face.classify_grid(us, ws) == expected).all()
         checked += got.size
         outside += int((expected == "outside").sum())
     assert checked > 0 and outside > 0   # the trims were met

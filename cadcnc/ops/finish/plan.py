@@ -99,7 +99,7 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
         (u0, u1), (w0, w1) = s.u_range, s.w_range
         us, wu = _nodes(u0, u1, nu)
         ws, ww = _nodes(w0, w1, nw)
-        inside = _classified(s, us, ws) != OUTSIDE
+        inside = s.classify_grid(us, ws) != OUTSIDE
         numbers.extend([s.number] * int(inside.sum()))
         weights.extend((wu[:, None] * ww[None, :])[inside].tolist())
         wrap = [per is not None and abs(hi - lo - per) <= 1e-9 * max(1.0, per)  # whole period
@@ -128,16 +128,6 @@ def sample_faces(part, faces, spacing: float, max_samples: int = MAX_SAMPLES) ->
     return FaceSamples(d[:, 0], normals, d[:, 1], d[:, 2], d[:, 3], d[:, 4], d[:, 5],
                        numbers, area * np.array(weights)[keep], spacing,
                        np.array(edge, bool)[keep])
-
-
-def _classified(face, us: np.ndarray, ws: np.ndarray) -> np.ndarray:
-    """(len(us), len(ws)) ``face.classify`` of every node of the grid ``us`` x ``ws``: read
-    from the face's trim grid where the kernel has one (the same answers, FClass2d asked
-    only in its MIXED cells), else asked node by node."""
-    data = getattr(face, "kernel", None)
-    if data:
-        return data[1].classify_grid(us, ws)
-    return np.array([[face.classify(u, w) for w in ws] for u in us], dtype=object)
 
 
 def _edge_nodes(inside: np.ndarray, wrap_u: bool, wrap_w: bool) -> np.ndarray:
