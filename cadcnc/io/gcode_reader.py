@@ -35,9 +35,10 @@ def rs274_path() -> str:
     return exe
 
 
-def canonical_calls(file) -> list[tuple[str, list[str]]]:
+def canonical_calls(file, strict: bool = False) -> list[tuple[str, list[str]]]:
     """rs274's canonical calls for the program ``file``: [(name, arguments)]; InputError
-    naming the file and rs274's message when it does not run to PROGRAM_END."""
+    naming the file and rs274's message when it does not run to PROGRAM_END, or
+    (``strict``: a test's reading) when it reports any error on the way."""
     file = Path(file)
     if not file.is_file():
         raise InputError(f"{file}: no such file")
@@ -48,9 +49,10 @@ def canonical_calls(file) -> list[tuple[str, list[str]]]:
         text = out.read_text() if out.exists() else ""
     calls = [(m.group(1), [a.strip() for a in m.group(2).split(",")])
              for m in map(CALL.match, text.splitlines()) if m]
-    if run.returncode != 0 or not any(name == "PROGRAM_END" for name, _ in calls):
-        msg = " ".join(ln.strip() for ln in run.stderr.splitlines()
-                       if ln.strip() and ln.strip() != "executing")
+    msg = " ".join(ln.strip() for ln in run.stderr.splitlines()
+                   if ln.strip() and ln.strip() != "executing")
+    if run.returncode != 0 or not any(name == "PROGRAM_END" for name, _ in calls) or \
+            (strict and msg):
         raise InputError(f"{file}: rs274 could not read the program ({msg or 'no M2'})")
     return calls
 
