@@ -95,14 +95,15 @@ def test_gcode_segments_are_the_program_moves(shelf, shelf_api):
 def test_rs274_reads_the_program(shelf, shelf_api, tmp_path):
     """rs274's feed moves are the cuts' points and the links' plunges, its traverses the
     links' rapids, in order, with the plunge feed then the cutting feed."""
+    from cadcnc.io.gcode_reader import canonical_calls
     from cadcnc.testing.rs274 import feed_points
 
     d, _, _ = shelf
     text = (d / "s.ngc").read_text()
     feeds = feed_points(tmp_path, text)
-    canon = (tmp_path / "canon.txt").read_text()
-    traverses = np.array([[float(v) for v in m.group(1).split(",")[:3]]
-                          for m in re.finditer(r"STRAIGHT_TRAVERSE\(([^)]*)\)", canon)])
+    calls = canonical_calls(tmp_path / "prog.ngc", strict=True)
+    traverses = np.array([[float(v) for v in args[:3]] for name, args in calls
+                          if name == "STRAIGHT_TRAVERSE"])
     want_feed, want_rapid = [], []
     for seg in shelf_api.segments:
         if seg.kind == "cut":
@@ -114,7 +115,7 @@ def test_rs274_reads_the_program(shelf, shelf_api, tmp_path):
     np.testing.assert_allclose(feeds, np.array(want_feed), rtol=0, atol=half)
     # rs274 adds the header's two rapids (to the first height, then over the start)
     np.testing.assert_allclose(traverses[2:], np.array(want_rapid), rtol=0, atol=half)
-    rates = [float(v) for v in re.findall(r"SET_FEED_RATE\(([^)]*)\)", canon)]
+    rates = [float(args[0]) for name, args in calls if name == "SET_FEED_RATE"]
     assert [r for r in rates if r] == [300.0, 1500.0, 300.0, 1500.0]
 
 
