@@ -10,10 +10,11 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable, TypeVar
 
 import numpy as np
 
-from ..core.errors import InputError, NothingToCutError
+from ..core.errors import CadcncError, InputError, NothingToCutError
 from ..core.job import Job
 from ..core.work_limits import MAX_CYCLES
 from ..geometry.part import Part, load_step
@@ -27,6 +28,8 @@ from ..program.program import Program
 from ..verification.gate_cache import open_shared
 from .exit_policy import Verdict, judge, settle
 from .program_plan import plan
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -153,9 +156,11 @@ def _settled(program: Program, part: Part, job: Job, step, what: str, settings: 
                               settings.gcode or {})
         # this process makes its outputs first: the workers have the JSON to make before
         # the gate's tasks reach them
-        (here, found), done = beside(lambda: (pieces.here(), verdict()), render_piece,
+        (here, found), done = beside(lambda: (_kept(pieces.here), verdict()), _render_kept,
                                      pieces.tasks, part, jobs, "writing outputs",
                                      pieces.sizes)
+        if isinstance(here, CadcncError) or any(isinstance(d, CadcncError) for d in done):
+            return found, None   # made again, and refused, only if the verdict writes them
         return found, pieces.joined(here, done)
 
     if join is not None and program.cuts and not settings.allow_gouge:
@@ -166,6 +171,21 @@ def _settled(program: Program, part: Part, job: Job, step, what: str, settings: 
         program = settle(program, part, safe_height(part, job), join, f"{step}: {what}",
                          settings.allow_gouge, processes=settings.processes)
     return (program, *judged(program))
+
+
+def _kept(fn: Callable[[], T]) -> T | CadcncError:
+    """``fn()``, or the library error it raised: an output made ahead of the verdict
+    fails only where the verdict asks for it (the gate's exit code comes first)."""
+    try:
+        return fn()
+    except CadcncError as e:
+        return e
+
+
+def _render_kept(part, task, beat=None):
+    """:func:`~cadcnc.io.outputs.render_piece` (an on_workers task), its library error
+    returned, not raised (:func:`_kept`)."""
+    return _kept(lambda: render_piece(part, task))
 
 
 def _title(program: Program, what: str) -> str:

@@ -15,6 +15,7 @@ from cadcnc.io.gcode import blend_for
 from cadcnc.io.outputs import render, render_all
 from cadcnc.io.program_json import RUNS_PER_JOB, _runs
 from cadcnc.parallel.pool import START_ENV, kept_pools
+from cadcnc.pipeline import operate as operate_module
 from cadcnc.pipeline.operate import Settings, operate, rendered
 from helpers.fixtures import FIXTURES
 
@@ -78,3 +79,24 @@ def test_outputs_rendered_beside_the_gate_are_those_written_after_it(tmp_path, m
         assert rendered(done, outs, done.what, two) is done.contents
     one = operate(step, job, "pencil", Settings(gcode=gcode, processes=1), outputs=outs)
     assert one.contents is None and rendered(one, outs, one.what, two) == again
+
+
+def _unmakeable(part, task, beat=None):
+    raise OutputError("this output cannot be made")
+
+
+def test_an_output_failing_ahead_of_the_verdict_does_not_pre_empt_it(tmp_path, monkeypatch):
+    """An output made beside the gate that fails (here every worker's piece) is not
+    raised there: ``operate`` returns its verdict with no contents, and the outputs are
+    made again, by ``rendered``, only when the verdict writes them: the gate's exit code
+    comes first, as at one process."""
+    monkeypatch.setenv(START_ENV, "fork")
+    monkeypatch.setattr(operate_module, "render_piece", _unmakeable)   # the forks inherit it
+    step = FIXTURES / "step_slot.step"
+    job = cadcnc.Job(cadcnc.Tool(3.0), 1500, 0.004, cadcnc.Pencil(), source=str(step))
+    outs = [str(tmp_path / "p.json"), str(tmp_path / "p.ngc")]
+    two = Settings(gcode=dict(blend=blend_for(job.tolerances.gouge)), processes=2)
+    with kept_pools():
+        done = operate(step, job, "pencil", two, outputs=outs)
+    assert done.verdict.write and done.contents is None
+    assert set(rendered(done, outs, done.what, two)) == set(outs)
