@@ -216,7 +216,9 @@ class Pools:
 
     def __init__(self) -> None:
         self._held: dict[int, tuple[Any, int, ProcessPoolExecutor]] = {}  # id(part) -> ...
-        self._busy: set[int] = set()   # parts whose map_ordered runs now (another thread's)
+        self._busy: dict[int, int] = {}   # id(part) -> its map_ordered calls running now
+                                          # (another thread's, or nested in a meanwhile)
+        self._lock = threading.Lock()
 
     def __enter__(self) -> "Pools":
         return self
@@ -253,12 +255,18 @@ class Pools:
 
     @contextmanager
     def busy(self, part) -> Iterator[None]:
-        """Mark ``part``'s pool as running tasks: another part's call leaves it alone."""
-        self._busy.add(id(part))
+        """Mark ``part``'s pool as running tasks: another part's call leaves it alone
+        (nested calls counted: a ``meanwhile`` may run tasks of its own on the pool)."""
+        key = id(part)
+        with self._lock:
+            self._busy[key] = self._busy.get(key, 0) + 1
         try:
             yield
         finally:
-            self._busy.discard(id(part))
+            with self._lock:
+                self._busy[key] -= 1
+                if not self._busy[key]:
+                    del self._busy[key]
 
     def close(self) -> None:
         """Shut every kept pool down (its workers exit)."""
