@@ -52,7 +52,8 @@ class GateResult:
 
 
 def gouge_gate(toolpath, part=None, tol: Tolerances | None = None, *, moves=None,
-               blend_mm: float = 0.0, progress=None, reference: bool = False) -> GateResult:
+               blend_mm: float = 0.0, progress=None, reference: bool = False,
+               before=None) -> GateResult:
     """Whether ``toolpath`` clears every face of ``part`` within ``tol.gouge`` (fails closed).
 
     ``part`` defaults to the STEP file the toolpath's job names; ``tol`` to the job's
@@ -64,6 +65,8 @@ def gouge_gate(toolpath, part=None, tol: Tolerances | None = None, *, moves=None
     as the checks advance ("surfaces", "whole part", "moves"). ``reference``: the gate
     as it was before its work was shared (:mod:`.gate_cache`) and bounded (a sampled
     cycle's exact distance always measured): the same answers, kept to test that.
+    ``before``: (point, uv, faces) of the centre the moves start beside, the previous
+    cut's last (:func:`~.whole_part.before_floors`; not with ``reference``).
     """
     require("toolpath", toolpath, Toolpath, "a cadcnc Toolpath")
     limit = math.nan
@@ -78,7 +81,7 @@ def gouge_gate(toolpath, part=None, tol: Tolerances | None = None, *, moves=None
         if reference:
             part, probes = prepare(toolpath, part, tol)
             surfaces = check_pair(toolpath, probes, tol, SAMPLE_UNSEEDED, progress)
-            shared = {}
+            shared, before = {}, None
         else:
             part = resolve_part(toolpath, part)
             cache = cache_for(part, tol)
@@ -92,7 +95,7 @@ def gouge_gate(toolpath, part=None, tol: Tolerances | None = None, *, moves=None
             shared = dict(faces=cache.faces, material=cache.material)
         whole, sweep = check_whole_part(part, probes, toolpath, surfaces,
                                         toolpath.job.tool.offset, tol, progress, moves=moves,
-                                        limit=limit, blend=blend, **shared)
+                                        limit=limit, blend=blend, before=before, **shared)
         depth = strict_max([whole.max_depth_mm, sweep.depth_mm])
     except Exception as e:  # noqa: BLE001 - any failure refuses the path
         return GateResult(False, math.nan, [], limit,

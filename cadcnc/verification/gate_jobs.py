@@ -20,7 +20,7 @@ from .surface_checks import resolve_part
 
 def _gate_task(part, task, beat=None) -> tuple[GateResult, tuple | None]:
     """One cut's gate (in a worker or here) and, when asked, what it found to share."""
-    toolpath, moves, blend, tol, reference, share, want = task
+    toolpath, moves, blend, before, tol, reference, share, want = task
     since = 0
     if want:  # a worker: its gates share their work while its pool lives
         open_shared(part)
@@ -28,14 +28,16 @@ def _gate_task(part, task, beat=None) -> tuple[GateResult, tuple | None]:
         cache = cache_for(part, tol)
         cache.take(share)
         since = len(cache.memo)
-    result = gouge_gate(toolpath, part, tol, moves=moves, blend_mm=blend, reference=reference)
+    result = gouge_gate(toolpath, part, tol, moves=moves, blend_mm=blend, reference=reference,
+                        before=before)
     out = cache.share(toolpath_key(toolpath), since) if want and not reference else None
     return result, out
 
 
 def gate_cuts(part, items: list, tol: Tolerances, *, jobs: int | None = 1,
               reference: bool = False, progress=None) -> list[GateResult]:
-    """The gate of each ``(toolpath, moves or None, blend_mm)`` of ``items`` on ``part``.
+    """The gate of each ``(toolpath, moves or None, blend_mm[, before])`` of ``items`` on
+    ``part`` (``before``: :func:`~.gate.gouge_gate`'s).
 
     ``jobs``: processes (None: every core; 1: here, in order). ``progress(done, total,
     "cuts")`` as each gate ends."""
@@ -43,9 +45,10 @@ def gate_cuts(part, items: list, tol: Tolerances, *, jobs: int | None = 1,
         part = resolve_part(items[0][0], None)
     shares = None if reference else cache_for(part, tol).shares
     many = jobs != 1 and len(items) > 1
-    tasks = [(tp, moves, float(blend), tol, reference,
+    items = [(*item, None)[:4] for item in items]
+    tasks = [(tp, moves, float(blend), before, tol, reference,
               None if shares is None or not many else shares.get(toolpath_key(tp)), many)
-             for tp, moves, blend in items]
+             for tp, moves, blend, before in items]
     count = [0]
 
     def arrived(k: int, res) -> None:
@@ -55,7 +58,7 @@ def gate_cuts(part, items: list, tol: Tolerances, *, jobs: int | None = 1,
         if progress is not None:
             progress(count[0], len(tasks), "cuts")
 
-    sizes = [len(tp.points) + (0 if moves is None else len(moves)) for tp, moves, _ in items]
+    sizes = [len(tp.points) + (0 if moves is None else len(moves)) for tp, moves, *_ in items]
     out = on_workers(_gate_task, tasks, part, jobs, arrived, "the gate of cut", sizes=sizes)
     return [r for r, _ in out]
 

@@ -108,6 +108,12 @@ def _in_links(result: GateResult, own: range) -> bool:
                for lo, hi in h.moves for k in range(lo, hi + 1))
 
 
+def last_centre(path) -> tuple:
+    """(point (3,), uv (2, 2), faces) of a toolpath's last centre: where the moves of the
+    next cut (its link first) start, as :func:`~.whole_part.before_floors` takes it."""
+    return path.points[-1], path.uv[-1], path.faces
+
+
 def cut_label(k: int, seg) -> str:
     where = "".join(f", {w} {v}" for w, v in (("edge", seg.edge), ("stretch", seg.stretch))
                     if v)
@@ -137,14 +143,15 @@ def gate_program(program, part=None, tol: Tolerances | None = None, *, moves=Non
     if not program.cuts:
         return ProgramGate([], labels, [])
     part = resolve_part(program.cuts[0].path, part)
+    befores = [None] + [last_centre(seg.path) for seg in program.cuts[:-1]]
     with shared_gates(part):  # the cuts share faces, probes and distances
         if jobs == 1:
             results = [gouge_gate(seg.path, part, tol, moves=m, blend_mm=blend_mm,
-                                  progress=progress, reference=reference)
-                       for seg, (m, _) in zip(program.cuts, per_cut)]
+                                  progress=progress, reference=reference, before=before)
+                       for seg, (m, _), before in zip(program.cuts, per_cut, befores)]
         else:
-            results = gate_cuts(part, [(seg.path, m, blend_mm)
-                                       for seg, (m, _) in zip(program.cuts, per_cut)],
+            results = gate_cuts(part, [(seg.path, m, blend_mm, before) for seg, (m, _), before
+                                       in zip(program.cuts, per_cut, befores)],
                                 tol, jobs=jobs, reference=reference, progress=progress)
     links = [not r.ok and _in_links(r, own) for r, (_, own) in zip(results, per_cut)]
     return ProgramGate(results, labels, links)

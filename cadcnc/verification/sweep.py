@@ -46,13 +46,14 @@ class Polyline:
     ``known``: {face: (unsigned, signed) (N,) distances} measured elsewhere (the pair's
     faces at the centres). ``anchors``: (match (N,) index into the anchor points,
     anchor points (K, 3), {face: (K,) distances, nan where unknown}): distances known at
-    nearby points, which bound these by the Lipschitz rule.
+    nearby points, which bound these by the Lipschitz rule. ``floors``: {face: (N,) lower
+    bounds of the points' distances} proven elsewhere (:func:`~.whole_part.before_floors`).
     """
 
     def __init__(self, faces: PartFaces, material: Material, points, ball: float, *,
                  hit: float | None = None, allowance: float | None = None,
-                 known: dict | None = None, anchors=None, progress=None,
-                 stage: str = "whole part"):
+                 known: dict | None = None, anchors=None, floors: dict | None = None,
+                 progress=None, stage: str = "whole part"):
         self.faces, self.material = faces, material
         self.points = np.asarray(points, float).reshape(-1, 3)
         bad = np.nonzero(~np.isfinite(self.points).all(axis=1))[0]
@@ -64,7 +65,7 @@ class Polyline:
         # move touches no face, stays out of the material and reaches less than R' deep
         self.clearance = None if allowance is None else max(self.ball - allowance,
                                                             0.5 * self.ball)
-        self.known, self.anchors = known or {}, anchors
+        self.known, self.anchors, self.floors = known or {}, anchors, floors or {}
         self.progress, self.stage = progress, stage
         n = len(self.points)
         self.length = np.linalg.norm(np.diff(self.points, axis=0), axis=1)
@@ -148,6 +149,9 @@ class Polyline:
         ``need`` asks both to be far) or the anchors it passes (:meth:`_inner`) is proven
         without any distance."""
         short = np.nonzero(lb < need)[0]
+        if k in self.floors:   # a floored point's move may be proven by its other end's
+            near = np.nonzero(self.floors[k] > 0.0)[0]
+            short = np.union1d(short, np.clip(np.r_[near - 1, near + 1], 0, len(lb) - 1))
         if len(short):
             floor = self.faces.probe(k).surface_floor(self.points[short])
             if floor is not None:
@@ -212,6 +216,8 @@ class Polyline:
             d, sd, have = np.full(n, np.inf), np.full(n, np.inf), np.zeros(n, bool)
             lb, ub = box.copy(), np.full(n, np.inf)
             self._anchor(k, lb, ub)
+            if k in self.floors:
+                np.maximum(lb, self.floors[k], out=lb)
             near_seg, need, inner = self._proven(k, lb, near_seg, need)
             self._points(k, d, sd, have, lb, need)
         self.d_lb = np.minimum(self.d_lb, np.where(have, d, lb))

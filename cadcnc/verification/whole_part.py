@@ -39,7 +39,8 @@ def check_whole_part(part, probes: dict[int, FaceProbe], toolpath,
                      surfaces: list[SurfaceCheck], ball: float, tol: Tolerances,
                      progress=None, *, moves=None, limit: float | None = None,
                      blend: float = 0.0, faces: PartFaces | None = None,
-                     material: Material | None = None) -> tuple[WholePartCheck, SweepCheck]:
+                     material: Material | None = None,
+                     before=None) -> tuple[WholePartCheck, SweepCheck]:
     """Every face of ``part`` against the ball of radius ``ball`` (R'): at every centre
     (a face is hit where the ball reaches deeper than ``tol.hit``), and swept along every
     straight move of ``moves`` ((M, 3) ball centres; default the toolpath's points), which
@@ -47,6 +48,8 @@ def check_whole_part(part, probes: dict[int, FaceProbe], toolpath,
 
     ``probes``: the pair's probes (others are made here); ``surfaces``: the pair's checks.
     ``faces``, ``material``: the part's, shared with other gates (default: made here).
+    ``before``: (point (3,), uv (2, 2), faces (2,)) of a centre the moves start beside
+    (the previous cut's last): what :func:`before_floors` proves of it bounds the moves.
     """
     limit = tol.gouge if limit is None else limit
     faces = PartFaces(part, probes, tol) if faces is None else faces
@@ -61,12 +64,38 @@ def check_whole_part(part, probes: dict[int, FaceProbe], toolpath,
     line = centres
     if moves is not None:
         moves = np.asarray(moves, float).reshape(-1, 3)
+        floors = None if before is None else before_floors(faces, before, moves, tol)
         line = Polyline(faces, material, moves, ball, allowance=allowance,
-                        anchors=_anchors(centres, moves), progress=progress,
+                        anchors=_anchors(centres, moves), floors=floors, progress=progress,
                         stage="moves").run()
     whole = _whole(centres, surfaces, ball, tol, len(part), material)
     sweep = _sweep(line, ball, allowance, blend, material)
     return whole, sweep
+
+
+def before_floors(faces: PartFaces, before, moves: np.ndarray, tol: Tolerances) -> dict:
+    """{face: (M,) lower bounds of the ``moves``' distances to it} from a centre of
+    another cut, ``before`` = (point (3,), uv (2, 2), faces (2,)): on each of its faces,
+    OCCT's local search from its own (u, w) finds a foot at distance d, and the surface's
+    bound (:meth:`~.probe.FaceProbe.surface_clear`) proves no point of the whole surface
+    nearer than d - noise / 2 (else nothing is claimed); the face is no nearer, and a move
+    point x at most |x - point| nearer (1-Lipschitz)."""
+    point, uv, pair = before
+    point = np.asarray(point, float)
+    gap = np.linalg.norm(moves - point, axis=1)
+    out = {}
+    for side, n in enumerate(pair):
+        if n is None:
+            continue
+        probe = faces.probe(n)
+        found = probe.project_seeded(point, *uv[side])
+        if found is None:
+            continue
+        u, w, d = found
+        floor = d - 0.5 * tol.noise
+        if floor > 0.0 and probe.surface_clear(point, u, w, floor):
+            out[n] = np.maximum(floor - gap, 0.0)
+    return out
 
 
 def _anchors(centres: Polyline, moves: np.ndarray):

@@ -170,3 +170,47 @@ def test_moves_proven_by_their_bounds_need_fewer_distances_and_keep_the_verdict(
     assert now[0] == before[0] and all(now[0])
     assert all(a <= b + 1e-12 for a, b in zip(now[1], before[1]))
     assert now[2] < before[2]
+
+
+def test_the_previous_cuts_last_centre_floors_the_next_cuts_moves(monkeypatch):
+    """``before_floors``: at every move of the wave's program (stepover 10) gated as
+    written, the floor from the previous cut's last centre is at most the distance OCCT
+    measures (DistShapeShape) to that face; gated with it, the verdicts are those without
+    it, depths no deeper (the deepest measured) and fewer point-to-face distances."""
+    from cadcnc.io.gcode import blend_for
+    from cadcnc.io.program_gcode import program_written_moves
+    from cadcnc.ops.finish.shortcut import finish
+    from cadcnc.verification import program_gate
+    from cadcnc.verification.gate_cache import cache_for
+    from cadcnc.verification.program_gate import cut_moves, last_centre
+    from cadcnc.verification.whole_part import before_floors
+    from cadcnc.verification.written_gate import gate_written
+
+    part = wave_part()
+    program = finish(part, [WAVE["top"]], radius=3.0, stepover=10.0)
+    tol = program.job.tolerances
+    gcode = dict(tolerance=None, tool_tip=False, blend=blend_for(tol.gouge))
+    faces = cache_for(part, tol).faces
+    per_cut = cut_moves(program, program_written_moves(program, **gcode))
+    checked = 0
+    for prev, (moves, _) in zip(program.cuts[:-1], per_cut[1:]):
+        floors = before_floors(faces, last_centre(prev.path), moves, tol)
+        assert set(floors) == {WAVE["top"]}   # proven at every pass end of this wave
+        floor, probe = floors[WAVE["top"]], faces.probe(WAVE["top"])
+        for j in np.nonzero(floor > 0.0)[0]:
+            assert floor[j] <= probe.face_distance(moves[j])[1] + ROUND
+            checked += 1
+    assert checked > 0
+
+    def run():
+        gate = gate_written(program, part, gcode)
+        evaluated = sum(r.sweep.distances_evaluated for r in gate.results)
+        assert all(r.sweep.depth_bound_mm <= r.sweep.allowance_mm for r in gate.results)
+        return [r.ok for r in gate.results], [r.depth_mm for r in gate.results], evaluated
+
+    now = run()
+    monkeypatch.setattr(program_gate, "last_centre", lambda path: None)
+    without = run()
+    assert now[0] == without[0] and all(now[0])
+    assert all(a <= b + 1e-12 for a, b in zip(now[1], without[1]))
+    assert now[2] < without[2]
