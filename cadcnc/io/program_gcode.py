@@ -171,6 +171,11 @@ def _as_written(points: np.ndarray, digits: int, dz: float) -> np.ndarray:
     return written_decimals(pts.ravel(), digits).reshape(-1, 3) + (0.0, 0.0, dz)
 
 
+DOUBT = 1e-6
+"""A value times 10^digits nearer a half than this is rounded as Python formats it (the
+product's own rounding is below 2^-50 of 2^50 = 1 there)."""
+
+
 def written_decimals(values: np.ndarray, digits: int) -> np.ndarray:
     """(N,) ``float(f"{v:.{digits}f}")`` of each value ("-0" read as 0): the decimal a
     program writes, read back. Vectorised: the text's integer k = v 10^digits rounded
@@ -183,11 +188,6 @@ def written_decimals(values: np.ndarray, digits: int) -> np.ndarray:
     doubt = ~(np.abs(x) < 2.0 ** 50) | (np.abs(np.abs(x - np.trunc(x)) - 0.5) < DOUBT)
     out[doubt] = [float(f"{v:.{digits}f}") for v in values[doubt].tolist()]
     return out + 0.0
-
-
-DOUBT = 1e-6
-"""A value times 10^digits nearer a half than this is rounded as Python formats it (the
-product's own rounding is below 2^-50 of 2^50 = 1 there)."""
 
 
 def to_ngc(paths, *, safe_z: float | None = None, **options) -> str:

@@ -38,7 +38,7 @@ def cut_back(program: Program, part, z_safe: float, join: float = 0.0, *,
     tol = program.job.tolerances
     cuts, skipped = [], list(program.skipped)
     changed = False
-    gates = gate_cuts(part, [(seg.path, None, 0.0) for seg in program.cuts], tol,
+    gates = gate_cuts(part, [(seg.path, None, 0.0, None) for seg in program.cuts], tol,
                       jobs=jobs, reference=reference, progress=progress)
     for seg, gate in zip(program.cuts, gates):
         if gate.ok:

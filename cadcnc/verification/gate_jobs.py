@@ -36,8 +36,8 @@ def _gate_task(part, task, beat=None) -> tuple[GateResult, tuple | None]:
 
 def gate_cuts(part, items: list, tol: Tolerances, *, jobs: int | None = 1,
               reference: bool = False, progress=None) -> list[GateResult]:
-    """The gate of each ``(toolpath, moves or None, blend_mm[, before])`` of ``items`` on
-    ``part`` (``before``: :func:`~.gate.gouge_gate`'s).
+    """The gate of each ``(toolpath, moves or None, blend_mm, before or None)`` of ``items``
+    on ``part`` (``before``: :func:`~.gate.gouge_gate`'s).
 
     ``jobs``: processes (None: every core; 1: here, in order). ``progress(done, total,
     "cuts")`` as each gate ends."""
@@ -45,7 +45,6 @@ def gate_cuts(part, items: list, tol: Tolerances, *, jobs: int | None = 1,
         part = resolve_part(items[0][0], None)
     shares = None if reference else cache_for(part, tol).shares
     many = jobs != 1 and len(items) > 1
-    items = [(*item, None)[:4] for item in items]
     tasks = [(tp, moves, float(blend), before, tol, reference,
               None if shares is None or not many else shares.get(toolpath_key(tp)), many)
              for tp, moves, blend, before in items]

@@ -140,6 +140,34 @@ def test_the_patch_boxes_floor_never_exceeds_occts_distance(name, face):
         assert (exact[30:] - floor[30:]).max() < 1.0
 
 
+def _wave_program():
+    """(part, program, G-code keywords): the wave's finish at stepover 10, as written."""
+    from cadcnc.io.gcode import blend_for
+    from cadcnc.ops.finish.shortcut import finish
+
+    part = wave_part()
+    program = finish(part, [WAVE["top"]], radius=3.0, stepover=10.0)
+    return part, program, dict(tolerance=None, tool_tip=False,
+                               blend=blend_for(program.job.tolerances.gouge))
+
+
+def _gated(part, program, gcode) -> tuple[list, list, int]:
+    """(verdicts, depths, point-to-face distances) of the program gated as written; every
+    move's proven depth bound within the allowance."""
+    from cadcnc.verification.written_gate import gate_written
+
+    gate = gate_written(program, part, gcode)
+    assert all(r.sweep.depth_bound_mm <= r.sweep.allowance_mm for r in gate.results)
+    return ([r.ok for r in gate.results], [r.depth_mm for r in gate.results],
+            sum(r.sweep.distances_evaluated for r in gate.results))
+
+
+def _same_verdicts_no_deeper_fewer(now, without) -> None:
+    assert now[0] == without[0] and all(now[0])
+    assert all(a <= b + 1e-12 for a, b in zip(now[1], without[1]))
+    assert now[2] < without[2]
+
+
 def test_moves_proven_by_their_bounds_need_fewer_distances_and_keep_the_verdict(
         monkeypatch):
     """The wave's finish (stepover 10) gated as written: with the patch boxes' floor and
@@ -148,28 +176,13 @@ def test_moves_proven_by_their_bounds_need_fewer_distances_and_keep_the_verdict(
     point-to-face distances. A cut's depth is the deepest measured (a lower bound of the
     true deepest): with fewer measurements it is no deeper; the proven bound of every
     move's depth stays within the allowance."""
-    from cadcnc.io.gcode import blend_for
-    from cadcnc.ops.finish.shortcut import finish
     from cadcnc.verification import sweep
-    from cadcnc.verification.written_gate import gate_written
 
-    part = wave_part()
-    program = finish(part, [WAVE["top"]], radius=3.0, stepover=10.0)
-    gcode = dict(tolerance=None, tool_tip=False, blend=blend_for(program.job.tolerances.gouge))
-
-    def run():
-        gate = gate_written(program, part, gcode)
-        evaluated = sum(r.sweep.distances_evaluated for r in gate.results)
-        assert all(r.sweep.depth_bound_mm <= r.sweep.allowance_mm for r in gate.results)
-        return [r.ok for r in gate.results], [r.depth_mm for r in gate.results], evaluated
-
-    now = run()
+    part, program, gcode = _wave_program()
+    now = _gated(part, program, gcode)
     monkeypatch.setattr(sweep.Polyline, "_proven",
                         lambda self, k, lb, near_seg, need: (near_seg, need, None))
-    before = run()
-    assert now[0] == before[0] and all(now[0])
-    assert all(a <= b + 1e-12 for a, b in zip(now[1], before[1]))
-    assert now[2] < before[2]
+    _same_verdicts_no_deeper_fewer(now, _gated(part, program, gcode))
 
 
 def test_the_previous_cuts_last_centre_floors_the_next_cuts_moves(monkeypatch):
@@ -177,19 +190,14 @@ def test_the_previous_cuts_last_centre_floors_the_next_cuts_moves(monkeypatch):
     written, the floor from the previous cut's last centre is at most the distance OCCT
     measures (DistShapeShape) to that face; gated with it, the verdicts are those without
     it, depths no deeper (the deepest measured) and fewer point-to-face distances."""
-    from cadcnc.io.gcode import blend_for
     from cadcnc.io.program_gcode import program_written_moves
-    from cadcnc.ops.finish.shortcut import finish
     from cadcnc.verification import program_gate
     from cadcnc.verification.gate_cache import cache_for
     from cadcnc.verification.program_gate import cut_moves, last_centre
     from cadcnc.verification.whole_part import before_floors
-    from cadcnc.verification.written_gate import gate_written
 
-    part = wave_part()
-    program = finish(part, [WAVE["top"]], radius=3.0, stepover=10.0)
+    part, program, gcode = _wave_program()
     tol = program.job.tolerances
-    gcode = dict(tolerance=None, tool_tip=False, blend=blend_for(tol.gouge))
     faces = cache_for(part, tol).faces
     per_cut = cut_moves(program, program_written_moves(program, **gcode))
     checked = 0
@@ -201,16 +209,6 @@ def test_the_previous_cuts_last_centre_floors_the_next_cuts_moves(monkeypatch):
             assert floor[j] <= probe.face_distance(moves[j])[1] + ROUND
             checked += 1
     assert checked > 0
-
-    def run():
-        gate = gate_written(program, part, gcode)
-        evaluated = sum(r.sweep.distances_evaluated for r in gate.results)
-        assert all(r.sweep.depth_bound_mm <= r.sweep.allowance_mm for r in gate.results)
-        return [r.ok for r in gate.results], [r.depth_mm for r in gate.results], evaluated
-
-    now = run()
+    now = _gated(part, program, gcode)
     monkeypatch.setattr(program_gate, "last_centre", lambda path: None)
-    without = run()
-    assert now[0] == without[0] and all(now[0])
-    assert all(a <= b + 1e-12 for a, b in zip(now[1], without[1]))
-    assert now[2] < without[2]
+    _same_verdicts_no_deeper_fewer(now, _gated(part, program, gcode))
