@@ -36,7 +36,7 @@ import numpy as np
 from numba import njit
 
 from ..core.errors import EXIT_GOUGE, CadcncError, InputError
-from . import topp
+from . import plan_once, topp
 from .machine import Machine
 from .pieces import Piece, constant_speed
 from .runs import JOIN_SHARE, Run, runs_of
@@ -95,9 +95,13 @@ class Profile:
 
 @njit(cache=True, error_model="numpy")
 def _positions(t, s, v, a, S, window: float, tau, out) -> None:
-    """Profile.position into ``out``: s(t) averaged over ``window`` (or s(t) if 0)."""
+    """Profile.position into ``out``: s(t) averaged over ``window`` (or s(t) if 0),
+    ``tau`` non-decreasing or not (sorted sweeps are linear)."""
+    if len(tau) and (tau[1:] >= tau[:-1]).all():
+        topp.averaged_sweep(t, s, v, a, S, window, tau, out)
+        return
     for i in range(len(tau)):
-        out[i] = topp.averaged(t, s, v, a, S, window, tau[i])
+        out[i] = topp.averaged(t, s, v, a, S, window, tau[i], 0)
 
 
 def _limits(machine: Machine, derate=(1.0, 1.0, 1.0)):
@@ -111,12 +115,8 @@ def _limits(machine: Machine, derate=(1.0, 1.0, 1.0)):
 
 def _speed_limits(run: Run, V, J, period: float) -> np.ndarray:
     """(n,) the squared speed limit at each grid point (before erosion)."""
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        terms = [run.cap ** 2,
-                 np.min((V / np.abs(run.T)) ** 2, axis=1),
-                 np.min((D_SHARE * J / run.D) ** (2.0 / 3.0), axis=1),
-                 np.min(JOIN_SHARE * J * period / run.jump, axis=1)]
-    return np.nan_to_num(np.min(terms, axis=0), nan=math.inf, posinf=math.inf)
+    return plan_once.speed_limits(run.cap, run.T, run.D, run.jump, V, J, period, D_SHARE,
+                                  JOIN_SHARE)
 
 
 def _plan_once(run: Run, wl: np.ndarray, V, A, J, period: float, window: float,
@@ -124,28 +124,10 @@ def _plan_once(run: Run, wl: np.ndarray, V, A, J, period: float, window: float,
     """One plan of the run with averaging ``window`` and the Coriolis term's share
     ``coriolis`` of J, the path's derivatives taken over ``reach`` ((lo, hi) (n,) arc
     lengths around each point; None: +- the top speed times the window): t, w, u, v, a,
-    S and per knot the window needed."""
-    s = run.s
-    wl_e = topp.erode(s, wl, window)
-    top = float(np.sqrt(np.max(wl_e[np.isfinite(wl_e)], initial=0.0)))
-    if reach is None:
-        reach = (s - top * window, s + top * window)
-    t_lo, t_hi = topp.boxes(s, run.T, *reach)
-    k_lo, k_hi = topp.boxes(s, run.K, *reach)
-    Tc, Tr = 0.5 * (t_lo + t_hi), 0.5 * (t_hi - t_lo)
-    Kc, Kr = 0.5 * (k_lo + k_hi), 0.5 * (k_hi - k_lo)
-    Kmax = np.maximum(np.abs(k_lo), np.abs(k_hi))
-    C = coriolis * J
-    w, u = topp.passes(s, wl_e, Tc, Tr, Kc, Kr, Kmax, A, C)
-    t, v, a, S = topp.time_law(s, w, u)
-    cap = np.minimum(wl_e, top * top)[:, None]
-    with np.errstate(invalid="ignore", over="ignore"):
-        static = (run.D * cap ** 1.5 + run.jump * cap / period
-                  + run.kink * np.sqrt(cap) / period ** 2)
-    static = topp.boxes(s, np.nan_to_num(static, nan=0.0), *reach)[1]
-    Tabs = np.maximum(np.abs(t_lo), np.abs(t_hi))
-    need = topp.window_needed(t, v, a, Tabs, Kmax, static, J, C, window)
-    return t, w, u, v, a, S, need
+    S and per knot the window needed (:func:`.plan_once.plan_once`)."""
+    lo, hi = (run.s, run.s) if reach is None else reach
+    return plan_once.plan_once(run.s, wl, run.T, run.K, run.D, run.jump, run.kink, A, J,
+                               period, window, coriolis, lo, hi, reach is not None)
 
 
 def _tightened(run: Run, wl, limits, period: float, window: float, coriolis: float, first):

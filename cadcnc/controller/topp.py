@@ -32,7 +32,8 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
     """(w (n,), u (n - 1,)): the time-optimal squared speeds from rest at s[0] to rest at
     s[-1] and the accelerations between (knots of length 0, a join, keep the speed)."""
     n = len(s)
-    cu, cw, rhs = np.empty(ROWS), np.empty(ROWS), np.empty(ROWS)
+    cu, cw, rhs = np.empty((n, ROWS)), np.empty((n, ROWS)), np.empty((n, ROWS))
+    cor = np.empty(n)   # each knot's constraints, made once for both passes
     buf = np.empty((4, ROWS + 1))   # largest's: the affine bounds on u
     wb = np.empty(n)
     wb[n - 1] = 0.0
@@ -42,11 +43,11 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
         if h <= 0.0:
             wb[k] = min(top, wb[k + 1])
             continue
-        cor = coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
-        if feasible(top, h, wb[k + 1], cu, cw, rhs, cor):
+        cor[k] = coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu[k], cw[k], rhs[k])
+        if feasible(top, h, wb[k + 1], cu[k], cw[k], rhs[k], cor[k]):
             wb[k] = top
         else:
-            wb[k] = largest(top, h, wb[k + 1], cu, cw, rhs, cor, buf)
+            wb[k] = largest(top, h, wb[k + 1], cu[k], cw[k], rhs[k], cor[k], buf)
     w = np.empty(n)
     u = np.zeros(n - 1)
     w[0] = 0.0
@@ -55,8 +56,7 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
         if h <= 0.0:
             w[k + 1] = min(w[k], wb[k + 1])
             continue
-        cor = coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
-        lo, hi = bounds(w[k], h, cu, cw, rhs, cor)
+        lo, hi = bounds(w[k], h, cu[k], cw[k], rhs[k], cor[k])
         x = min(hi, (wb[k + 1] - w[k]) / (2.0 * h))
         x = max(x, lo)
         u[k] = x
@@ -131,28 +131,54 @@ def boxes(s, x, lo_s, hi_s):
 
 
 @njit(cache=True, error_model="numpy")
-def _integral(t, s, v, a, S, tau: float) -> float:
-    """The time integral of s(t) from 0 to tau (s = 0 before 0, s[-1] after the end)."""
+def _knot_at(t, tau: float, k: int) -> int:
+    """The knot holding ``tau``: the last k <= n - 2 with t[k] <= tau (0 before the
+    start), searched forward from ``k`` (a knot at or before it: callers whose times
+    only grow keep it, so that a sweep is linear)."""
+    last = len(t) - 2
+    k = min(max(k, 0), last)
+    while k < last and t[k + 1] <= tau:
+        k += 1
+    return k
+
+
+@njit(cache=True, error_model="numpy")
+def _integral(t, s, v, a, S, tau: float, k: int) -> float:
+    """The time integral of s(t) from 0 to tau (s = 0 before 0, s[-1] after the end);
+    ``k``: a knot at or before tau's (:func:`_knot_at`)."""
     if tau <= 0.0:
         return 0.0
     n = len(t)
     end = t[n - 1]
-    k = min(max(np.searchsorted(t, tau, side="right") - 1, 0), n - 2)
+    k = _knot_at(t, tau, k)
     x = min(tau, end) - t[k]
     return (S[k] + s[k] * x + v[k] * x * x / 2.0 + a[k] * x ** 3 / 6.0
             + s[n - 1] * max(tau - end, 0.0))
 
 
 @njit(cache=True, error_model="numpy")
-def averaged(t, s, v, a, S, window: float, tau: float) -> float:
-    """s(t) averaged over the ``window`` s before ``tau`` (s(tau) itself if window 0)."""
+def averaged(t, s, v, a, S, window: float, tau: float, k: int = 0) -> float:
+    """s(t) averaged over the ``window`` s before ``tau`` (s(tau) itself if window 0);
+    ``k``: a knot at or before that of tau - window (0: search from the start)."""
     if window <= 0.0:
         n = len(t)
-        k = min(max(np.searchsorted(t, tau, side="right") - 1, 0), n - 2)
+        k = _knot_at(t, tau, k)
         y = min(max(tau, 0.0), t[n - 1]) - t[k]
         return min(max(s[k] + v[k] * y + a[k] * y * y / 2.0, 0.0), s[n - 1])
-    x = (_integral(t, s, v, a, S, tau) - _integral(t, s, v, a, S, tau - window)) / window
+    early = _knot_at(t, tau - window, k)
+    x = (_integral(t, s, v, a, S, tau, early)
+         - _integral(t, s, v, a, S, tau - window, early)) / window
     return min(max(x, 0.0), s[len(s) - 1])
+
+
+@njit(cache=True, error_model="numpy")
+def averaged_sweep(t, s, v, a, S, window: float, tau, out) -> None:
+    """:func:`averaged` at every time of ``tau`` (non-decreasing) into ``out``, in one
+    forward sweep of the knots."""
+    k = 0
+    for i in range(len(tau)):
+        out[i] = averaged(t, s, v, a, S, window, tau[i], k)
+        k = _knot_at(t, tau[i] - window, k)
 
 
 @njit(cache=True, error_model="numpy")
@@ -162,9 +188,12 @@ def ranges(t, s, v, a, S, window: float):
     speed and acceleration."""
     n = len(t)
     lo, hi = np.empty(n), np.empty(n)
-    for k in range(n):
-        lo[k] = min(averaged(t, s, v, a, S, window, t[k]), s[k])
-        hi[k] = max(averaged(t, s, v, a, S, window, t[k] + window), s[k])
+    k0 = k1 = 0
+    for k in range(n):   # t only grows: both searches sweep forward
+        lo[k] = min(averaged(t, s, v, a, S, window, t[k], k0), s[k])
+        hi[k] = max(averaged(t, s, v, a, S, window, t[k] + window, k1), s[k])
+        k0 = _knot_at(t, t[k] - window, k0)   # the knots these calls started from
+        k1 = _knot_at(t, (t[k] + window) - window, k1)
     return lo, hi
 
 

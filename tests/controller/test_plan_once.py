@@ -1,0 +1,137 @@
+"""The plan's compiled core against the same steps written in NumPy, and the averaged
+motion's forward sweeps against a binary search of every time.
+
+:func:`cadcnc.controller.plan_once.plan_once` repeats erosion, boxes, passes, time law and
+the window each knot needs in one compiled call; here the same steps are spelled out with
+NumPy's array arithmetic on a quarter arc with a curvature jump at its join (the finishing
+pass's shape): the profiles agree to round-off (NumPy's vectorised power and libm's may
+differ in the last bit). The sweeps that turn a profile into per-period arc lengths must
+pick the very knot a binary search picks: equal bits.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from cadcnc.controller import plan_once, topp
+from cadcnc.controller.runs import JOIN_SHARE
+
+V = np.array([57.15, 57.15, 42.3])
+A = np.array([381.0, 381.0, 254.0])
+J = np.array([7620.0, 7620.0, 5080.0])
+PERIOD = 0.001
+
+
+def _arc_run(n: int = 150, radius: float = 9.0):
+    """A line of 10 mm along X into a quarter arc of ``radius`` in XZ: s, T, K, D, jump,
+    kink (n, 3), cap (n,) as a run's grid has them."""
+    s_line = np.linspace(0.0, 10.0, n // 3)
+    th = np.linspace(0.0, math.pi / 2, n - n // 3)
+    s = np.r_[s_line, 10.0 + radius * th]
+    T = np.r_[np.tile([1.0, 0.0, 0.0], (len(s_line), 1)),
+              np.c_[np.cos(th), np.zeros_like(th), np.sin(th)]]
+    K = np.r_[np.zeros((len(s_line), 3)),
+              np.c_[-np.sin(th), np.zeros_like(th), np.cos(th)] / radius]
+    D = np.r_[np.zeros((len(s_line), 3)), np.abs(np.c_[-np.cos(th), np.zeros_like(th),
+                                                        -np.sin(th)]) / radius ** 2]
+    jump = np.zeros_like(T)
+    jump[len(s_line) - 1:len(s_line) + 1] = np.abs(K[len(s_line)])
+    kink = np.zeros_like(T)
+    cap = np.full(len(s), 166.7)
+    return s, T, K, D, jump, kink, cap
+
+
+def _speed_limits_numpy(s, T, D, jump, cap, d_share: float):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        terms = [cap ** 2, np.min((V / np.abs(T)) ** 2, axis=1),
+                 np.min((d_share * J / D) ** (2.0 / 3.0), axis=1),
+                 np.min(JOIN_SHARE * J * PERIOD / jump, axis=1)]
+    return np.nan_to_num(np.min(terms, axis=0), nan=math.inf, posinf=math.inf)
+
+
+def _plan_numpy(s, wl, T, K, D, jump, kink, window: float, coriolis: float):
+    wl_e = topp.erode(s, wl, window)
+    top = float(np.sqrt(np.max(wl_e[np.isfinite(wl_e)], initial=0.0)))
+    reach = (s - top * window, s + top * window)
+    t_lo, t_hi = topp.boxes(s, T, *reach)
+    k_lo, k_hi = topp.boxes(s, K, *reach)
+    Kmax = np.maximum(np.abs(k_lo), np.abs(k_hi))
+    C = coriolis * J
+    w, u = topp.passes(s, wl_e, 0.5 * (t_lo + t_hi), 0.5 * (t_hi - t_lo),
+                       0.5 * (k_lo + k_hi), 0.5 * (k_hi - k_lo), Kmax, A, C)
+    t, v, a, S = topp.time_law(s, w, u)
+    cap = np.minimum(wl_e, top * top)[:, None]
+    with np.errstate(invalid="ignore", over="ignore"):
+        static = D * cap ** 1.5 + jump * cap / PERIOD + kink * np.sqrt(cap) / PERIOD ** 2
+    static = topp.boxes(s, np.nan_to_num(static, nan=0.0), *reach)[1]
+    Tabs = np.maximum(np.abs(t_lo), np.abs(t_hi))
+    need = topp.window_needed(t, v, a, Tabs, Kmax, static, J, C, window)
+    return t, w, u, v, a, S, need
+
+
+def test_the_compiled_plan_is_the_numpy_steps():
+    s, T, K, D, jump, kink, cap = _arc_run()
+    wl = plan_once.speed_limits(cap, T, D, jump, V, J, PERIOD, 0.25, JOIN_SHARE)
+    ref = _speed_limits_numpy(s, T, D, jump, cap, 0.25)
+    assert np.allclose(wl, ref, rtol=1e-14, atol=0.0)
+    assert np.isinf(wl).sum() == np.isinf(ref).sum()
+    for window, share in ((0.05, 0.25), (0.08, 0.4)):
+        got = plan_once.plan_once(s, ref, T, K, D, jump, kink, A, J, PERIOD, window, share,
+                                  s, s, False)
+        want = _plan_numpy(s, ref, T, K, D, jump, kink, window, share)
+        for name, x, y in zip("t w u v a S need".split(), got, want):
+            scale = max(float(np.max(np.abs(y[np.isfinite(y)]), initial=0.0)), 1e-300)
+            assert np.array_equal(np.isfinite(x), np.isfinite(y)), name
+            fin = np.isfinite(y)
+            assert np.max(np.abs(x[fin] - y[fin]), initial=0.0) <= 1e-12 * scale, name
+        assert got[0][-1] > 0.0 and got[1][0] == 0.0 and got[1][-1] == 0.0
+
+
+@njit(cache=False)
+def _knot_searched(t, x: float) -> int:
+    return min(max(np.searchsorted(t, x, side="right") - 1, 0), len(t) - 2)
+
+
+@njit(cache=False)
+def _integral_searched(t, s, v, a, S, x: float) -> float:
+    if x <= 0.0:
+        return 0.0
+    end = t[-1]
+    k = _knot_searched(t, x)
+    y = min(x, end) - t[k]
+    return S[k] + s[k] * y + v[k] * y * y / 2.0 + a[k] * y ** 3 / 6.0 + s[-1] * max(x - end,
+                                                                                    0.0)
+
+
+@njit(cache=False)
+def _averaged_searched(t, s, v, a, S, window: float, tau: float) -> float:
+    """topp.averaged with every knot found by a binary search (the reference; compiled,
+    so that its arithmetic rounds as the library's)."""
+    if window <= 0.0:
+        k = _knot_searched(t, tau)
+        y = min(max(tau, 0.0), t[-1]) - t[k]
+        return min(max(s[k] + v[k] * y + a[k] * y * y / 2.0, 0.0), s[-1])
+    x = (_integral_searched(t, s, v, a, S, tau)
+         - _integral_searched(t, s, v, a, S, tau - window)) / window
+    return min(max(x, 0.0), s[-1])
+
+
+def test_the_sweeps_pick_the_knots_a_binary_search_picks():
+    s, T, K, D, jump, kink, cap = _arc_run(90)
+    wl = plan_once.speed_limits(cap, T, D, jump, V, J, PERIOD, 0.25, JOIN_SHARE)
+    s[40:42] = s[40]   # a zero-length knot (a join): equal times in t
+    for window in (0.0, 0.05):
+        t, w, u, v, a, S, _ = plan_once.plan_once(s, wl, T, K, D, jump, kink, A, J, PERIOD,
+                                                  max(window, 0.05), 0.25, s, s, False)
+        tau = np.r_[-0.01, np.arange(0.0, t[-1] + window + 0.01, PERIOD / 3)]
+        out = np.empty(len(tau))
+        topp.averaged_sweep(t, s, v, a, S, window, tau, out)
+        want = [_averaged_searched(t, s, v, a, S, window, x) for x in tau]
+        assert np.array_equal(out, want)
+        lo, hi = topp.ranges(t, s, v, a, S, 0.05)
+        for k in range(len(t)):
+            assert lo[k] == min(_averaged_searched(t, s, v, a, S, 0.05, t[k]), s[k])
+            assert hi[k] == max(_averaged_searched(t, s, v, a, S, 0.05, t[k] + 0.05), s[k])
