@@ -18,17 +18,10 @@ import cadcnc
 from cadcnc.core.tolerances import DEFAULT
 from cadcnc.guard import guard_for
 from cadcnc.ops.path import stretches
+from cadcnc.ops.path.feasibility import FEASIBLE, ONE_SIDED, Feasibility
 from cadcnc.ops.path.limit_search import limit_samples, root_limit
 from cadcnc.ops.path.pair_path import pair_job
-from cadcnc.ops.path.stretches import (
-    FEASIBLE,
-    LIMIT_TOL,
-    ONE_SIDED,
-    SPACING,
-    Feasibility,
-    bisect_limit,
-    pair_stretches,
-)
+from cadcnc.ops.path.stretches import LIMIT_TOL, SPACING, bisect_limit, pair_stretches
 from helpers.fixtures import FIXTURES
 from helpers.programs import pencil_run
 

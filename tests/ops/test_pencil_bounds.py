@@ -18,9 +18,10 @@ from cadcnc.core.job import Job, PairPath, Pencil, Tool
 from cadcnc.core.tolerances import DEFAULT
 from cadcnc.core.work_limits import HEARTBEAT_S, WorkLimitError
 from cadcnc.ops.common import safe_height
+from cadcnc.ops.path.feasibility import too_tight
 from cadcnc.ops.path.pair_path import plan_path
 from cadcnc.ops.path.pair_program import program_for_job, stretch_cuts
-from cadcnc.ops.path.stretches import EdgeStretches, Limit, Stretch, too_tight
+from cadcnc.ops.path.stretches import EdgeStretches, Limit, Stretch
 from cadcnc.ops.pencil.pencil_program import pencil_program
 from cadcnc.pipeline.exit_policy import judge, settle
 from cadcnc.testing.moves_judge import polyline_depths

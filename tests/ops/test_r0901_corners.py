@@ -30,7 +30,8 @@ import cadcnc
 from cadcnc.core.tolerances import DEFAULT
 from cadcnc.geometry.setup import job_setup, setup_part
 from cadcnc.interp.cycle import Contact
-from cadcnc.ops.path.stretches import TANGENT, pair_stretches
+from cadcnc.ops.path.feasibility import TANGENT
+from cadcnc.ops.path.stretches import pair_stretches
 from cadcnc.testing.occt import occt_distance as distance
 from helpers.fixtures import FIXTURES
 

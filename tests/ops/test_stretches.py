@@ -22,8 +22,9 @@ from cadcnc.core.errors import EXIT_NOTHING, NothingToCutError
 from cadcnc.core.job import Tool
 from cadcnc.core.tolerances import DEFAULT
 from cadcnc.guard import guard_for
+from cadcnc.ops.path.feasibility import COLLISION, REASONS, Feasibility
 from cadcnc.ops.path.stretch_paths import nearest_start, stretch_paths
-from cadcnc.ops.path.stretches import COLLISION, REASONS, Feasibility, pair_stretches
+from cadcnc.ops.path.stretches import pair_stretches
 from helpers.fixtures import FIXTURES, stretch_pair_job
 
 SIDECAR = json.loads((FIXTURES / "stretch_fixtures.json").read_text())
@@ -165,7 +166,7 @@ class _Window:
 
     def sample(self, s, anchor, tangent, seed=None, quick=False):
         from cadcnc.interp.stepper import Tangency
-        from cadcnc.ops.path.stretches import BOUNDARY, FEASIBLE, Sample
+        from cadcnc.ops.path.feasibility import BOUNDARY, FEASIBLE, Sample
 
         u = s % 10.0
         ok = u >= 9.9 or u <= 2.5

@@ -32,10 +32,11 @@ from ...program.program import STOPPED_SHORT, CutSegment, Program, Skipped
 from ...program.toolpath import Toolpath, toolpath_from_record
 from ..common import require_ball, run_stretch, safe_height
 from ..entries import entered_program_segments
+from .feasibility import FEASIBLE, Feasibility
 from .pair_path import PathPlan, plan_path, shared_edge_for, stepper_for
 from .stretch_paths import nearest_start, plan_for_stretch, refuse_without_stretch
 from .stretch_split import split_at_stop
-from .stretches import FEASIBLE, Feasibility, Stretch, pair_stretches
+from .stretches import Stretch, pair_stretches
 
 LIMIT_SLACK = 1e-3
 """mm: a cut stopping on a boundary or collision this near its stretch's end limit has

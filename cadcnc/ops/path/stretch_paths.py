@@ -17,8 +17,9 @@ from ...core.errors import NothingToCutError
 from ...core.job import Job
 from ...guard.clearance import ClearanceGuard
 from ...program.toolpath import Toolpath
+from .feasibility import Feasibility
 from .pair_path import PathPlan, run_plan
-from .stretches import EdgeStretches, Feasibility, Stretch, pair_stretches
+from .stretches import EdgeStretches, Stretch, pair_stretches
 
 
 def plan_for_stretch(s1, s2, job: Job, stretch: Stretch) -> PathPlan:
@@ -59,7 +60,7 @@ def nearest_start(found: list[EdgeStretches], feas: Feasibility, point):
     """(tangency, note) for a user's start ``point``: the tangency through it when that
     position is feasible (note ""), else the nearest stretch limit and a note saying so.
 
-    ``feas`` judges the position (see :class:`~cadcnc.ops.path.stretches.Feasibility`).
+    ``feas`` judges the position (see :class:`~cadcnc.ops.path.feasibility.Feasibility`).
     """
     point = np.asarray(point, dtype=float)
     limits = [lim for e in found for st in e.stretches for lim in (st.start, st.end)]

@@ -17,7 +17,8 @@ from __future__ import annotations
 import numpy as np
 
 from .centre_curve import polyline_length, travel_direction
-from .stretches import UNSOLVED, EdgeStretches, Limit, Sample, Stretch, locate_limit, sample_at
+from .feasibility import UNSOLVED, Sample
+from .stretches import EdgeStretches, Limit, Stretch, locate_limit, sample_at
 
 FIRST_PROBE = 1e-7   # mm of edge past the stop: the first position judged (then doubled)
 BISECTIONS = 60      # halvings locating the stop's arc length between two samples

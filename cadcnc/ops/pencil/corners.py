@@ -29,7 +29,7 @@ from ...core.tolerances import DEFAULT, Tolerances
 from ...geometry.blends import Blend, find_blends
 from ...geometry.part import CONCAVE, MIXED, TANGENT, Part
 from ...program.program import Skipped
-from ..path.stretches import too_tight
+from ..path.feasibility import too_tight
 
 EDGE, BLEND = "edge", "blend"
 TANGENT_FACES, MIXED_EDGE, BLEND_ROLLS = "tangent", "mixed", "blend_rolls"

@@ -23,13 +23,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ...core.errors import CadcncError, InputError, NothingToCutError
 from ...core.job import PRINCIPAL_AXES, Job, Pencil, axis_name
 from ...core.units import check_axis
-from ...geometry.edge_curve import EdgeCurve
-from ...geometry.part import CONCAVE, Part
+from ...geometry.part import Part
 from ...geometry.setup import Setup, original_part, setup_in, setup_part
 from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program, Skipped
@@ -40,11 +38,8 @@ from ..path.pair_program import NO_STRETCH
 from ..run import RunOptions, operation_of
 from .pencil_program import CHAIN_GAP
 from .reach_samples import BallSamples, axis_reach, ball_samples, stretch_lines, true_runs
+from .setup_positions import SPACING, corner_positions, cut_keys, edge_positions, line_keys
 
-SPACING = 0.5      # mm between two positions along a concave edge
-REACH_RADII = 5.0  # a ball centre farther than this many R' from its corner's edge counts nothing
-VOXEL = 1.0        # mm: the grid of a blend corner's positions
-DENSE = 0.1        # mm between the points keyed along a line of feasible samples (a cut's step)
 AUTO = "auto"
 AUTO_ORDER = ("+Z", "-Z", "+X", "-X", "+Y", "-Y")  # the candidates of AUTO, +Z first on ties
 TRIMMED = "setup boundary"  # the stop reason of a cut trimmed where an earlier setup cut
@@ -132,11 +127,11 @@ def pencil_setups(part: Part, job: Job, setups="auto", overlap: float = 0.0, *,
     axes = [PRINCIPAL_AXES[n] for n in AUTO_ORDER] if parse_setups(setups) == AUTO else \
         parse_setups(setups)
     part = original_part(part)
-    samples = _positions(part, job)
+    samples = corner_positions(part, job)
     extra = {} if max_cycles is None else {"max_cycles": max_cycles}
     options = RunOptions(progress=progress, processes=processes, **extra)
     counts = {pair: {k: len(pts) for k, pts in edges}
-              for pair, edges in _edge_positions(part, job).items()}
+              for pair, edges in edge_positions(part, job).items()}
     balls = ball_samples(part, job, counts, SPACING, processes=processes)
     runs, reach_sets = [], []
     for n, axis in enumerate(axes):
@@ -167,7 +162,7 @@ def _chosen(runs: list[SetupRun], reach: list[set], samples: dict, job: Job,
     """:func:`choose` on the candidates ``runs``, their samples' ``reach`` (updated), a
     program computed with :func:`_computed`, a closer look with the stretch search."""
     def look(k: int, pair: tuple[int, int]) -> set:
-        keys = _line_keys({pair: stretch_lines(runs[k].part, runs[k].program.job, pair,
+        keys = line_keys({pair: stretch_lines(runs[k].part, runs[k].program.job, pair,
                                                max_cycles=options.max_cycles)}, samples, job)
         runs[k].reached = len({key for key in reach[k] if key[0] != pair} | keys)
         return keys
@@ -230,7 +225,7 @@ def _sampled(part: Part, job: Job, axis, samples: dict, balls: BallSamples,
         if isinstance(e, InputError):
             raise
         lines, error = {}, f"{type(e).__name__}: {e}"
-    keys = _line_keys(lines, samples, job)
+    keys = line_keys(lines, samples, job)
     blocked = [Skipped(pair, NO_STRETCH, "a third face or the shank is in the way at every "
                        "reach sample") for pair in {*balls.runs, *(c.faces for c in balls.stepped)}
                if pair not in lines]
@@ -251,7 +246,7 @@ def _computed(run: SetupRun, samples: dict, job: Job, options: RunOptions) -> se
         if isinstance(e, InputError):
             raise
         program, error = Program(sub), f"{type(e).__name__}: {e}"
-    run.keys = _keys(in_part_coordinates(program, setup_in(run.part)), samples, job)
+    run.keys = cut_keys(in_part_coordinates(program, setup_in(run.part)), samples, job)
     reached = set().union(*run.keys) if run.keys else set()
     reached.discard(None)
     run.program, run.error, run.reached, run.computed = program, error, len(reached), True
@@ -273,70 +268,6 @@ def _fewest(reach: list[set], universe: set) -> tuple[list[int], int]:
         if best is not None:
             return sorted(best[1], key=lambda i: (-len(reach[i]), i)), checked
     return [], checked
-
-
-def _edge_positions(part: Part, job: Job) -> dict[tuple[int, int], list]:
-    """Per concave pair (i < j) of the selected faces, per concave edge (its index among
-    the pair's, as a corner's ``edge``) its positions (M, 3), mm."""
-    faces = None if job.operation.faces is None else set(job.operation.faces)
-    out: dict = {}
-    for pair, edges in part.adjacency.items():
-        if faces is not None and not set(pair) <= faces:
-            continue
-        concave = [e for e in edges if e.edge_class == CONCAVE]
-        for k, e in enumerate(concave):
-            curve = EdgeCurve(e)
-            n = max(int(np.ceil(curve.length / SPACING)), 1)
-            pts = [curve.point_tangent(s)[0] for s in np.linspace(0.0, curve.length, n + 1)]
-            out.setdefault(pair, []).append((k, np.array(pts)))
-    return out
-
-
-def _positions(part: Part, job: Job) -> dict[tuple[int, int], np.ndarray]:
-    """Per concave pair (i < j) of the selected faces, its edges' positions (M, 3), mm."""
-    return {pair: np.concatenate([pts for _, pts in edges])
-            for pair, edges in _edge_positions(part, job).items()}
-
-
-def _keys(program: Program, samples: dict, job: Job) -> list[list]:
-    """Per cut of ``program`` (part coordinates), per point its position key or None."""
-    trees: dict = {}
-    return [_point_keys(tuple(sorted(cut.path.faces)), cut.points, samples, trees, job)
-            for cut in program.cuts]
-
-
-def _line_keys(lines: dict, samples: dict, job: Job) -> set:
-    """The positions the polylines of feasible centres ``lines`` (per pair, part
-    coordinates) reach: their points every DENSE mm keyed as a cut's points."""
-    trees: dict = {}
-    out: set = set()
-    for pair, pair_lines in lines.items():
-        for line in pair_lines:
-            out.update(_point_keys(pair, _dense(line), samples, trees, job))
-    out.discard(None)
-    return out
-
-
-def _dense(line: np.ndarray) -> np.ndarray:
-    """``line``'s vertices and points between them at most DENSE mm apart."""
-    pts = [line[:1]]
-    for a, b in zip(line[:-1], line[1:]):
-        n = max(int(np.ceil(np.linalg.norm(b - a) / DENSE)), 1)
-        pts.append(a + np.outer(np.arange(1, n + 1) / n, b - a))
-    return np.concatenate(pts)
-
-
-def _point_keys(pair: tuple[int, int], pts: np.ndarray, samples: dict, trees: dict,
-                job: Job) -> list:
-    """Per point of a cut (or a line of samples) of ``pair``, its position key or None:
-    its corner's nearest position within REACH_RADII R', or on a blend corner its VOXEL."""
-    if pair not in samples:   # a blend corner: its ball centres on a grid
-        return [(pair, tuple(np.round(p / VOXEL).astype(int))) for p in pts]
-    if pair not in trees:
-        trees[pair] = cKDTree(samples[pair])
-    d, near = trees[pair].query(pts)
-    ok = d <= REACH_RADII * job.tool.offset
-    return [(pair, int(k)) if good else None for k, good in zip(near, ok)]
 
 
 def _unreached(samples: dict, universe: set, runs: list[SetupRun]) -> list:

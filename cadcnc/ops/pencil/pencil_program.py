@@ -36,16 +36,11 @@ from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program, Skipped
 from ..common import refuse_cycles, require_ball, run_stretch, safe_height
 from ..entries import UNREACHABLE, entered_program_segments
+from ..path.feasibility import Feasibility
 from ..path.limit_search import limit_samples
 from ..path.pair_path import plan_path
 from ..path.pair_program import stretch_cuts
-from ..path.stretches import (
-    MIN_SAMPLES,
-    SPACING,
-    Feasibility,
-    edge_stretches,
-    pair_stretches,
-)
+from ..path.stretches import MIN_SAMPLES, SPACING, edge_stretches, pair_stretches
 from .corners import BLEND, EDGE, Corner, find_corners
 
 CHAIN_GAP = 1e-3

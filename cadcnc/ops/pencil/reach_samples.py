@@ -6,7 +6,7 @@ samples and computes the full programs (stretch search, stepping, entries, links
 chosen setups only. The samples are the chooser's own positions: along every concave edge
 of a corner the pencil cuts, one every ``spacing`` mm of arc length, the ball's tangency in
 the plane normal to the edge there, solved and judged as the stretch search judges its
-samples (:class:`~cadcnc.ops.path.stretches.Feasibility`), seeded along the edge as it is;
+samples (:class:`~cadcnc.ops.path.feasibility.Feasibility`), seeded along the edge as it is;
 a blend corner's along its rail. What does not depend on the axis (the tangency, the
 trims, tangent faces, curvature) is judged once, in part coordinates
 (:func:`ball_samples`); then, per setup, the third faces and the shank along its axis
@@ -40,8 +40,9 @@ from ...geometry.part import CONCAVE, Part
 from ...guard import guard_for
 from ...parallel.tasks import on_workers
 from ...program.program import Skipped
+from ..path.feasibility import Feasibility, Sample
 from ..path.pair_program import NO_STRETCH
-from ..path.stretches import Feasibility, Sample, edge_stretches, pair_stretches, reseeded
+from ..path.stretches import edge_stretches, pair_stretches, reseeded
 from .corners import BLEND, EDGE, Corner, find_corners
 from .pencil_program import blend_cut, rail_refs, rails_back
 
