@@ -1,9 +1,8 @@
 """A batch's records: one :class:`Record` per part and operation, the job hash that lets a
 re-run skip an unchanged part, the summary files (CSV and JSON) and the batch's exit code.
 
-Exit code of a batch (docs/reliability.md): 0 when every part's every operation exited 0;
-the parts' one code when every failing part failed the same way and none succeeded; else 6
-(partial: some parts are done, see the summary).
+Exit code of a batch (docs/reliability.md): the pipeline's rule across parts
+(:func:`cadcnc.pipeline.exit_policy.across_parts`).
 """
 
 from __future__ import annotations
@@ -17,9 +16,10 @@ from dataclasses import asdict, dataclass, field, fields
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
-from ..core.errors import EXIT_OK, EXIT_PARTIAL, InputError
+from ..core.errors import EXIT_OK, InputError
 from ..core.jsonable import plain
 from ..io.atomic import write_text
+from ..pipeline.exit_policy import across_parts
 from .task import BatchPart, OperationResult
 
 STATE = "batch-part.json"
@@ -111,11 +111,8 @@ def save_state(folder: Path, digest: str, records: list[Record]) -> None:
 
 
 def batch_exit(records: list[Record]) -> int:
-    """The batch's exit code (module doc)."""
-    codes = {r.exit for r in records}
-    if codes <= {EXIT_OK}:
-        return EXIT_OK
-    return codes.pop() if len(codes) == 1 else EXIT_PARTIAL
+    """The batch's exit code (module doc): the pipeline's rule across parts."""
+    return across_parts(r.exit for r in records)
 
 
 def summary_csv(records: list[Record]) -> str:

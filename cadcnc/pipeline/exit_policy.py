@@ -99,6 +99,18 @@ def worst(codes) -> int:
                default=EXIT_OK)
 
 
+def across_parts(codes) -> int:
+    """The exit code of a run over several parts (``cadcnc batch``) from each part's:
+    EXIT_OK when every part exited 0 (or there are none); the parts' one code when every
+    part that did not exit 0 exited that same code and none exited 0; else EXIT_PARTIAL
+    (some parts done, some not: the summary says which). One part's several programs (its
+    setups) exit with the :func:`worst` instead: they are one result."""
+    codes = set(codes)
+    if codes <= {EXIT_OK}:
+        return EXIT_OK
+    return codes.pop() if len(codes) == 1 else EXIT_PARTIAL
+
+
 def hint(program: Program, gate: ProgramGate, gcode: dict | None) -> str:
     """What may help, only where it can: fewer dropped points when only moves between
     written points cut; a smaller ball for a shallow side cut (not in the material)."""
