@@ -29,6 +29,7 @@ s, lengths mm.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
 
@@ -305,4 +306,22 @@ def plan_feed(pieces: list[Piece], machine: Machine, planned: bool = True,
         pairs = [_constant_run(k, p, machine) for k, p in enumerate(pieces)]
         return FeedPlan(pieces, [r for r, _ in pairs], [p for _, p in pairs], machine, False)
     runs = runs_of(pieces, machine)
-    return FeedPlan(pieces, runs, [plan_run(r, machine, derate) for r in runs], machine, True)
+    planned_runs: dict[bytes, Profile] = {}   # a run repeated exactly (a raster's passes
+    profiles = []                             # and links) is planned once
+    for run in runs:
+        key = _run_key(run)
+        if key not in planned_runs:
+            planned_runs[key] = plan_run(run, machine, derate)
+        profiles.append(planned_runs[key])
+    return FeedPlan(pieces, runs, profiles, machine, True)
+
+
+def _run_key(run: Run) -> bytes:
+    """Everything the plan of ``run`` depends on besides the machine: equal keys, equal
+    plans."""
+    h = hashlib.blake2b(digest_size=32)
+    for a in (run.offsets, run.s, run.T, run.K, run.D, run.jump, run.kink, run.cap):
+        a = np.ascontiguousarray(a, dtype=np.float64)
+        h.update(np.int64(a.size).tobytes())
+        h.update(a.tobytes())
+    return h.digest()

@@ -17,7 +17,9 @@ from numba import njit
 ROWS = 24   # acceleration constraints per knot: 2 ends x 3 axes x 4 corners of the box
 BISECTIONS = 40   # the fallback: the top of the feasible speeds to 2^-40 of its bracket
 SHRINKS = 4       # the closed form's top lowered by 1e-15 .. 1e-12 if round-off fails it
-ROOT_STEPS = 60   # a Coriolis root bisected to 2^-60 of its (monotone) bracket
+ROOT_STEPS = 60   # Newton steps for a Coriolis root at most (converges in a few)
+DOWN_STEPS = 64   # then steps of growing ulps onto it from the infeasible side
+EPS = 2.0 ** -52
 
 
 @njit(cache=True, error_model="numpy")
@@ -73,7 +75,12 @@ def feasible(w, h, w_next, cu, cw, rhs, coriolis) -> bool:
 @njit(cache=True, error_model="numpy")
 def _cubic_root(q: float, p: float, c: float, x: float) -> float:
     """The first x' > 0 where q x'³ + p x' + c (c > 0) reaches 0, if below ``x`` (else
-    ``x``): bisected where the cubic is still decreasing, so the root is the first."""
+    ``x``), on the side where the cubic is still >= 0 and within a few ulps of the root.
+
+    Newton's method from the end of the bracket from which it converges monotonically
+    (the cubic is concave on x > 0 for q <= 0: from the right end; convex up to its
+    minimum for q > 0: from the left), a bisection step where one would leave the
+    bracket; from the right, then down onto the root by growing ulps."""
     if q * x ** 3 + p * x + c >= 0.0 and not (q > 0.0 and p < 0.0):
         return x
     hi = x
@@ -81,13 +88,35 @@ def _cubic_root(q: float, p: float, c: float, x: float) -> float:
         hi = min(x, math.sqrt(-p / (3.0 * q)))
         if q * hi ** 3 + p * hi + c >= 0.0:
             return x
-    lo = 0.0
+    lo = 0.0   # the cubic is > 0 at lo, < 0 at hi
+    z = lo if q > 0.0 else hi
     for _ in range(ROOT_STEPS):
-        m = 0.5 * (lo + hi)
-        if q * m ** 3 + p * m + c >= 0.0:
-            lo = m
+        f = q * z ** 3 + p * z + c
+        if f >= 0.0:
+            lo = max(lo, z)
         else:
-            hi = m
+            hi = min(hi, z)
+        d = 3.0 * q * z * z + p
+        nxt = z - f / d if d != 0.0 else 0.5 * (lo + hi)
+        if not lo < nxt < hi:
+            nxt = 0.5 * (lo + hi)
+        if nxt == z or hi - lo <= 4.0 * EPS * hi:
+            break
+        z = nxt
+    if q * z ** 3 + p * z + c >= 0.0:
+        lo = max(lo, z)
+    else:
+        hi = min(hi, z)
+    if q > 0.0:   # the iterates came from the feasible side: lo is on the root
+        return lo
+    down, gap = hi, EPS * hi
+    for _ in range(DOWN_STEPS):
+        down -= gap
+        if down <= lo:
+            break
+        if q * down ** 3 + p * down + c >= 0.0:
+            return down
+        gap *= 2.0
     return lo
 
 

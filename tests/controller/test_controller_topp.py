@@ -140,3 +140,37 @@ def test_knots_keep_the_ends_and_no_step_below_min_knot(n):
     far = dropped[s[dropped] - s[keep[np.searchsorted(keep, dropped) - 1]] >= runs.MIN_KNOT]
     assert len(far) <= 1 and (s[-1] - s[far] < runs.MIN_KNOT).all()
     assert n < 50 or len(dropped) > 0   # the sample has points to drop
+
+
+def _root_bisected(q: float, p: float, c: float, x: float) -> float:
+    """The reference: the first root of q x³ + p x + c below x by 200 halvings of its
+    monotone bracket (on the side where the cubic is >= 0), in Python floats."""
+    f = lambda y: q * (y * y * y) + p * y + c   # noqa: E731
+    if f(x) >= 0.0 and not (q > 0.0 and p < 0.0):
+        return x
+    hi = x if not (q > 0.0 and p < 0.0) else min(x, math.sqrt(-p / (3.0 * q)))
+    if f(hi) >= 0.0:
+        return x
+    lo = 0.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if f(mid) >= 0.0 else (lo, mid)
+    return lo
+
+
+def test_the_coriolis_root_is_the_first_root_on_its_feasible_side():
+    """knot._cubic_root (Newton) against a long bisection on random cubics of every sign
+    pattern: on the feasible side (the cubic >= 0 there) and within 1e-14 of the root."""
+    rng = np.random.default_rng(7)
+    checked = 0
+    for _ in range(4000):
+        q, p = rng.normal(scale=10.0 ** rng.uniform(-3, 3), size=2)
+        c = 10.0 ** rng.uniform(-2, 4)
+        x = 10.0 ** rng.uniform(-1, 3)
+        got = knot._cubic_root(q, p, c, x)
+        want = _root_bisected(q, p, c, x)
+        assert 0.0 <= got <= x
+        assert q * (got * got * got) + p * got + c >= 0.0 or got == 0.0   # as compiled
+        assert abs(got - want) <= 1e-14 * max(want, 1.0), (q, p, c, x, got, want)
+        checked += want < x
+    assert checked > 500   # most cases bind: the root lies below x

@@ -135,3 +135,24 @@ def test_the_sweeps_pick_the_knots_a_binary_search_picks():
         for k in range(len(t)):
             assert lo[k] == min(_averaged_searched(t, s, v, a, S, 0.05, t[k]), s[k])
             assert hi[k] == max(_averaged_searched(t, s, v, a, S, 0.05, t[k] + 0.05), s[k])
+
+
+def test_a_repeated_run_is_planned_once_as_it_would_be_alone():
+    """Three straight moves meeting at right angles (three runs), the first and last
+    the same move: planned once, shared, and equal to each run planned on its own."""
+    from cadcnc.controller import Machine
+    from cadcnc.controller.feed_plan import plan_feed, plan_run
+    from cadcnc.controller.pieces import Piece
+
+    corners = np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 0.0, 5.0],
+                        [20.0, 0.0, 5.0]])
+    pieces = [Piece(corners[k:k + 2], np.array([0.0, np.linalg.norm(corners[k + 1]
+                                                                     - corners[k])]),
+                    100.0, k) for k in range(3)]
+    machine = Machine.default()
+    plan = plan_feed(pieces, machine)
+    assert len(plan.runs) == 3
+    assert plan.profiles[0] is plan.profiles[2] and plan.profiles[1] is not plan.profiles[0]
+    for run, profile in zip(plan.runs, plan.profiles):
+        alone = plan_run(run, machine)
+        assert alone.duration == profile.duration and np.array_equal(alone.v, profile.v)
