@@ -90,11 +90,10 @@ class Stream:
         (so every chord of the stream belongs to exactly one segment): the gate's moves."""
         seg_of_row = np.array([p.segment for p in self.plan.pieces])[self.rows]
         seg_of_row[0] = 0
+        starts = _first_rows(seg_of_row, len(program.segments))
         out, prev = [], self.positions[0]
         for k in range(len(program.segments)):
-            mine = self.positions[seg_of_row == k]
-            if k == 0:
-                mine = mine[1:]
+            mine = self.positions[max(starts[k], 1):starts[k + 1]]   # row 0 leads segment 0
             out.append(np.vstack([prev[None], mine]))
             if len(mine):
                 prev = mine[-1]
@@ -110,6 +109,14 @@ class Stream:
             **{f"max_{k}_share": dict(zip(AXES, v)) for k, v in shares.items()},
             "kernel_cuts": self.kernel_cuts, "hermite_cuts": self.hermite_cuts,
             "machine": self.machine.source}
+
+
+def _first_rows(owner: np.ndarray, count: int) -> np.ndarray:
+    """(count + 1,) where each owner's rows start in ``owner`` (non-decreasing: the
+    stream's rows are in time order): owner k's rows are [out[k], out[k + 1])."""
+    if len(owner) > 1 and (owner[1:] < owner[:-1]).any():
+        raise ValueError("the stream's rows are not in the order of their pieces")
+    return np.searchsorted(owner, np.arange(count + 1), side="left")
 
 
 def _line(piece: Piece, s: np.ndarray) -> np.ndarray:
@@ -276,8 +283,9 @@ def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
     positions = np.empty((len(s), 3))
     cuts = program.cuts
     kernel = hermite = 0
+    starts = _first_rows(rows, len(pieces))
     for j, piece in enumerate(pieces):
-        sel = np.flatnonzero(rows == j)
+        sel = slice(starts[j], starts[j + 1])
         if piece.cut is None:   # a link's straight move, or a blend by its samples
             positions[sel] = (_line if len(piece.points) == 2 else _hermite)(piece, s[sel])
             continue
@@ -287,7 +295,7 @@ def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
             positions[sel] = _hermite(piece, s[sel])
             hermite += 1
             continue
-        done = int(sel[0]) if len(sel) else 0
+        done = int(starts[j])
         positions[sel] = _cut_rows(stepper, piece, s[sel], f"cut {piece.cut + 1}", done,
                                    total, progress)
         kernel += 1
