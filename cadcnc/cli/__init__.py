@@ -22,7 +22,7 @@ def main(argv: list[str] | None = None) -> int:
     """
     ctrl_c_interrupts()   # not lost inside numba's compiler callbacks
     try:
-        code = load("cadcnc.cli.app:main")(argv)   # Ctrl-C while it loads is caught
+        code = load("cadcnc.cli.app:main")(argv, ending=argv is None)   # Ctrl-C caught
     except KeyboardInterrupt:  # during start-up or argument parsing
         print("cadcnc: interrupted", file=sys.stderr)
         code = EXIT_INTERRUPTED

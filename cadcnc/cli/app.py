@@ -10,6 +10,7 @@ commands are imported on dispatch from the table of :mod:`cadcnc.cli.commands`.
 from __future__ import annotations
 
 import argparse
+import gc
 import os
 import sys
 from importlib.metadata import version
@@ -205,7 +206,10 @@ def _negative_points_joined(argv: list[str]) -> list[str]:
     return out
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, ending: bool = False) -> int:
+    """Parse ``argv`` and run its command; its exit code. ``ending``: this process ends
+    when the command does (the console program): what the imports made is then kept out
+    of the garbage collector's walks (it lives to the end anyway)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(_negative_points_joined(argv))
     debug = getattr(args, "debug", False)
@@ -217,6 +221,8 @@ def main(argv: list[str] | None = None) -> int:
             if getattr(args, "processes", 1) != 1:   # its imports run beside ours
                 pool.start(args.processes)
             run = handler(args.command)   # the library imported now (commands.py)
+            if ending:
+                gc.freeze()
         return int(run(args) or 0)
     except KeyboardInterrupt:
         print("cadcnc: interrupted", file=sys.stderr)

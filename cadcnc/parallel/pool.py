@@ -31,6 +31,7 @@ naming the task, never a hang. No OCCT here: the part is opaque.
 
 from __future__ import annotations
 
+import gc
 import multiprocessing
 import multiprocessing.forkserver
 import os
@@ -122,6 +123,10 @@ def _init(build: Callable, args: tuple, parent: int) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     threading.Thread(target=_watch, args=(parent,), daemon=True).start()
     _IN_WORKER["part"] = build(*args)
+    # What the worker started with (the parent's modules and part, copied by the fork,
+    # or rebuilt) lives as long as it does: its collector need not walk those objects
+    # again (0.2 s a worker on a finishing program), nor touch their shared pages.
+    gc.freeze()
 
 
 def _watch(parent: int) -> None:
