@@ -17,7 +17,8 @@ every timing):
 - ``py step``: the bare step from Python, one ``step(feed)`` call per period (for scale).
 
 ``--long``: one stream of about 1e6 periods (the corner at a crawl): its time per period
-and its peak memory per period.
+and its peak memory per period, then the same for its gate (what ``cadcnc stream`` checks
+before writing).
 """
 
 from __future__ import annotations
@@ -30,11 +31,13 @@ from cadcnc.controller import Machine, stream_program
 from cadcnc.controller.feed_plan import plan_feed
 from cadcnc.controller.pieces import pieces_of
 from cadcnc.controller.stream import LANDING, follow_plan
+from cadcnc.core.tolerances import DEFAULT
 from cadcnc.interp.planned_follow import follow
 from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.ops.stream_steppers import stepper_factory
+from cadcnc.verification import gate_program
 
 FIXTURES = Path(__file__).resolve().parents[2] / "fixtures"
 
@@ -133,6 +136,16 @@ def long_stream(periods: int = 1_000_000) -> None:
     print(f"long stream: {name} at F {feed:.3g}: {n} periods in {seconds:.1f} s "
           f"({1e6 * seconds / n:.2f} us per period), peak memory {peak / 1e6:.0f} MB "
           f"({peak / n:.0f} bytes per period; the positions alone take 24)")
+    moves = stream.segment_moves(program)   # what `cadcnc stream` gates before writing
+    tracemalloc.start()
+    t = time.perf_counter()
+    gate = gate_program(program, part, DEFAULT, moves=moves)
+    seconds = time.perf_counter() - t
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    print(f"its gate: {'passed' if gate.ok else 'refused'} in {seconds:.1f} s "
+          f"({1e6 * seconds / n:.1f} us per period), peak memory {peak / 1e6:.0f} MB "
+          f"({peak / n:.0f} bytes per period)")
 
 
 def main() -> None:

@@ -247,7 +247,8 @@ class Polyline:
         cand = np.nonzero(lb < need)[0]
         if not len(cand):
             return
-        top, travel, pts = float(need.max()), self.travel, self.points
+        top, pts = float(need.max()), self.points
+        travel = self.travel[cand]   # the candidates' travel, once (not per exact distance)
         i, e = 0, -1
         while i < len(cand):
             j = cand[i]
@@ -262,10 +263,11 @@ class Polyline:
             i += 1
             if math.isfinite(d[j]):  # an unmeasured distance proves nothing further on
                 e = j
-                stop = np.searchsorted(travel[cand], travel[j] + d[j] - top, side="left")
+                stop = np.searchsorted(travel, travel[i - 1] + d[j] - top, side="left")
                 if stop > i:  # these are proven by the travel from j alone
                     skipped = cand[i:stop]
-                    lb[skipped] = np.maximum(lb[skipped], d[j] - (travel[skipped] - travel[j]))
+                    lb[skipped] = np.maximum(lb[skipped], d[j] - (travel[i:stop]
+                                                                  - travel[i - 1]))
                     i = stop
 
     # -- moves -------------------------------------------------------------------------
