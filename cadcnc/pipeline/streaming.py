@@ -98,12 +98,9 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
                                  planned=planned, max_periods=max_periods, say=say,
                                  blend=blend if planned else 0.0, exact=exact)
         tick.stage = "checking the stream against the machine's limits"
-        contents = _contents(stream.positions, outputs)
-        problems = _limits_broken(program, machine, stream.positions, contents)
+        problems = _limits_broken(program, machine, stream.positions, {})
         if problems:
-            return StreamRun(EXIT_GOUGE, [f"cadcnc: stream: {line}" for line in problems[:8]]
-                             + ["cadcnc: stream: over the machine's limits: nothing written"
-                                + (" or executed" if hal else "") + " (exit 5)"])
+            return _over_limits(problems, hal)
         tick.stage = "gating the stream against the part"
         gate = gate_program(program, part, tolerances or DEFAULT,
                             moves=stream.segment_moves(program))
@@ -119,6 +116,13 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
                                       "(--allow-gouge writes it)"])
     done = StreamRun(EXIT_OK if gate.ok else EXIT_GOUGE, stream=stream)
     if outputs is not None:
+        # made once the gate has let go of its moves: the files' bytes never sit in
+        # memory beside them; each .txt's numbers as printed are checked again
+        tick.stage = "checking the files' numbers against the machine's limits"
+        contents = _contents(stream.positions, outputs)
+        problems = _limits_broken(program, machine, None, contents)
+        if problems:
+            return _over_limits(problems, hal)
         tick.stage = "writing"
         outputs.write(contents)
         done.written = [str(d) for d in outputs.destinations]
@@ -189,12 +193,20 @@ def _contents(positions, outputs) -> dict:
     return contents
 
 
+def _over_limits(problems: list[str], hal: bool) -> StreamRun:
+    """The refusal of a stream over the machine's limits (exit 5, nothing written)."""
+    return StreamRun(EXIT_GOUGE, [f"cadcnc: stream: {line}" for line in problems[:8]]
+                     + ["cadcnc: stream: over the machine's limits: nothing written"
+                        + (" or executed" if hal else "") + " (exit 5)"])
+
+
 def _limits_broken(program, machine, positions, contents) -> list[str]:
-    """What breaks the machine's limits or misses the program's ends: in the positions,
-    and in each .txt's numbers as written (9 decimals)."""
+    """What breaks the machine's limits or misses the program's ends: in the positions
+    (None: not checked here), and in each .txt's numbers as written (9 decimals)."""
     limits = (machine.max_velocity, machine.max_acceleration, machine.max_jerk)
     ends = (program.segments[0].points[0], program.segments[-1].points[-1])
-    found = check_stream(positions, machine.period, limits, *ends).problems
+    found = [] if positions is None else \
+        check_stream(positions, machine.period, limits, *ends).problems
     for dest, text in contents.items():
         if isinstance(text, str) and not found:
             rows = np.fromstring(text, dtype=np.float64, sep=" ").reshape(-1, 3)

@@ -29,6 +29,9 @@ from .material import Material, PartFaces
 from .probe import FaceProbe
 from .sweep import Polyline
 
+MOVES_BLOCK = 250_000
+"""Moves checked at once: a longer polyline (a stream's periods) is checked in blocks of
+this many, so that the check's arrays (about 280 bytes a move) stay bounded."""
 FAR_MATCH_STEPS = 4.0  # a move farther than 4 steps from the centre found near it is
 MATCH_WINDOW = 64      # matched against every centre (a link); else within 64 centres
 UNIQUE_REL, UNIQUE_ABS = 1e-9, 1e-12  # a nearest centre nearer than the next by more than
@@ -61,16 +64,62 @@ def check_whole_part(part, probes: dict[int, FaceProbe], toolpath,
     centres = Polyline(faces, material, pts, ball, hit=tol.hit,
                        allowance=allowance if moves is None else None, known=known,
                        progress=progress).run()
-    line = centres
-    if moves is not None:
-        moves = np.asarray(moves, float).reshape(-1, 3)
-        floors = None if before is None else before_floors(faces, before, moves, tol)
-        line = Polyline(faces, material, moves, ball, allowance=allowance,
-                        anchors=_anchors(centres, moves), floors=floors, progress=progress,
-                        stage="moves").run()
     whole = _whole(centres, surfaces, ball, tol, len(part), material)
-    sweep = _sweep(line, ball, allowance, blend, material)
-    return whole, sweep
+    if moves is None:
+        return whole, _sweep(centres, ball, allowance, blend, material)
+    moves = np.asarray(moves, float).reshape(-1, 3)
+    sweeps = []
+    for first in range(0, max(len(moves) - 1, 1), MOVES_BLOCK):
+        block = moves[first:first + MOVES_BLOCK + 1]   # the next block starts at its end
+        floors = None if before is None else before_floors(faces, before, block, tol)
+        line = Polyline(faces, material, block, ball, allowance=allowance,
+                        anchors=_anchors(centres, block), floors=floors, progress=progress,
+                        stage="moves").run()
+        sweeps.append((first, _sweep(line, ball, allowance, blend, material)))
+        del line   # a block's arrays go before the next block's are made
+    return whole, sweeps[0][1] if len(sweeps) == 1 else merged_sweeps(sweeps)
+
+
+def merged_sweeps(blocks: list[tuple[int, SweepCheck]]) -> SweepCheck:
+    """One :class:`SweepCheck` of a polyline checked in consecutive blocks, each given
+    with the index of its first move: counts summed, bounds and depths the largest (nan
+    if any is), each face's hits joined with their moves numbered along the whole."""
+    checks = [c for _, c in blocks]
+    out = SweepCheck(n_moves=sum(c.n_moves for c in checks),
+                     proven=all(c.proven for c in checks),
+                     allowance_mm=checks[0].allowance_mm, blend_mm=checks[0].blend_mm,
+                     clearance_mm=checks[0].clearance_mm,
+                     faces_near=max(c.faces_near for c in checks),
+                     distances_evaluated=sum(c.distances_evaluated for c in checks),
+                     exact_moves=sum(c.exact_moves for c in checks),
+                     classified=sum(c.classified for c in checks))
+    bounds = np.array([c.depth_bound_mm for c in checks])
+    depths = np.array([c.depth_mm for c in checks])
+    out.depth_bound_mm = float(np.nan if np.isnan(bounds).any() else bounds.max())
+    out.depth_mm = float(np.nan if np.isnan(depths).any() else depths.max())
+    worst = int(np.argmax(np.where(np.isnan(depths), np.inf, depths)))
+    out.worst_move = blocks[worst][0] + checks[worst].worst_move
+    per_face: dict[int, list[tuple[int, SweepHit]]] = {}
+    for first, c in blocks:
+        for h in c.hits:
+            per_face.setdefault(h.face, []).append((first, h))
+    for face in sorted(per_face):
+        rows = per_face[face]
+        deep = np.array([h.depth_mm for _, h in rows])
+        w = int(np.argmax(np.where(np.isnan(deep), np.inf, deep)))
+        ranges: list[list[int]] = []
+        for first, h in rows:
+            for a, b in h.moves:
+                if ranges and ranges[-1][1] + 1 >= first + a:   # joined across blocks
+                    ranges[-1][1] = max(ranges[-1][1], first + b)
+                else:
+                    ranges.append([first + a, first + b])
+        out.hits.append(SweepHit(face=face, depth_mm=float(np.nan if np.isnan(deep).any()
+                                                          else deep[w]),
+                                 worst_move=rows[w][0] + rows[w][1].worst_move,
+                                 n_moves=sum(h.n_moves for _, h in rows), moves=ranges,
+                                 exact=rows[w][1].exact))
+    return out
 
 
 def before_floors(faces: PartFaces, before, moves: np.ndarray, tol: Tolerances) -> dict:
