@@ -139,22 +139,26 @@ def _hermite(piece: Piece, s: np.ndarray) -> np.ndarray:
     return h00 * p[k] + h10 * h[:, None] * d[k] + h01 * p[k + 1] + h11 * h[:, None] * d[k + 1]
 
 
-def follow_plan(piece: Piece, s: np.ndarray) -> np.ndarray:
+def follow_plan(piece: Piece, s: np.ndarray, before: float = 0.0,
+                travelled: float = 0.0) -> np.ndarray:
     """(rows, 3) the per-period plan the kernel follows on a cut (kernel/follow.py): the
     target length as the kernel's chord sum, the blend weight onto the distance left to
-    the end (C2 from 0 to 1 over the last BLEND mm), and the planned length left."""
-    ds = np.diff(np.r_[0.0, s])
+    the end (C2 from 0 to 1 over the last BLEND mm), and the planned length left.
+    ``before``, ``travelled``: the arc length and the target length of the row before
+    s[0] (0, 0: s starts the cut), so that a cut's plan is made a block at a time, the
+    same numbers as at once."""
+    ds = np.diff(np.r_[before, s])
     kappa = np.interp(s, piece.s, piece.kappa)
     plan = np.empty((len(s), 3))
-    plan[:, 0] = np.cumsum(ds * (1.0 - kappa ** 2 * ds ** 2 / 24.0))   # the kernel's travel
+    plan[:, 0] = np.cumsum(np.r_[travelled, ds * (1.0 - kappa ** 2 * ds ** 2 / 24.0)])[1:]
     plan[:, 2] = left = piece.length - s
     x = np.clip(1.0 - left / BLEND, 0.0, 1.0)
     plan[:, 1] = x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)
     return plan
 
 
-def _landed(stepper, piece: Piece, out: np.ndarray, what: str) -> np.ndarray:
-    """``out`` once the stepper has landed on the cut's last point (GeometryError if it
+def _landed(stepper, piece: Piece, what: str) -> None:
+    """Nothing once the stepper has landed on the cut's last point (GeometryError if it
     stopped on the way or missed it): the kernel's path is a few 1e-7 of its length longer
     or shorter than the program's points say, so over the last BLEND mm the target moves
     smoothly onto the distance left to the end, and the rest of the cut may lie between
@@ -175,7 +179,6 @@ def _landed(stepper, piece: Piece, out: np.ndarray, what: str) -> np.ndarray:
         raise GeometryError(f"{what}: the stepper did not land on the cut's last point "
                             f"(stopped: {stepper.stop_reason}; {np.linalg.norm(p - end):.3g} "
                             "mm from it)")
-    return out
 
 
 CHUNK = 100_000   # periods the kernel follows between two progress calls
@@ -223,18 +226,19 @@ def _refusal(over: list[tuple[float, int, int]], machine: Machine) -> PlanError:
         f"({why})")
 
 
-def _cut_rows(stepper, piece: Piece, s: np.ndarray, what: str, done: int, total: int,
-              progress: Progress | None) -> np.ndarray:
-    """The kernel's positions of one cut, CHUNK periods at a time (progress between)."""
-    plan = follow_plan(piece, s)
-    out = np.empty((len(s), 3))
+def _cut_rows(stepper, piece: Piece, s: np.ndarray, dest: np.ndarray, what: str, done: int,
+              total: int, progress: Progress | None) -> None:
+    """The kernel's positions of one cut into ``dest`` (len(s), 3), CHUNK periods at a
+    time (progress between; the plan made a chunk at a time too)."""
+    before = travelled = 0.0
     for a in range(0, len(s), CHUNK):
         b = min(a + CHUNK, len(s))
-        out[a:b] = follow(stepper, plan[a:b], piece.points[-1], float(piece.kappa[-1]),
-                          LANDING)
+        plan = follow_plan(piece, s[a:b], before, travelled)
+        dest[a:b] = follow(stepper, plan, piece.points[-1], float(piece.kappa[-1]), LANDING)
+        before, travelled = float(s[b - 1]), float(plan[-1, 0])
         if progress is not None:
             progress(min(done + b, total), total, "periods")
-    return _landed(stepper, piece, out, what)
+    _landed(stepper, piece, what)
 
 
 def stream_program(program: Program, machine: Machine, steppers: StepperFactory | None = None,
@@ -296,8 +300,8 @@ def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
             hermite += 1
             continue
         done = int(starts[j])
-        positions[sel] = _cut_rows(stepper, piece, s[sel], f"cut {piece.cut + 1}", done,
-                                   total, progress)
+        _cut_rows(stepper, piece, s[sel], positions[sel], f"cut {piece.cut + 1}", done,
+                  total, progress)
         kernel += 1
     positions[0] = pieces[0].points[0]
     positions[-1] = pieces[-1].points[-1]
@@ -307,7 +311,8 @@ def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
 
 
 def stream_text(positions: np.ndarray) -> str:
-    """One line per period, ``X Y Z`` in mm with 9 decimals (halstreamer, cfg=fff)."""
-    if not len(positions):
-        return ""
-    return "\n".join(" ".join(f"{v:.9f}" for v in row) for row in positions) + "\n"
+    """One line per period, ``X Y Z`` in mm with 9 decimals (halstreamer, cfg=fff); made
+    CHUNK rows at a time (the lines of one chunk, not of the whole stream, in memory)."""
+    return "".join("".join(f"{x:.9f} {y:.9f} {z:.9f}\n" for x, y, z in
+                           positions[a:a + CHUNK].tolist())
+                   for a in range(0, len(positions), CHUNK))

@@ -21,6 +21,9 @@ from ..core.interrupts import signals_deferred
 from ..core.work_limits import sigterm_as_interrupt
 from .atomic import NAME_MAX, temp_prefix
 
+TEXT_SLICE = 1 << 24
+"""Characters of a text output encoded at a time while it is written."""
+
 
 def _umask() -> int:
     mask = os.umask(0)
@@ -114,12 +117,15 @@ class OutputSet:
         for d in self.destinations:
             target = self.targets[d]
             data = contents[d]
-            data = data.encode("utf-8") if isinstance(data, str) else data
             fd, tmp = tempfile.mkstemp(prefix=temp_prefix(target), suffix=".tmp",
                                        dir=target.parent)
             temps.append((tmp, target, d))
             with os.fdopen(fd, "wb") as fh:
-                fh.write(data)
+                if isinstance(data, str):   # encoded a slice at a time: no second copy
+                    for a in range(0, len(data), TEXT_SLICE):
+                        fh.write(data[a:a + TEXT_SLICE].encode("utf-8"))
+                else:
+                    fh.write(data)
             os.chmod(tmp, 0o666 & ~_umask())
 
 

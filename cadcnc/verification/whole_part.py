@@ -29,9 +29,9 @@ from .material import Material, PartFaces
 from .probe import FaceProbe
 from .sweep import Polyline
 
-MOVES_BLOCK = 250_000
+MOVES_BLOCK = 100_000
 """Moves checked at once: a longer polyline (a stream's periods) is checked in blocks of
-this many, so that the check's arrays (about 280 bytes a move) stay bounded."""
+this many, so that the check's arrays (about 280 bytes a move, 28 MB) stay bounded."""
 FAR_MATCH_STEPS = 4.0  # a move farther than 4 steps from the centre found near it is
 MATCH_WINDOW = 64      # matched against every centre (a link); else within 64 centres
 UNIQUE_REL, UNIQUE_ABS = 1e-9, 1e-12  # a nearest centre nearer than the next by more than
