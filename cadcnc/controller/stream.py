@@ -87,17 +87,15 @@ class Stream:
 
     def segment_moves(self, program: Program) -> list[np.ndarray]:
         """Per program segment, the streamed positions inside it, led by the row before
-        (so every chord of the stream belongs to exactly one segment): the gate's moves."""
+        (so every chord of the stream belongs to exactly one segment): the gate's moves.
+        Read-only views of the positions (a segment's rows are consecutive)."""
         seg_of_row = np.array([p.segment for p in self.plan.pieces])[self.rows]
         seg_of_row[0] = 0
         starts = _first_rows(seg_of_row, len(program.segments))
-        out, prev = [], self.positions[0]
-        for k in range(len(program.segments)):
-            mine = self.positions[max(starts[k], 1):starts[k + 1]]   # row 0 leads segment 0
-            out.append(np.vstack([prev[None], mine]))
-            if len(mine):
-                prev = mine[-1]
-        return out
+        view = self.positions.view()
+        view.flags.writeable = False
+        return [view[max(starts[k] - 1, 0):max(starts[k + 1], 1)]
+                for k in range(len(program.segments))]
 
     def summary(self) -> dict:
         """Cycle time, periods, shares of the limits per axis, time lost to the limits."""
