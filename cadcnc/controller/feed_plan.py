@@ -284,8 +284,11 @@ class FeedPlan:
         r = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, len(self.runs) - 1)
         piece = np.empty(n + 1, dtype=np.int64)
         s = np.empty(n + 1)
-        for j in np.unique(r):
-            sel = np.flatnonzero(r == j)
+        bounds = np.searchsorted(r, np.arange(len(self.runs) + 1), side="left")  # r grows
+        for j in range(len(self.runs)):
+            sel = slice(bounds[j], bounds[j + 1])
+            if bounds[j] == bounds[j + 1]:
+                continue
             run = self.runs[j]
             at = self.profiles[j].position(times[sel] - starts[j])
             k = np.clip(np.searchsorted(run.offsets, at, side="right") - 1, 0,
