@@ -116,33 +116,35 @@ def whole(program, factory, machine, feed) -> float:
     return time.perf_counter() - t
 
 
-def long_stream(periods: int = 1_000_000) -> None:
-    """The corner at the feed that makes its stream ``periods`` long: time per period and
-    the peak memory the stream takes (tracemalloc: numpy's arrays included), per period."""
+def _measured(fn):
+    """(fn(), wall seconds, peak memory in bytes by tracemalloc: numpy's arrays included)."""
     import tracemalloc
 
+    tracemalloc.start()
+    t = time.perf_counter()
+    out = fn()
+    seconds = time.perf_counter() - t
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    return out, seconds, peak
+
+
+def long_stream(periods: int = 1_000_000) -> None:
+    """The corner at the feed that makes its stream ``periods`` long: time per period and
+    the peak memory the stream takes, per period; then the same for its gate."""
     machine = Machine.default()
     name, part, program = next(iter(programs()))
     factory = stepper_factory(part)
     length = program.cut_length + sum(s.feed_length for s in program.links)
     feed = 60.0 * length / (periods * machine.period)
-    tracemalloc.start()
-    t = time.perf_counter()
-    stream = stream_program(program, machine, factory, feed=feed)
-    seconds = time.perf_counter() - t
-    peak = tracemalloc.get_traced_memory()[1]
-    tracemalloc.stop()
+    stream, seconds, peak = _measured(
+        lambda: stream_program(program, machine, factory, feed=feed))
     n = stream.periods
     print(f"long stream: {name} at F {feed:.3g}: {n} periods in {seconds:.1f} s "
           f"({1e6 * seconds / n:.2f} us per period), peak memory {peak / 1e6:.0f} MB "
           f"({peak / n:.0f} bytes per period; the positions alone take 24)")
     moves = stream.segment_moves(program)   # what `cadcnc stream` gates before writing
-    tracemalloc.start()
-    t = time.perf_counter()
-    gate = gate_program(program, part, DEFAULT, moves=moves)
-    seconds = time.perf_counter() - t
-    peak = tracemalloc.get_traced_memory()[1]
-    tracemalloc.stop()
+    gate, seconds, peak = _measured(lambda: gate_program(program, part, DEFAULT, moves=moves))
     print(f"its gate: {'passed' if gate.ok else 'refused'} in {seconds:.1f} s "
           f"({1e6 * seconds / n:.1f} us per period), peak memory {peak / 1e6:.0f} MB "
           f"({peak / n:.0f} bytes per period)")
