@@ -98,7 +98,7 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
                                  planned=planned, max_periods=max_periods, say=say,
                                  blend=blend if planned else 0.0, exact=exact)
         tick.stage = "checking the stream against the machine's limits"
-        problems = _limits_broken(program, machine, stream.positions, {})
+        problems = _limits_broken(program, machine, stream.positions)
         if problems:
             return _over_limits(problems, hal)
         tick.stage = "gating the stream against the part"
@@ -120,7 +120,7 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
         # memory beside them; each .txt's numbers as printed are checked again
         tick.stage = "checking the files' numbers against the machine's limits"
         contents = _contents(stream.positions, outputs)
-        problems = _limits_broken(program, machine, None, contents)
+        problems = _printed_broken(program, machine, contents)
         if problems:
             return _over_limits(problems, hal)
         tick.stage = "writing"
@@ -200,15 +200,20 @@ def _over_limits(problems: list[str], hal: bool) -> StreamRun:
                         + (" or executed" if hal else "") + " (exit 5)"])
 
 
-def _limits_broken(program, machine, positions, contents) -> list[str]:
-    """What breaks the machine's limits or misses the program's ends: in the positions
-    (None: not checked here), and in each .txt's numbers as written (9 decimals)."""
+def _limits_broken(program, machine, positions, what: str = "the stream") -> list[str]:
+    """What breaks the machine's limits or misses the program's ends in ``positions``
+    ((N, 3) mm, named ``what``)."""
     limits = (machine.max_velocity, machine.max_acceleration, machine.max_jerk)
     ends = (program.segments[0].points[0], program.segments[-1].points[-1])
-    found = [] if positions is None else \
-        check_stream(positions, machine.period, limits, *ends).problems
+    return check_stream(positions, machine.period, limits, *ends, what=what).problems
+
+
+def _printed_broken(program, machine, contents) -> list[str]:
+    """:func:`_limits_broken` of each .txt's numbers as printed (9 decimals)."""
     for dest, text in contents.items():
-        if isinstance(text, str) and not found:
+        if isinstance(text, str):
             rows = np.fromstring(text, dtype=np.float64, sep=" ").reshape(-1, 3)
-            found = check_stream(rows, machine.period, limits, *ends, what=str(dest)).problems
-    return found
+            found = _limits_broken(program, machine, rows, str(dest))
+            if found:
+                return found
+    return []

@@ -24,6 +24,7 @@ from .check_records import (
     WholePartCheck,
     WholePartHit,
     cycle_ranges,
+    strict_max,
 )
 from .material import Material, PartFaces
 from .probe import FaceProbe
@@ -93,11 +94,9 @@ def merged_sweeps(blocks: list[tuple[int, SweepCheck]]) -> SweepCheck:
                      distances_evaluated=sum(c.distances_evaluated for c in checks),
                      exact_moves=sum(c.exact_moves for c in checks),
                      classified=sum(c.classified for c in checks))
-    bounds = np.array([c.depth_bound_mm for c in checks])
-    depths = np.array([c.depth_mm for c in checks])
-    out.depth_bound_mm = float(np.nan if np.isnan(bounds).any() else bounds.max())
-    out.depth_mm = float(np.nan if np.isnan(depths).any() else depths.max())
-    worst = int(np.argmax(np.where(np.isnan(depths), np.inf, depths)))
+    out.depth_bound_mm = strict_max(c.depth_bound_mm for c in checks)
+    out.depth_mm = strict_max(c.depth_mm for c in checks)
+    worst = _worst([c.depth_mm for c in checks])
     out.worst_move = blocks[worst][0] + checks[worst].worst_move
     per_face: dict[int, list[tuple[int, SweepHit]]] = {}
     for first, c in blocks:
@@ -105,8 +104,7 @@ def merged_sweeps(blocks: list[tuple[int, SweepCheck]]) -> SweepCheck:
             per_face.setdefault(h.face, []).append((first, h))
     for face in sorted(per_face):
         rows = per_face[face]
-        deep = np.array([h.depth_mm for _, h in rows])
-        w = int(np.argmax(np.where(np.isnan(deep), np.inf, deep)))
+        w = _worst([h.depth_mm for _, h in rows])
         ranges: list[list[int]] = []
         for first, h in rows:
             for a, b in h.moves:
@@ -114,8 +112,7 @@ def merged_sweeps(blocks: list[tuple[int, SweepCheck]]) -> SweepCheck:
                     ranges[-1][1] = max(ranges[-1][1], first + b)
                 else:
                     ranges.append([first + a, first + b])
-        out.hits.append(SweepHit(face=face, depth_mm=float(np.nan if np.isnan(deep).any()
-                                                          else deep[w]),
+        out.hits.append(SweepHit(face=face, depth_mm=strict_max(h.depth_mm for _, h in rows),
                                  worst_move=rows[w][0] + rows[w][1].worst_move,
                                  n_moves=sum(h.n_moves for _, h in rows), moves=ranges,
                                  exact=rows[w][1].exact))
@@ -261,7 +258,7 @@ def _sweep(line: Polyline, ball: float, allowance: float, blend: float,
     out.proven = not failed.any()
     out.depth_bound_mm = float(np.nan if np.isnan(bound).any() else bound.max())
     out.depth_mm = float(np.nan if np.isnan(meas).any() else meas.max())
-    out.worst_move = int(np.nanargmax(np.where(np.isnan(meas), np.inf, meas)))
+    out.worst_move = _worst(meas)
     if not out.proven:
         out.hits = _sweep_hits(line, failed, inside | unknown, ball, allowance, meas)
     return out
@@ -287,12 +284,18 @@ def _sweep_hits(line: Polyline, failed, blamed_on_nearest, ball, allowance, meas
     for k in sorted(per_face):
         rows = per_face[k]
         depths = np.array([r[1] for r in rows], float)
-        w = int(np.argmax(np.where(np.isnan(depths), np.inf, depths)))
+        w = _worst(depths)
         hits.append(SweepHit(face=k, depth_mm=float(np.nan if np.isnan(depths).any()
                                                       else depths[w]),
                              worst_move=rows[w][0], n_moves=len(rows),
                              moves=cycle_ranges(sorted(r[0] for r in rows)), exact=rows[w][2]))
     return hits
+
+
+def _worst(depths) -> int:
+    """Index of the deepest of ``depths``; an unmeasured one (nan) counts deepest."""
+    depths = np.asarray(depths, float)
+    return int(np.argmax(np.where(np.isnan(depths), np.inf, depths)))
 
 
 def _hit(face: int, followed: bool, depth: np.ndarray, hit_tol: float) -> WholePartHit | None:
