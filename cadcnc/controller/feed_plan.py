@@ -55,6 +55,10 @@ FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
 TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
 TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened this much
 MAX_PERIODS = 50_000_000
+SAME_RUN = 1e-11
+"""Runs whose path derivatives agree within this (absolute, in their units, and relative)
+share one plan: the limits are then met within about 1e-7 of themselves on the other
+run, far inside MARGIN."""
 
 
 class PlanError(CadcncError):
@@ -309,22 +313,38 @@ def plan_feed(pieces: list[Piece], machine: Machine, planned: bool = True,
         pairs = [_constant_run(k, p, machine) for k, p in enumerate(pieces)]
         return FeedPlan(pieces, [r for r, _ in pairs], [p for _, p in pairs], machine, False)
     runs = runs_of(pieces, machine)
-    planned_runs: dict[bytes, Profile] = {}   # a run repeated exactly (a raster's passes
-    profiles = []                             # and links) is planned once
-    for run in runs:
-        key = _run_key(run)
-        if key not in planned_runs:
-            planned_runs[key] = plan_run(run, machine, derate)
-        profiles.append(planned_runs[key])
+    planned_runs: dict[bytes, list[tuple[Run, Profile]]] = {}   # a run repeated (a
+    profiles = []                                                 # raster's passes and
+    for run in runs:                                              # links) planned once
+        same = planned_runs.setdefault(_run_key(run), [])
+        profile = next((p for r, p in same if _same_run(r, run)), None)
+        if profile is None:
+            profile = plan_run(run, machine, derate)
+            same.append((run, profile))
+        profiles.append(profile)
     return FeedPlan(pieces, runs, profiles, machine, True)
 
 
+_DERIVATIVES = ("T", "K", "D", "jump", "kink")
+
+
 def _run_key(run: Run) -> bytes:
-    """Everything the plan of ``run`` depends on besides the machine: equal keys, equal
-    plans."""
+    """The run's lengths and speed caps exactly and its path's derivatives to 1e-6: runs
+    that may share a plan (:func:`_same_run` decides)."""
     h = hashlib.blake2b(digest_size=32)
-    for a in (run.offsets, run.s, run.T, run.K, run.D, run.jump, run.kink, run.cap):
+    arrays = [run.offsets, run.s, run.cap]
+    arrays += [np.round(getattr(run, name), 6) + 0.0 for name in _DERIVATIVES]   # (no -0)
+    for a in arrays:
         a = np.ascontiguousarray(a, dtype=np.float64)
         h.update(np.int64(a.size).tobytes())
         h.update(a.tobytes())
     return h.digest()
+
+
+def _same_run(a: Run, b: Run) -> bool:
+    """Whether one plan serves both runs: the same lengths and caps, and derivatives within
+    SAME_RUN (a raster's repeated passes differ by round-off where they lie on the part)."""
+    return (np.array_equal(a.offsets, b.offsets) and np.array_equal(a.s, b.s)
+            and np.array_equal(a.cap, b.cap)
+            and all(np.allclose(getattr(a, n), getattr(b, n), rtol=SAME_RUN, atol=SAME_RUN,
+                                equal_nan=True) for n in _DERIVATIVES))

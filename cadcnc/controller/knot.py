@@ -98,9 +98,11 @@ def _cubic_root(q: float, p: float, c: float, x: float) -> float:
             hi = min(hi, z)
         d = 3.0 * q * z * z + p
         nxt = z - f / d if d != 0.0 else 0.5 * (lo + hi)
+        if nxt == z:   # converged: the step is below z's last bit
+            break
         if not lo < nxt < hi:
             nxt = 0.5 * (lo + hi)
-        if nxt == z or hi - lo <= 4.0 * EPS * hi:
+        if hi - lo <= 4.0 * EPS * hi:
             break
         z = nxt
     if q * z ** 3 + p * z + c >= 0.0:
@@ -118,6 +120,34 @@ def _cubic_root(q: float, p: float, c: float, x: float) -> float:
             return down
         gap *= 2.0
     return lo
+
+
+@njit(cache=True, error_model="numpy")
+def _crossing(w: float, lp, lq, nl: int, up, uq, nu: int) -> float:
+    """The largest w' <= w where max_i (lp + lq w') <= min_j (up + uq w') (the first
+    ``nl`` and ``nu`` entries), the crossing of a (lower, upper) pair: the gap is concave
+    in w', so from w each step goes to the crossing of the pair binding there, which is
+    never below the answer (a pair whose gap closes as w' falls: w itself is returned
+    and the caller's check decides)."""
+    for _ in range(nl + nu + 2):
+        i, lo = 0, lp[0] + lq[0] * w
+        for k in range(1, nl):
+            x = lp[k] + lq[k] * w
+            if x > lo:
+                i, lo = k, x
+        j, hi = 0, up[0] + uq[0] * w
+        for k in range(1, nu):
+            x = up[k] + uq[k] * w
+            if x < hi:
+                j, hi = k, x
+        d = lq[i] - uq[j]
+        if lo <= hi or d <= 0.0:
+            return w
+        nxt = (up[j] - lp[i]) / d
+        if not nxt < w:
+            return w
+        w = nxt
+    return w
 
 
 @njit(cache=True, error_model="numpy")
@@ -143,12 +173,7 @@ def largest(top: float, h: float, w_next: float, cu, cw, rhs, coriolis: float,
             nl += 1
         elif cw[j] > 0.0:
             best = min(best, rhs[j] / cw[j])
-    for i in range(nl):
-        for j in range(nu):
-            d = lq[i] - uq[j]
-            if d > 0.0:
-                best = min(best, (up[j] - lp[i]) / d)
-    best = max(best, 0.0)
+    best = max(_crossing(best, lp, lq, nl, up, uq, nu), 0.0)
     if coriolis < math.inf and best > 0.0:
         x = math.sqrt(best)
         for j in range(nu):   # -c / sqrt(w) <= up + uq w

@@ -126,6 +126,28 @@ def test_the_closed_form_largest_speed_is_the_bisected_one():
     assert checked > 200
 
 
+def test_the_crossing_walk_is_the_lowest_pair_crossing():
+    """knot._crossing (a walk along the binding pairs) against every (lower, upper) pair's
+    crossing: the lowest one below the start where the bounds meet, else the start."""
+    rng = np.random.default_rng(11)
+    checked = 0
+    for _ in range(3000):
+        nl, nu = rng.integers(1, 14, size=2)
+        lp, up = rng.normal(scale=100.0, size=nl) - 50.0, rng.normal(scale=100.0, size=nu) + 50.0
+        lq, uq = rng.normal(scale=0.1, size=nl), rng.normal(scale=0.1, size=nu)
+        w = 10.0 ** rng.uniform(2, 6)
+        got = knot._crossing(w, lp, lq, nl, up, uq, nu)
+        if (lp + lq * got).max() > (up + uq * got).min() + 1e-9 * (1.0 + got):
+            continue   # the bounds never meet below w: the caller's check refuses it
+        d = lq[:, None] - uq[None, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cross = np.where(d > 0.0, (up[None, :] - lp[:, None]) / d, np.inf)
+        want = min(w, cross.min())
+        assert got == pytest.approx(want, rel=1e-12, abs=1e-9), (got, want)
+        checked += want < w
+    assert checked > 200   # the bounds meet below w in about a tenth of the draws
+
+
 @pytest.mark.parametrize("n", [1, 2, 3, 50, 2000])
 def test_knots_keep_the_ends_and_no_step_below_min_knot(n):
     """The ends kept; kept knots at least MIN_KNOT apart (the last excepted); a point

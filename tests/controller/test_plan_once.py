@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from numba import njit
 
 from cadcnc.controller import plan_once, topp
@@ -156,3 +157,35 @@ def test_a_repeated_run_is_planned_once_as_it_would_be_alone():
     for run, profile in zip(plan.runs, plan.profiles):
         alone = plan_run(run, machine)
         assert alone.duration == profile.duration and np.array_equal(alone.v, profile.v)
+
+
+def test_runs_equal_but_for_round_off_share_a_plan_and_others_do_not():
+    """The same R 9 quarter arc at two places (its tangents then differ by round-off)
+    shares one plan, within 1e-9 of the second's own; the arc at R 9.001 has its own."""
+    from cadcnc.controller import Machine
+    from cadcnc.controller.feed_plan import plan_feed, plan_run
+    from cadcnc.controller.pieces import Piece
+
+    def arc(radius: float, at) -> np.ndarray:
+        phi = np.linspace(0.0, 0.5 * np.pi, 60)
+        return np.c_[radius * np.cos(phi), radius * np.sin(phi), 0.0 * phi] + at
+
+    moves = []
+    for radius, at in ((9.0, (0.0, 0.0, 0.0)), (9.0, (0.1234567, 0.7654321, 5.0)),
+                       (9.001, (0.0, 0.0, 10.0))):
+        p = arc(radius, np.asarray(at))
+        moves += [p, np.array([p[-1], p[-1] + (0.0, 0.0, 5.0)])]   # a corner: a new run
+    lengths = [np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
+               for p in moves]
+    lengths[2] = lengths[0]   # as a program gives them: the arc lengths of its steps
+    pieces = [Piece(p, s, 150.0, k) for k, (p, s) in enumerate(zip(moves, lengths))]
+    machine = Machine.default()
+    plan = plan_feed(pieces, machine)
+    arcs = [k for k, run in enumerate(plan.runs) if run.curved]
+    assert len(arcs) == 3
+    first, moved, wider = (plan.runs[k] for k in arcs)
+    assert not np.array_equal(first.T, moved.T)   # the round-off is there
+    assert plan.profiles[arcs[0]] is plan.profiles[arcs[1]]
+    assert plan.profiles[arcs[2]] is not plan.profiles[arcs[0]]
+    alone = plan_run(moved, machine)
+    assert plan.profiles[arcs[1]].duration == pytest.approx(alone.duration, rel=1e-9)
