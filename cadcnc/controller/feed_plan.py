@@ -162,9 +162,24 @@ def _first_window(run: Run, A, J) -> float:
     return float(np.min(np.where(t > 0.0, A / J, np.inf)))
 
 
-def _plan_share(run: Run, machine: Machine, limits, coriolis: float) -> Profile:
-    """The run's profile with the Coriolis term's share ``coriolis`` (see the module
-    doc): turns flattened, or the window grown, until the window is long enough."""
+@dataclass
+class _Windowed:
+    """A run's plan at one Coriolis share once its window suffices, before the derivatives
+    are tightened: ``plan`` as :func:`.plan_once.plan_once` returns it."""
+
+    coriolis: float
+    window: float
+    wl: np.ndarray
+    plan: tuple
+
+    @property
+    def duration(self) -> float:
+        return float(self.plan[0][-1]) + self.window
+
+
+def _windowed(run: Run, machine: Machine, limits, coriolis: float) -> _Windowed:
+    """The run's plan with the Coriolis term's share ``coriolis`` (see the module doc):
+    turns flattened, or the window grown, until the window is long enough."""
     V, A, J = limits
     wl = _speed_limits(run, V, J, machine.period)
     window = _first_window(run, A, J)
@@ -174,7 +189,7 @@ def _plan_share(run: Run, machine: Machine, limits, coriolis: float) -> Profile:
         t, w, u, v, a, S, need = plan
         top = float(np.max(need, initial=0.0))
         if top <= window:
-            break
+            return _Windowed(coriolis, window, wl, plan)
         flattening = flattening and round_ < FLATTEN_ROUNDS and top < last   # progress
         last = top
         if flattening and topp.flatten(run.s, t, w, u, wl, need, window):
@@ -184,14 +199,20 @@ def _plan_share(run: Run, machine: Machine, limits, coriolis: float) -> Profile:
                             "curvature leaves no jerk for the feed to change (limits "
                             f"{machine.summary()})")
         window = top
-    else:
-        raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: no "
-                        f"averaging window keeps the jerk within {machine.summary()}")
-    if run.curved:   # (a straight run's derivatives are the same everywhere)
-        plan = _tightened(run, wl, limits, machine.period, window, coriolis, plan)
+    raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: no "
+                    f"averaging window keeps the jerk within {machine.summary()}")
+
+
+def _profile(run: Run, machine: Machine, limits, chosen: _Windowed) -> Profile:
+    """The chosen plan with, on a curved run, the derivatives taken only where the motion
+    goes (a straight run's are the same everywhere), as a profile."""
+    plan = chosen.plan
+    if run.curved:
+        plan = _tightened(run, chosen.wl, limits, machine.period, chosen.window,
+                          chosen.coriolis, plan)
     t, w, u, v, a, S, need = plan
     keep = np.r_[np.diff(run.s) > 0.0, True]
-    return Profile(t[keep], run.s[keep], v[keep], a[keep], S[keep], window)
+    return Profile(t[keep], run.s[keep], v[keep], a[keep], S[keep], chosen.window)
 
 
 def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
@@ -211,21 +232,22 @@ def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
 def _best_share(run: Run, machine: Machine, limits) -> Profile:
     """The run planned at CORIOLIS_SHARE; where the curvature terms lengthened its window
     past the first one, the share moved by SHARE_STEP while that shortens the run (a larger
-    share lets the feed change faster on a curve but asks for a longer window)."""
-    plan = _plan_share(run, machine, limits, CORIOLIS_SHARE)
-    if plan.window <= _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9):  # round-off
-        return plan
+    share lets the feed change faster on a curve but asks for a longer window). The shares
+    are compared before the derivatives are tightened, and only the chosen one is."""
+    first = _windowed(run, machine, limits, CORIOLIS_SHARE)
+    if first.window <= _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9):  # round-off
+        return _profile(run, machine, limits, first)
     for step in (-SHARE_STEP, SHARE_STEP):
-        share, best = CORIOLIS_SHARE, plan
+        best, share = first, CORIOLIS_SHARE
         for _ in range(SHARE_STEPS):
             share += step
-            other = _plan_share(run, machine, limits, share)
+            other = _windowed(run, machine, limits, share)
             if other.duration >= best.duration:
                 break
             best = other
-        if best is not plan:
-            return best
-    return plan
+        if best is not first:
+            return _profile(run, machine, limits, best)
+    return _profile(run, machine, limits, first)
 
 
 def _even_ratio(run: Run, A: np.ndarray, J: np.ndarray) -> np.ndarray | None:
@@ -346,5 +368,13 @@ def _same_run(a: Run, b: Run) -> bool:
     SAME_RUN (a raster's repeated passes differ by round-off where they lie on the part)."""
     return (np.array_equal(a.offsets, b.offsets) and np.array_equal(a.s, b.s)
             and np.array_equal(a.cap, b.cap)
-            and all(np.allclose(getattr(a, n), getattr(b, n), rtol=SAME_RUN, atol=SAME_RUN,
-                                equal_nan=True) for n in _DERIVATIVES))
+            and all(_close(getattr(a, n), getattr(b, n)) for n in _DERIVATIVES))
+
+
+def _close(a: np.ndarray, b: np.ndarray) -> bool:
+    """Equal, or within SAME_RUN (absolute and relative) everywhere; a NaN or an infinity
+    that differs: not close."""
+    if np.array_equal(a, b):
+        return True
+    with np.errstate(invalid="ignore"):
+        return bool(np.all(np.abs(a - b) <= SAME_RUN * (1.0 + np.abs(b))))

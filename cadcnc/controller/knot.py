@@ -130,18 +130,20 @@ def _crossing(w: float, lp, lq, nl: int, up, uq, nu: int) -> float:
     never below the answer (a pair whose gap closes as w' falls: w itself is returned
     and the caller's check decides)."""
     for _ in range(nl + nu + 2):
-        i, lo = 0, lp[0] + lq[0] * w
-        for k in range(1, nl):
-            x = lp[k] + lq[k] * w
-            if x > lo:
-                i, lo = k, x
-        j, hi = 0, up[0] + uq[0] * w
-        for k in range(1, nu):
-            x = up[k] + uq[k] * w
-            if x < hi:
-                j, hi = k, x
+        lo, hi = -math.inf, math.inf   # (no branches: most knots stop here)
+        for k in range(nl):
+            lo = max(lo, lp[k] + lq[k] * w)
+        for k in range(nu):
+            hi = min(hi, up[k] + uq[k] * w)
+        if lo <= hi:
+            return w
+        i, j = 0, 0   # the first binding pair, as a scan would find it
+        while i < nl - 1 and lp[i] + lq[i] * w != lo:
+            i += 1
+        while j < nu - 1 and up[j] + uq[j] * w != hi:
+            j += 1
         d = lq[i] - uq[j]
-        if lo <= hi or d <= 0.0:
+        if d <= 0.0:
             return w
         nxt = (up[j] - lp[i]) / d
         if not nxt < w:
