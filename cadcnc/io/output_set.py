@@ -92,7 +92,9 @@ class OutputSet:
             self.targets[d] = target
 
     def write(self, contents: dict) -> None:
-        """Write ``{destination: bytes or str}`` (every destination of the set) atomically."""
+        """Write ``{destination: bytes or str, or an iterable of them}`` (every destination
+        of the set) atomically; an iterable is written a chunk at a time as it yields them
+        (an error it raises leaves nothing written)."""
         contents = {Path(k): v for k, v in contents.items()}
         missing = [str(d) for d in self.destinations if d not in contents]
         if missing:
@@ -121,11 +123,13 @@ class OutputSet:
                                        dir=target.parent)
             temps.append((tmp, target, d))
             with os.fdopen(fd, "wb") as fh:
-                if isinstance(data, str):   # encoded a slice at a time: no second copy
-                    for a in range(0, len(data), TEXT_SLICE):
-                        fh.write(data[a:a + TEXT_SLICE].encode("utf-8"))
-                else:
-                    fh.write(data)
+                chunks = (data,) if isinstance(data, (str, bytes, bytearray)) else data
+                for chunk in chunks:
+                    if isinstance(chunk, str):   # encoded a slice at a time: no second copy
+                        for a in range(0, len(chunk), TEXT_SLICE):
+                            fh.write(chunk[a:a + TEXT_SLICE].encode("utf-8"))
+                    else:
+                        fh.write(chunk)
             os.chmod(tmp, 0o666 & ~_umask())
 
 

@@ -28,9 +28,10 @@ from ..io.output_set import OutputSet
 from ..io.program_json import read_program
 from ..ops.stream_steppers import stepper_factory
 from ..verification import gate_program
-from ..verification.stream_check import check_program_on_part, check_stream
+from ..verification.stream_check import StreamChecker, check_program_on_part, check_stream
 
 SUFFIXES = (".npy", ".txt")
+WRITE_ROWS = 1 << 15   # periods printed or copied to a file at a time (a few MB)
 
 
 @dataclass
@@ -116,15 +117,13 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
                                       "(--allow-gouge writes it)"])
     done = StreamRun(EXIT_OK if gate.ok else EXIT_GOUGE, stream=stream)
     if outputs is not None:
-        # made once the gate has let go of its moves: the files' bytes never sit in
-        # memory beside them; each .txt's numbers as printed are checked again
-        tick.stage = "checking the files' numbers against the machine's limits"
-        contents = _contents(stream.positions, outputs)
-        problems = _printed_broken(program, machine, contents)
-        if problems:
-            return _over_limits(problems, hal)
-        tick.stage = "writing"
-        outputs.write(contents)
+        # written WRITE_ROWS periods at a time, each .txt's numbers as printed checked
+        # again on the way: a refusal leaves nothing written
+        tick.stage = "writing (each .txt's numbers checked as printed)"
+        try:
+            outputs.write(_contents(program, machine, stream.positions, outputs))
+        except _PrintedOver as over:
+            return _over_limits(over.problems, hal)
         done.written = [str(d) for d in outputs.destinations]
     if hal:
         tick.stage = "executing in HAL"
@@ -166,7 +165,7 @@ def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_peri
         total = plan.periods
         refuse_over("the stream", total, max_periods, "servo periods",
                     "raise the feed or the machine's limits, or give --max-periods N "
-                    "(each about 150 bytes in memory)")
+                    "(each about 55 bytes in memory)")
         if say is not None:
             say(f"cadcnc: stream: {total} periods of {machine.period * 1e3:g} ms "
                 f"(cycle {total * machine.period:.3f} s) to compute")
@@ -180,17 +179,44 @@ def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_peri
                           exact=exact, on_plan=counted)
 
 
-def _contents(positions, outputs) -> dict:
-    """``{destination: bytes or str}`` of every output (.npy, .txt)."""
-    contents = {}
-    for dest in (outputs.destinations if outputs is not None else ()):
-        if dest.suffix.lower() == ".npy":
-            buf = io.BytesIO()
-            np.save(buf, positions)
-            contents[dest] = buf.getvalue()
-        else:
-            contents[dest] = stream_text(positions)
-    return contents
+class _PrintedOver(Exception):
+    """A .txt's numbers as printed break the limits or miss the ends (``problems``)."""
+
+    def __init__(self, problems: list[str]):
+        super().__init__(problems[0])
+        self.problems = problems
+
+
+def _contents(program, machine, positions, outputs) -> dict:
+    """``{destination: chunks}`` of every output (.npy, .txt), made as they are written
+    (a file's bytes are never all in memory)."""
+    return {dest: _npy_chunks(positions) if dest.suffix.lower() == ".npy"
+            else _txt_chunks(program, machine, positions, str(dest))
+            for dest in outputs.destinations}
+
+
+def _npy_chunks(positions: np.ndarray):
+    """The bytes ``np.save`` writes for ``positions``: its header, then its rows."""
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(header, np.lib.format.header_data_from_array_1_0(
+        positions))
+    yield header.getvalue()
+    for a in range(0, len(positions), WRITE_ROWS):
+        yield np.ascontiguousarray(positions[a:a + WRITE_ROWS]).tobytes()
+
+
+def _txt_chunks(program, machine, positions: np.ndarray, name: str):
+    """:func:`stream_text` of ``positions`` a block at a time, each block's numbers as
+    printed checked against the limits and ends (:class:`_PrintedOver` after the last)."""
+    limits, ends = _limits_and_ends(program, machine)
+    checker = StreamChecker(machine.period, limits, name)
+    for a in range(0, len(positions), WRITE_ROWS):
+        text = stream_text(positions[a:a + WRITE_ROWS])
+        checker.feed(np.fromstring(text, dtype=np.float64, sep=" ").reshape(-1, 3))
+        yield text
+    problems = checker.result(*ends).problems
+    if problems:
+        raise _PrintedOver(problems)
 
 
 def _over_limits(problems: list[str], hal: bool) -> StreamRun:
@@ -200,20 +226,14 @@ def _over_limits(problems: list[str], hal: bool) -> StreamRun:
                         + (" or executed" if hal else "") + " (exit 5)"])
 
 
-def _limits_broken(program, machine, positions, what: str = "the stream") -> list[str]:
+def _limits_and_ends(program, machine) -> tuple[tuple, tuple]:
+    """The machine's (velocity, acceleration, jerk) limits and the program's ends."""
+    return ((machine.max_velocity, machine.max_acceleration, machine.max_jerk),
+            (program.segments[0].points[0], program.segments[-1].points[-1]))
+
+
+def _limits_broken(program, machine, positions) -> list[str]:
     """What breaks the machine's limits or misses the program's ends in ``positions``
-    ((N, 3) mm, named ``what``)."""
-    limits = (machine.max_velocity, machine.max_acceleration, machine.max_jerk)
-    ends = (program.segments[0].points[0], program.segments[-1].points[-1])
-    return check_stream(positions, machine.period, limits, *ends, what=what).problems
-
-
-def _printed_broken(program, machine, contents) -> list[str]:
-    """:func:`_limits_broken` of each .txt's numbers as printed (9 decimals)."""
-    for dest, text in contents.items():
-        if isinstance(text, str):
-            rows = np.fromstring(text, dtype=np.float64, sep=" ").reshape(-1, 3)
-            found = _limits_broken(program, machine, rows, str(dest))
-            if found:
-                return found
-    return []
+    ((N, 3) mm)."""
+    limits, ends = _limits_and_ends(program, machine)
+    return check_stream(positions, machine.period, limits, *ends).problems

@@ -15,6 +15,7 @@ Lengths in mm.
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 
 import numpy as np
 from OCP.Bnd import Bnd_Box
@@ -56,7 +57,9 @@ class PartFaces:
 
     ``probes``: probes already made (the pair's), by face number. ``memo``: a dict that
     keeps every exact point-to-face distance of :meth:`distance` by face and point, so
-    that gates on the same part share them (None: none kept, the reference gate).
+    that gates on the same part share them (None: none kept, the reference gate). Inside
+    :meth:`scratch` new distances go to a dict of their own, dropped when it ends (a long
+    stream's moves: the memo would grow with every period).
     """
 
     def __init__(self, part, probes: dict[int, FaceProbe], tol: Tolerances,
@@ -64,6 +67,7 @@ class PartFaces:
         self.part, self.tol = part, tol
         self.probes = dict(probes)
         self.memo = memo
+        self._scratch: dict | None = None
         n = len(part)
         self.loose = np.empty((n + 1, 2, 3))
         self.loose[0, 0], self.loose[0, 1] = np.inf, -np.inf
@@ -92,12 +96,23 @@ class PartFaces:
             return self.probe(n).face_distance(point)
         key = (n, np.asarray(point, float).tobytes())
         found = self.memo.get(key)
+        if found is None and self._scratch is not None:
+            found = self._scratch.get(key)
         if found is None:
             probe = self.probe(n)
             found = probe.plane_distance(point) or self._twin_distance(n, point) \
                 or probe.interior_distance(point) or probe.face_distance(point)
-            self.memo[key] = found
+            (self.memo if self._scratch is None else self._scratch)[key] = found
         return found
+
+    @contextmanager
+    def scratch(self):
+        """Distances computed inside are kept only until it ends (the memo is still read)."""
+        before, self._scratch = self._scratch, {}
+        try:
+            yield
+        finally:
+            self._scratch = before
 
     def _twin_distance(self, n: int, point) -> tuple[float, float] | None:
         if n not in self._twins:

@@ -60,15 +60,42 @@ class ProgramGate:
 
 
 def _joined(parts: list[np.ndarray]) -> np.ndarray | None:
-    """The polylines end to end, a repeated joint point dropped; None when empty."""
+    """The polylines end to end, a repeated joint point dropped; None when empty. Parts
+    that lie end to end in one array (a stream's segments) are joined as a read-only view
+    of it, not copied."""
     out: list[np.ndarray] = []
     for p in parts:
         p = np.asarray(p, float).reshape(-1, 3)
         if out and len(p) and len(out[-1]) and np.array_equal(out[-1][-1], p[0]):
             p = p[1:]
         if len(p):
-            out.append(p)
-    return np.vstack(out) if out else None
+            both = _adjacent(out[-1], p) if out else None
+            if both is None:
+                out.append(p)
+            else:
+                out[-1] = both
+    if not out:
+        return None
+    return out[0] if len(out) == 1 else np.vstack(out)
+
+
+def _adjacent(a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """``a`` then ``b`` as one read-only view when both are C-contiguous (n, 3) rows of
+    the array that owns ``b``'s memory and ``b``'s rows follow ``a``'s, else None."""
+    owner = b
+    while isinstance(owner.base, np.ndarray):
+        owner = owner.base
+    if (owner is b or owner.dtype != np.float64 or not owner.flags.c_contiguous
+            or owner.size % 3 or not (a.flags.c_contiguous and b.flags.c_contiguous)):
+        return None
+    start, row = owner.ctypes.data, 3 * owner.itemsize
+    if not (start <= a.ctypes.data and a.ctypes.data + a.nbytes == b.ctypes.data
+            and b.ctypes.data + b.nbytes <= start + owner.nbytes):
+        return None
+    first = (a.ctypes.data - start) // row
+    view = owner.reshape(-1, 3)[first:first + len(a) + len(b)]
+    view.flags.writeable = False
+    return view
 
 
 def _n_moves(polyline) -> int:

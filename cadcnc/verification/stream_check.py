@@ -39,12 +39,87 @@ class StreamCheck:
     over: dict = field(default_factory=dict)
 
 
-def _differences(x: np.ndarray, period: float, order: int):
-    """Per chunk: (first row, |diff(x, order)| / T^order) over the whole array."""
-    n = len(x) - order
-    for lo in range(0, max(n, 0), CHUNK):
-        hi = min(n, lo + CHUNK)
-        yield lo, np.abs(np.diff(x[lo:hi + order], order, axis=0)) / period ** order
+class StreamChecker:
+    """:func:`check_stream` fed a block of rows at a time (a stream printed or written in
+    chunks), with the same verdict as the whole array at once: the last three rows of each
+    block are kept for the next block's differences."""
+
+    def __init__(self, period: float, limits, what: str = "the stream"):
+        self.period, self.what = period, what
+        self.limits = [np.asarray(lim, dtype=np.float64) for lim in limits]
+        self.rows = 0
+        self.tail = np.empty((0, 3))
+        self.first = self.last = None
+        self.bad_shape: tuple | None = None
+        self.not_finite: int | None = None
+        self.peak = np.zeros((3, 3))
+        self.where = np.zeros((3, 3), dtype=np.int64)
+        self.count = np.zeros((3, 3), dtype=np.int64)
+
+    def feed(self, rows) -> None:
+        """The next rows ((n, 3) mm)."""
+        x = np.asarray(rows, dtype=np.float64)
+        if x.ndim != 2 or x.shape[1] != 3:
+            self.bad_shape = self.bad_shape or x.shape
+            return
+        if not len(x) or self.bad_shape or self.not_finite is not None:
+            self.rows += len(x)
+            return
+        finite = np.isfinite(x).all(axis=1)
+        if not finite.all():
+            self.not_finite = self.rows + int(np.flatnonzero(~finite)[0])
+            self.rows += len(x)
+            return
+        if self.first is None:
+            self.first = x[0].copy()
+        self.last = x[-1].copy()
+        for lo in range(0, len(x), CHUNK):
+            self._differences(x[lo:lo + CHUNK])
+
+    def _differences(self, x: np.ndarray) -> None:
+        both = np.concatenate([self.tail, x])
+        origin = self.rows - len(self.tail)   # the stream's row of both[0]
+        for k in range(3):
+            order = k + 1
+            new = max(len(self.tail) - order, 0)   # the first difference not taken yet
+            if len(both) - new <= order:
+                continue
+            d = np.abs(np.diff(both[new:], order, axis=0)) / self.period ** order
+            top = d.max(axis=0)
+            better = top > self.peak[k]
+            self.where[k][better] = origin + new + d.argmax(axis=0)[better]
+            self.peak[k] = np.maximum(self.peak[k], top)
+            allowed = self.limits[k] * (1.0 + STREAM_LIMIT_SLACK)
+            self.count[k] += (d > allowed).sum(axis=0)
+        self.rows += len(x)
+        self.tail = both[-3:].copy()
+
+    def result(self, start, end) -> StreamCheck:
+        """The verdict on every row fed, its ends against ``start`` and ``end`` (mm)."""
+        what = self.what
+        if self.bad_shape is not None or self.rows < 1:
+            shape = self.bad_shape or (0, 3)
+            return StreamCheck(False, [f"{what}: not an (N, 3) array of positions: {shape}"])
+        if self.not_finite is not None:
+            return StreamCheck(False, [f"{what}: position {self.not_finite} is not finite"])
+        problems: list[str] = []
+        for name, row, want in (("first", self.first, start), ("last", self.last, end)):
+            off = float(np.abs(row - np.asarray(want, dtype=np.float64)).max())
+            if not off <= STREAM_END:
+                problems.append(f"{what}: its {name} position is {off:.3g} mm from the "
+                                f"program's {name} point (at most {STREAM_END:g} mm)")
+        peaks, over = {}, {}
+        for k, ((kind, unit), limit) in enumerate(zip(KINDS, self.limits)):
+            peak, count = self.peak[k], self.count[k]
+            peaks[kind] = dict(zip(AXES, peak.tolist()))
+            over[kind] = dict(zip(AXES, count.tolist()))
+            for a in range(3):
+                if count[a]:
+                    problems.append(
+                        f"{what}: {kind} of axis {AXES[a]} reaches {peak[a]:.6g} {unit} at "
+                        f"period {self.where[k][a]} ({100 * peak[a] / limit[a]:.4g} % of the "
+                        f"machine's {limit[a]:g}), over the limit in {count[a]} periods")
+        return StreamCheck(not problems, problems, peaks, over)
 
 
 def check_stream(positions, period: float, limits, start, end,
@@ -53,37 +128,11 @@ def check_stream(positions, period: float, limits, start, end,
     (velocity, acceleration, jerk), each three numbers per axis X Y Z (mm/s, mm/s²,
     mm/s³), and its ends against ``start`` and ``end`` (mm) (module doc)."""
     x = np.asarray(positions, dtype=np.float64)
-    problems: list[str] = []
+    checker = StreamChecker(period, limits, what)
     if x.ndim != 2 or x.shape[1] != 3 or len(x) < 1:
         return StreamCheck(False, [f"{what}: not an (N, 3) array of positions: {x.shape}"])
-    if not np.isfinite(x).all():
-        bad = int(np.flatnonzero(~np.isfinite(x).all(axis=1))[0])
-        return StreamCheck(False, [f"{what}: position {bad} is not finite"])
-    for name, row, want in (("first", x[0], start), ("last", x[-1], end)):
-        off = float(np.abs(row - np.asarray(want, dtype=np.float64)).max())
-        if not off <= STREAM_END:
-            problems.append(f"{what}: its {name} position is {off:.3g} mm from the program's "
-                            f"{name} point (at most {STREAM_END:g} mm)")
-    peaks, over = {}, {}
-    for order, ((kind, unit), limit) in enumerate(zip(KINDS, limits), 1):
-        limit = np.asarray(limit, dtype=np.float64)
-        allowed = limit * (1.0 + STREAM_LIMIT_SLACK)
-        peak, where, count = np.zeros(3), np.zeros(3, dtype=np.int64), np.zeros(3, np.int64)
-        for lo, d in _differences(x, period, order):
-            top = d.max(axis=0)
-            better = top > peak
-            where[better] = lo + d.argmax(axis=0)[better]
-            peak = np.maximum(peak, top)
-            count += (d > allowed).sum(axis=0)
-        peaks[kind] = dict(zip(AXES, peak.tolist()))
-        over[kind] = dict(zip(AXES, count.tolist()))
-        for a in range(3):
-            if count[a]:
-                problems.append(
-                    f"{what}: {kind} of axis {AXES[a]} reaches {peak[a]:.6g} {unit} at period "
-                    f"{where[a]} ({100 * peak[a] / limit[a]:.4g} % of the machine's "
-                    f"{limit[a]:g}), over the limit in {count[a]} periods")
-    return StreamCheck(not problems, problems, peaks, over)
+    checker.feed(x)
+    return checker.result(start, end)
 
 
 def check_program_on_part(program, part, name: str, part_name: str, within: float) -> None:

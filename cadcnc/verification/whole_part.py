@@ -72,12 +72,13 @@ def check_whole_part(part, probes: dict[int, FaceProbe], toolpath,
     sweeps = []
     for first in range(0, max(len(moves) - 1, 1), MOVES_BLOCK):
         block = moves[first:first + MOVES_BLOCK + 1]   # the next block starts at its end
-        floors = None if before is None else before_floors(faces, before, block, tol)
-        line = Polyline(faces, material, block, ball, allowance=allowance,
-                        anchors=_anchors(centres, block), floors=floors, progress=progress,
-                        stage="moves").run()
-        sweeps.append((first, _sweep(line, ball, allowance, blend, material)))
-        del line   # a block's arrays go before the next block's are made
+        with faces.scratch():   # a block's distances and arrays go before the next's
+            floors = None if before is None else before_floors(faces, before, block, tol)
+            line = Polyline(faces, material, block, ball, allowance=allowance,
+                            anchors=_anchors(centres, block), floors=floors,
+                            progress=progress, stage="moves").run()
+            sweeps.append((first, _sweep(line, ball, allowance, blend, material)))
+            del line
     return whole, sweeps[0][1] if len(sweeps) == 1 else merged_sweeps(sweeps)
 
 

@@ -31,3 +31,46 @@ def test_moves_in_blocks_are_judged_as_all_at_once(boss, monkeypatch, every):
                                      for a, b in h.moves)
     else:
         assert blocks.ok and blocks.sweep.depth_bound_mm <= blocks.limit_mm
+
+
+def test_a_blocks_distances_are_dropped_with_it(boss, monkeypatch):
+    """Inside shared gates the moves' exact distances live only as long as their block (a
+    long stream's would grow the memo with every period): the same verdict as when the
+    memo keeps them, and a memo no larger than the centres' own."""
+    import contextlib
+
+    from cadcnc.verification.gate_cache import cache_for, shared_gates
+    from cadcnc.verification.material import PartFaces
+
+    part, tp = boss
+    moves = tp.points[::8]
+    sizes, gates = [], []
+    for keep in (False, True):
+        if keep:
+            monkeypatch.setattr(PartFaces, "scratch", lambda self: contextlib.nullcontext())
+        with shared_gates(part):
+            gates.append(gouge_gate(tp, part, moves=moves))
+            sizes.append(len(cache_for(part, tp.job.tolerances).memo))
+    same(*gates)
+    assert sizes[0] < sizes[1]   # the moves asked for distances of their own
+
+
+def test_a_streams_segments_are_joined_without_a_copy():
+    """Segments that lie end to end in one array (each led by the row before) join as a
+    read-only view of it; separate arrays are copied; both equal to stacking them."""
+    import numpy as np
+
+    from cadcnc.verification.program_gate import _joined
+
+    rows = np.arange(60.0).reshape(20, 3)
+    view = rows.view()
+    view.flags.writeable = False
+    parts = [view[0:5], view[4:12], view[11:20]]
+    joined = _joined(parts)
+    assert np.array_equal(joined, rows) and np.shares_memory(joined, rows)
+    assert not joined.flags.writeable
+    apart = [rows[0:5].copy(), rows[4:12].copy(), rows[11:20].copy()]
+    copied = _joined(apart)
+    assert np.array_equal(copied, rows) and not np.shares_memory(copied, rows)
+    gap = _joined([view[0:5], view[6:12]])   # not adjacent: stacked
+    assert np.array_equal(gap, np.vstack([rows[0:5], rows[6:12]]))
