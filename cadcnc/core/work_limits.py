@@ -30,9 +30,9 @@ MAX_VERIFY_POINTS = 2_000_000
 """Program points ``verify`` checks against OCCT in one run."""
 MAX_STREAM_PERIODS = 20_000_000
 """Servo periods one stream may hold (``cadcnc stream --max-periods``): 480 MB of
-positions (N x 3 float64); ``cadcnc stream`` takes about 55 bytes a period above its
+positions (N x 3 float64); ``cadcnc stream`` takes about 65 bytes a period above its
 0.5 GB start while it computes, gates and writes them (.npy and .txt; measured at 1, 2
-and 4 million periods), about 1.6 GB for this many: 5.6 h at 1 ms."""
+and 4 million periods), about 1.8 GB for this many: 5.6 h at 1 ms."""
 HEARTBEAT_S = 5.0
 """Longest silence (s) of a long stage: progress is reported at least this often."""
 

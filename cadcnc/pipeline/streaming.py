@@ -165,7 +165,7 @@ def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_peri
         total = plan.periods
         refuse_over("the stream", total, max_periods, "servo periods",
                     "raise the feed or the machine's limits, or give --max-periods N "
-                    "(each about 55 bytes in memory)")
+                    "(each about 65 bytes in memory)")
         if say is not None:
             say(f"cadcnc: stream: {total} periods of {machine.period * 1e3:g} ms "
                 f"(cycle {total * machine.period:.3f} s) to compute")
