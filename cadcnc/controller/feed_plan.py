@@ -305,24 +305,37 @@ class FeedPlan:
                              f"{self.machine.period * 1e3:g} ms), over the limit of "
                              f"{max_periods}: raise --max-periods, or check the feed and "
                              "the machine's limits")
-        times = np.arange(n + 1) * self.machine.period
-        starts = self.starts
-        r = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, len(self.runs) - 1)
+        period, starts = self.machine.period, self.starts
         piece = np.empty(n + 1, dtype=np.int64)
         s = np.empty(n + 1)
-        bounds = np.searchsorted(r, np.arange(len(self.runs) + 1), side="left")  # r grows
+        bounds = _first_periods(starts, period, n)
         for j in range(len(self.runs)):
             sel = slice(bounds[j], bounds[j + 1])
             if bounds[j] == bounds[j + 1]:
                 continue
             run = self.runs[j]
-            at = self.profiles[j].position(times[sel] - starts[j])
+            at = self.profiles[j].position(np.arange(bounds[j], bounds[j + 1]) * period
+                                           - starts[j])
             k = np.clip(np.searchsorted(run.offsets, at, side="right") - 1, 0,
                         len(run.pieces) - 1)
             piece[sel] = run.first + k
             lengths = np.diff(run.offsets)
             s[sel] = np.clip(at - run.offsets[k], 0.0, lengths[k])
         return piece, s
+
+
+def _first_periods(starts: np.ndarray, period: float, n: int) -> list[int]:
+    """Per run j, its first position: the first k in 0..n with k * period >= starts[j]
+    (run 0 from 0, and n + 1 after the last), without a time per period in memory."""
+    out = [0]
+    for start in starts[1:-1]:   # (starts[-1]: the end of the last run)
+        k = min(max(math.ceil(start / period), 0), n + 1)
+        while k > 0 and (k - 1) * period >= start:
+            k -= 1
+        while k <= n and k * period < start:
+            k += 1
+        out.append(max(k, out[-1]))
+    return out + [n + 1]
 
 
 def plan_feed(pieces: list[Piece], machine: Machine, planned: bool = True,

@@ -189,3 +189,22 @@ def test_runs_equal_but_for_round_off_share_a_plan_and_others_do_not():
     assert plan.profiles[arcs[2]] is not plan.profiles[arcs[0]]
     alone = plan_run(moved, machine)
     assert plan.profiles[arcs[1]].duration == pytest.approx(alone.duration, rel=1e-9)
+
+
+def test_each_runs_first_period_is_the_one_a_time_per_period_gives():
+    """feed_plan._first_periods against the searches over a time per period it replaces,
+    on random run starts, starts on a period exactly, and empty runs."""
+    from cadcnc.controller.feed_plan import _first_periods
+
+    rng = np.random.default_rng(5)
+    for period in (0.001, 0.0005, 0.004, 1e-6 * 3):
+        for _ in range(200):
+            durations = rng.choice([0.0, period, 3 * period, rng.uniform(0, 50 * period)],
+                                   size=rng.integers(1, 8))
+            starts = np.r_[0.0, np.cumsum(durations)]
+            n = max(int(math.ceil(starts[-1] / period)) + int(rng.integers(-3, 3)), 0)
+            times = np.arange(n + 1) * period
+            r = np.clip(np.searchsorted(starts, times, side="right") - 1, 0,
+                        len(durations) - 1)
+            want = np.searchsorted(r, np.arange(len(durations) + 1), side="left")
+            assert _first_periods(starts, period, n) == want.tolist()
