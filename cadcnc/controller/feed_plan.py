@@ -55,6 +55,7 @@ FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
 TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
 TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened this much
 MAX_PERIODS = 50_000_000
+BLOCK_ROWS = 1 << 16   # periods of targets made at a time (FeedPlan.blocks): a few MB
 SAME_RUN = 1e-11
 """Runs whose path derivatives agree within this (absolute, in their units, and relative)
 share one plan: the limits are then met within about 1e-7 of themselves on the other
@@ -298,30 +299,44 @@ class FeedPlan:
         return int(math.ceil(self.duration / self.machine.period - 1e-9))  # ceil's round-off
 
     def targets(self, max_periods: int = MAX_PERIODS) -> tuple[np.ndarray, np.ndarray]:
-        """Per position n = 0..periods (time n Ts): the piece and the arc length in it."""
+        """Per position n = 0..periods (time n Ts): the piece and the arc length in it
+        (:meth:`blocks` joined: the whole stream's targets in memory)."""
+        pieces, s = [], []
+        for piece, _, block in self.blocks(max_periods):
+            pieces.append(np.full(len(block), piece, dtype=np.int64))
+            s.append(block)
+        return np.concatenate(pieces), np.concatenate(s)
+
+    def checked_periods(self, max_periods: int = MAX_PERIODS) -> int:
+        """:attr:`periods`, InputError over ``max_periods``."""
         n = self.periods
         if n > max_periods:
             raise InputError(f"the stream would need {n} periods ({self.duration:.1f} s at "
                              f"{self.machine.period * 1e3:g} ms), over the limit of "
                              f"{max_periods}: raise --max-periods, or check the feed and "
                              "the machine's limits")
+        return n
+
+    def blocks(self, max_periods: int = MAX_PERIODS, size: int | None = None):
+        """Yield ``(piece, row, s)``: the positions n = row .. row + len(s) - 1 (time n Ts)
+        lie in piece ``piece`` at arc lengths ``s`` (mm) in it; rows in order, at most
+        ``size`` (default BLOCK_ROWS) a block, a piece's rows consecutive (pieces between
+        two periods have none). The targets of a stream of any length, a block at a time."""
+        n = self.checked_periods(max_periods)
+        size = size or BLOCK_ROWS
         period, starts = self.machine.period, self.starts
-        piece = np.empty(n + 1, dtype=np.int64)
-        s = np.empty(n + 1)
         bounds = _first_periods(starts, period, n)
-        for j in range(len(self.runs)):
-            sel = slice(bounds[j], bounds[j + 1])
-            if bounds[j] == bounds[j + 1]:
-                continue
-            run = self.runs[j]
-            at = self.profiles[j].position(np.arange(bounds[j], bounds[j + 1]) * period
-                                           - starts[j])
-            k = np.clip(np.searchsorted(run.offsets, at, side="right") - 1, 0,
-                        len(run.pieces) - 1)
-            piece[sel] = run.first + k
+        for j, run in enumerate(self.runs):
             lengths = np.diff(run.offsets)
-            s[sel] = np.clip(at - run.offsets[k], 0.0, lengths[k])
-        return piece, s
+            for a in range(bounds[j], bounds[j + 1], size):
+                b = min(a + size, bounds[j + 1])
+                at = self.profiles[j].position(np.arange(a, b) * period - starts[j])
+                k = np.clip(np.searchsorted(run.offsets, at, side="right") - 1, 0,
+                            len(run.pieces) - 1)
+                s = np.clip(at - run.offsets[k], 0.0, lengths[k])
+                cuts = (np.flatnonzero(k[1:] != k[:-1]) + 1).tolist()
+                for lo, hi in zip([0] + cuts, cuts + [len(k)]):
+                    yield run.first + int(k[lo]), a + lo, s[lo:hi]
 
 
 def _first_periods(starts: np.ndarray, period: float, n: int) -> list[int]:

@@ -14,12 +14,15 @@ program's first point at t = 0, row n the position at n Ts.
 
 from __future__ import annotations
 
+import errno
+import os
+import tempfile
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 
-from ..core.errors import GeometryError
+from ..core.errors import GeometryError, OutputError
 from ..core.progress import Progress
 from ..core.tolerances import STREAM_END
 from ..interp.cycle import CLOSED, END
@@ -46,7 +49,7 @@ class Stream:
     positions: np.ndarray
     plan: FeedPlan
     programmed_time: float
-    rows: np.ndarray          # (N,) the piece of each row
+    starts: np.ndarray        # (pieces + 1,) each piece's first row (the last: N)
     kernel_cuts: int = 0
     hermite_cuts: int = 0
     notes: list[str] = field(default_factory=list)
@@ -63,21 +66,24 @@ class Stream:
     def cycle_time(self) -> float:
         return self.periods * self.machine.period
 
+    @property
+    def rows(self) -> np.ndarray:
+        """(N,) the piece of each row (made on demand: 8 bytes a period)."""
+        return np.repeat(np.arange(len(self.starts) - 1), np.diff(self.starts))
+
     def derivatives(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Finite-difference velocity, acceleration and jerk of the positions (mm/s...)."""
+        """Finite-difference velocity, acceleration and jerk of the positions (mm/s...;
+        whole arrays: for short streams and plots)."""
         ts, x = self.machine.period, self.positions
         return (np.diff(x, axis=0) / ts, np.diff(x, 2, axis=0) / ts ** 2,
                 np.diff(x, 3, axis=0) / ts ** 3)
 
     def shares(self) -> dict[str, tuple[float, float, float]]:
-        """Per axis, the largest |v|, |a|, |j| of the positions as a share of the limits."""
-        m = self.machine
-        out = {}
-        for name, d, lim in zip(("velocity", "acceleration", "jerk"), self.derivatives(),
-                                (m.max_velocity, m.max_acceleration, m.max_jerk)):
-            peak = np.abs(d).max(axis=0) if len(d) else np.zeros(3)
-            out[name] = tuple(float(p / q) for p, q in zip(peak, lim))
-        return out
+        """Per axis, the largest |v|, |a|, |j| of the positions as a share of the limits
+        (a block of rows at a time)."""
+        peaks, _ = _peaks(self.positions, self.machine)
+        return {name: tuple(float(v) for v in peaks[k])
+                for k, name in enumerate(("velocity", "acceleration", "jerk"))}
 
     @property
     def rounded(self) -> frozenset[int]:
@@ -89,9 +95,8 @@ class Stream:
         """Per program segment, the streamed positions inside it, led by the row before
         (so every chord of the stream belongs to exactly one segment): the gate's moves.
         Read-only views of the positions (a segment's rows are consecutive)."""
-        seg_of_row = np.array([p.segment for p in self.plan.pieces])[self.rows]
-        seg_of_row[0] = 0
-        starts = _first_rows(seg_of_row, len(program.segments))
+        starts = _segment_rows(self.starts, [p.segment for p in self.plan.pieces],
+                               len(program.segments))
         view = self.positions.view()
         view.flags.writeable = False
         return [view[max(starts[k] - 1, 0):max(starts[k + 1], 1)]
@@ -109,12 +114,47 @@ class Stream:
             "machine": self.machine.source}
 
 
-def _first_rows(owner: np.ndarray, count: int) -> np.ndarray:
-    """(count + 1,) where each owner's rows start in ``owner`` (non-decreasing: the
-    stream's rows are in time order): owner k's rows are [out[k], out[k + 1])."""
-    if len(owner) > 1 and (owner[1:] < owner[:-1]).any():
-        raise ValueError("the stream's rows are not in the order of their pieces")
-    return np.searchsorted(owner, np.arange(count + 1), side="left")
+def _segment_rows(starts: np.ndarray, segments: list[int], count: int) -> np.ndarray:
+    """(count + 1,) where each program segment's rows start, from the pieces' first rows
+    ``starts`` and their ``segments`` (non-decreasing): row 0 belongs to segment 0."""
+    first = np.searchsorted(np.asarray(segments), np.arange(count + 1), side="left")
+    out = np.asarray(starts)[first]
+    out[1:] = np.maximum(out[1:], 1)
+    out[0] = 0
+    return out
+
+
+IN_MEMORY_ROWS = 1 << 18
+"""A stream of more positions keeps them in a scratch file (:func:`_positions_array`)."""
+
+
+def _reserve(f, size: int) -> None:
+    """The file's ``size`` bytes taken on the disk now (a full disk refuses here, not as
+    a fault while the positions are written), or merely set where the file system cannot."""
+    try:
+        os.posix_fallocate(f.fileno(), 0, size)
+    except OSError as e:
+        if e.errno not in (errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL):
+            raise
+        f.truncate(size)
+
+
+def _positions_array(rows: int, scratch: str | None) -> np.ndarray:
+    """(rows, 3) float64 for the positions: in memory up to IN_MEMORY_ROWS, else mapped
+    from a nameless scratch file in the folder ``scratch`` (None: the system's temporary
+    folder), gone with the array: the stream's memory stays bounded, the OS pages it."""
+    if rows <= IN_MEMORY_ROWS:
+        return np.empty((rows, 3))
+    size = rows * 3 * 8
+    folder = scratch or tempfile.gettempdir()
+    try:
+        with tempfile.TemporaryFile(dir=folder) as f:
+            _reserve(f, size)
+            return np.memmap(f, dtype=np.float64, mode="w+", shape=(rows, 3))
+    except OSError as e:
+        raise OutputError(f"the stream's scratch file of {size / 1e6:.0f} MB in {folder}: "
+                          f"{e.strerror or e}; free some room there or stream fewer "
+                          "periods") from None
 
 
 def _line(piece: Piece, s: np.ndarray) -> np.ndarray:
@@ -179,31 +219,41 @@ def _landed(stepper, piece: Piece, what: str) -> None:
                             "mm from it)")
 
 
-CHUNK = 100_000   # periods the kernel follows between two progress calls
+CHUNK = 100_000   # rows differenced or printed at a time
 SLACK = 1e-6      # relative: the finite differences' allowance over a limit
 REPLANS = 3       # plans again with the limit that was broken lowered by as much ...
 NOISE = 1.5       # ... unless it is broken this much: the positions' noise, not the plan
 NOISY_PERIOD = 1e-4   # s: below it the positions' rounding can break the jerk
 
 
-def _over(positions: np.ndarray, machine: Machine) -> list[tuple[float, int, int]]:
-    """Per quantity (velocity, acceleration, jerk): the largest finite-difference share
-    of the axis's limit, its period and its axis (CHUNK rows at a time: the differences'
-    temporaries stay bounded whatever the stream's length)."""
+def _peaks(positions: np.ndarray, machine: Machine) -> tuple[np.ndarray, np.ndarray]:
+    """(3, 3) shares and (3, 3) rows: per quantity (velocity, acceleration, jerk) and
+    axis, the largest finite-difference share of the limit and the period where it is
+    first reached (CHUNK rows at a time: the differences' temporaries stay bounded
+    whatever the stream's length)."""
     ts = machine.period
-    out = [(0.0, 0, 0)] * 3
+    share, where = np.zeros((3, 3)), np.zeros((3, 3), dtype=np.int64)
     for start in range(0, max(len(positions) - 1, 1), CHUNK):
         block = positions[start:start + CHUNK + 3]
         for k, lim in enumerate((machine.max_velocity, machine.max_acceleration,
                                  machine.max_jerk), start=1):
             if len(block) <= k:
                 continue
-            share = np.abs(np.diff(block, k, axis=0))
-            share /= ts ** k * np.asarray(lim)
-            row, axis = np.unravel_index(int(np.argmax(share)), share.shape)
-            if share[row, axis] > out[k - 1][0]:
-                out[k - 1] = (float(share[row, axis]), start + int(row) + k, int(axis))
-    return out
+            d = np.abs(np.diff(block, k, axis=0))
+            d /= ts ** k * np.asarray(lim)
+            top, row = d.max(axis=0), d.argmax(axis=0)
+            better = top > share[k - 1]
+            share[k - 1][better] = top[better]
+            where[k - 1][better] = start + row[better] + k
+    return share, where
+
+
+def _over(positions: np.ndarray, machine: Machine) -> list[tuple[float, int, int]]:
+    """Per quantity (velocity, acceleration, jerk): the largest finite-difference share
+    of the axis's limit, its period and its axis (:func:`_peaks`)."""
+    share, where = _peaks(positions, machine)
+    axes = share.argmax(axis=1)
+    return [(float(share[q, a]), int(where[q, a]), int(a)) for q, a in enumerate(axes)]
 
 
 def _refusal(over: list[tuple[float, int, int]], machine: Machine) -> PlanError:
@@ -224,43 +274,51 @@ def _refusal(over: list[tuple[float, int, int]], machine: Machine) -> PlanError:
         f"({why})")
 
 
-def _cut_rows(stepper, piece: Piece, s: np.ndarray, dest: np.ndarray, what: str, done: int,
-              total: int, progress: Progress | None) -> None:
-    """The kernel's positions of one cut into ``dest`` (len(s), 3), CHUNK periods at a
-    time (progress between; the plan made a chunk at a time too)."""
-    before = travelled = 0.0
-    for a in range(0, len(s), CHUNK):
-        b = min(a + CHUNK, len(s))
-        plan = follow_plan(piece, s[a:b], before, travelled)
-        dest[a:b] = follow(stepper, plan, piece.points[-1], float(piece.kappa[-1]), LANDING)
-        before, travelled = float(s[b - 1]), float(plan[-1, 0])
-        if progress is not None:
-            progress(min(done + b, total), total, "periods")
-    _landed(stepper, piece, what)
+class _CutRows:
+    """One cut's positions by its stepper, a block of rows at a time (the plan it follows
+    made a block at a time too: the same numbers as at once)."""
+
+    def __init__(self, stepper, piece: Piece, what: str):
+        self.stepper, self.piece, self.what = stepper, piece, what
+        self.before = self.travelled = 0.0
+
+    def __call__(self, s: np.ndarray) -> np.ndarray:
+        piece = self.piece
+        plan = follow_plan(piece, s, self.before, self.travelled)
+        out = follow(self.stepper, plan, piece.points[-1], float(piece.kappa[-1]), LANDING)
+        if len(s):
+            self.before, self.travelled = float(s[-1]), float(plan[-1, 0])
+        return out
+
+    def close(self) -> None:
+        _landed(self.stepper, self.piece, self.what)
 
 
 def stream_program(program: Program, machine: Machine, steppers: StepperFactory | None = None,
                    *, feed: float | None = None, planned: bool = True,
                    max_periods: int = MAX_PERIODS, progress: Progress | None = None,
                    blend: float = 0.0, exact: frozenset[int] = frozenset(),
-                   on_plan: Callable[[FeedPlan], None] | None = None) -> Stream:
+                   on_plan: Callable[[FeedPlan], None] | None = None,
+                   scratch: str | None = None) -> Stream:
     """Every period's position of ``program`` on ``machine`` (see the module doc).
 
     ``feed`` (mm/min) replaces the program's feed; ``planned=False`` streams at the
     programmed feed ignoring the limits (a comparison, not for a machine). A plan over
     ``max_periods`` periods is refused before any position is computed (InputError);
-    ``progress(done, total, "periods")`` hears of the work at least every CHUNK periods. A planned
+    ``progress(done, total, "periods")`` hears of the work after each block of periods
+    (:data:`~.feed_plan.BLOCK_ROWS` at most). A planned
     stream whose finite differences break a limit is planned again with that limit
     lowered by as much (REPLANS times at most), then refused (PlanError). ``blend`` (mm)
     rounds the corners of the links that pay for it within it, but not of the segments
     in ``exact`` (:func:`.link_blends.stream_pieces`); a blend is positioned on its samples by
     the Hermite. ``on_plan(plan)`` hears of each plan before its positions are computed
-    (to count, bound or announce the periods; a replan is heard again)."""
+    (to count, bound or announce the periods; a replan is heard again). ``scratch``: the
+    folder of a long stream's positions file (:func:`_positions_array`)."""
     pieces = stream_pieces(program, machine, feed, blend, exact)
     derate = np.ones(3)
     for _ in range(REPLANS + 1):
         stream = _stream(program, machine, pieces, steppers, planned, derate, max_periods,
-                         progress, on_plan)
+                         progress, on_plan, scratch)
         if not planned:
             return stream
         over = _over(stream.positions, machine)
@@ -275,37 +333,60 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
 
 
 def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
-            progress, on_plan=None) -> Stream:
-    """One plan (limits scaled by ``derate``) and its positions."""
+            progress, on_plan=None, scratch=None) -> Stream:
+    """One plan (limits scaled by ``derate``) and its positions, a block of periods at a
+    time (:meth:`FeedPlan.blocks`: no per-period array but the positions)."""
     plan = plan_feed(pieces, machine, planned, tuple(derate))
     if on_plan is not None:
         on_plan(plan)
-    rows, s = plan.targets(max_periods)
-    total = len(s) - 1   # periods: the rows after the start
-    positions = np.empty((len(s), 3))
-    cuts = program.cuts
-    kernel = hermite = 0
-    starts = _first_rows(rows, len(pieces))
-    for j, piece in enumerate(pieces):
-        sel = slice(starts[j], starts[j + 1])
-        if piece.cut is None:   # a link's straight move, or a blend by its samples
-            positions[sel] = (_line if len(piece.points) == 2 else _hermite)(piece, s[sel])
-            continue
-        stepper = None if steppers is None else steppers(piece.cut, cuts[piece.cut],
-                                                         machine.period)
-        if stepper is None:
-            positions[sel] = _hermite(piece, s[sel])
-            hermite += 1
-            continue
-        done = int(starts[j])
-        _cut_rows(stepper, piece, s[sel], positions[sel], f"cut {piece.cut + 1}", done,
-                  total, progress)
-        kernel += 1
+    total = plan.checked_periods(max_periods)
+    positions = _positions_array(total + 1, scratch)
+    starts = np.full(len(pieces) + 1, total + 1, dtype=np.int64)
+    counts = {"kernel": 0, "hermite": 0}
+    current, rows_of = -1, None
+
+    def begin(j: int, row: int) -> None:   # the pieces after ``current`` up to j
+        nonlocal current, rows_of
+        if j < current:
+            raise ValueError("the stream's rows are not in the order of their pieces")
+        for q in range(current + 1, j + 1):
+            if rows_of is not None and hasattr(rows_of, "close"):
+                rows_of.close()
+            rows_of, starts[q] = _piece_rows(program, machine, pieces[q], steppers,
+                                             counts), row
+        current = j
+
+    for j, row, s in plan.blocks(max_periods):
+        if j != current:
+            begin(j, row)
+        positions[row:row + len(s)] = rows_of(s)
+        if progress is not None:
+            progress(row + len(s) - 1, total, "periods")
+    begin(len(pieces) - 1, total + 1)   # pieces after the last period: none, or empty
+    if hasattr(rows_of, "close"):
+        rows_of.close()
     positions[0] = pieces[0].points[0]
     positions[-1] = pieces[-1].points[-1]
     if progress is not None:
         progress(total, total, "periods")
-    return Stream(positions, plan, programmed_time(pieces, machine), rows, kernel, hermite)
+    return Stream(positions, plan, programmed_time(pieces, machine), starts,
+                  counts["kernel"], counts["hermite"])
+
+
+def _piece_rows(program, machine, piece: Piece, steppers, counts: dict):
+    """``rows(s)``: the positions of ``piece`` at arc lengths ``s`` (a block at a time; a
+    cut's by its stepper, whose ``close()`` checks its landing); ``counts`` the cuts
+    positioned by the kernel and by their points."""
+    if piece.cut is None:   # a link's straight move, or a blend by its samples
+        line = len(piece.points) == 2
+        return lambda s: (_line if line else _hermite)(piece, s)
+    stepper = None if steppers is None else steppers(piece.cut, program.cuts[piece.cut],
+                                                     machine.period)
+    if stepper is None:
+        counts["hermite"] += 1
+        return lambda s: _hermite(piece, s)
+    counts["kernel"] += 1
+    return _CutRows(stepper, piece, f"cut {piece.cut + 1}")
 
 
 def stream_text(positions: np.ndarray) -> str:

@@ -29,10 +29,9 @@ MAX_PLANES = 20_000
 MAX_VERIFY_POINTS = 2_000_000
 """Program points ``verify`` checks against OCCT in one run."""
 MAX_STREAM_PERIODS = 20_000_000
-"""Servo periods one stream may hold (``cadcnc stream --max-periods``): 480 MB of
-positions (N x 3 float64); ``cadcnc stream`` takes about 65 bytes a period above its
-0.5 GB start while it computes, gates and writes them (.npy and .txt; measured at 1, 2
-and 4 million periods), about 1.8 GB for this many: 5.6 h at 1 ms."""
+"""Servo periods one stream may hold (``cadcnc stream --max-periods``): 5.6 h at 1 ms.
+Its memory does not grow with them (the positions in a scratch file of 24 bytes a
+period, 480 MB for this many; each .npy as large, each .txt about 40 bytes a period)."""
 HEARTBEAT_S = 5.0
 """Longest silence (s) of a long stage: progress is reported at least this often."""
 

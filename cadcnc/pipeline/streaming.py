@@ -97,7 +97,8 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
         tick.stage = "planning the feed"
         stream = _planned_stream(program, machine, stepper_factory(part), tick, feed=feed,
                                  planned=planned, max_periods=max_periods, say=say,
-                                 blend=blend if planned else 0.0, exact=exact)
+                                 blend=blend if planned else 0.0, exact=exact,
+                                 scratch=_scratch(outputs))
         tick.stage = "checking the stream against the machine's limits"
         problems = _limits_broken(program, machine, stream.positions)
         if problems:
@@ -156,8 +157,14 @@ def _refused_links(program, gate) -> frozenset[int]:
     return frozenset(out)
 
 
+def _scratch(outputs) -> str | None:
+    """The folder of a long stream's positions file: the first output's (the disk that
+    will hold the stream anyway), else the system's temporary folder."""
+    return None if outputs is None else str(outputs.destinations[0].parent)
+
+
 def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_periods, say,
-                    blend=0.0, exact=frozenset()):
+                    blend=0.0, exact=frozenset(), scratch=None):
     """The stream, its periods counted and bounded from its plan before the positions are
     computed (``stream_program``'s ``on_plan``), progress reported."""
 
@@ -165,7 +172,8 @@ def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_peri
         total = plan.periods
         refuse_over("the stream", total, max_periods, "servo periods",
                     "raise the feed or the machine's limits, or give --max-periods N "
-                    "(each about 65 bytes in memory)")
+                    "(each 24 bytes of scratch file beside the first output, and of each "
+                    ".npy; about 40 in a .txt)")
         if say is not None:
             say(f"cadcnc: stream: {total} periods of {machine.period * 1e3:g} ms "
                 f"(cycle {total * machine.period:.3f} s) to compute")
@@ -176,7 +184,7 @@ def _planned_stream(program, machine, steppers, tick, *, feed, planned, max_peri
 
     return stream_program(program, machine, steppers, feed=feed, planned=planned,
                           max_periods=max_periods, progress=progress, blend=blend,
-                          exact=exact, on_plan=counted)
+                          exact=exact, on_plan=counted, scratch=scratch)
 
 
 class _PrintedOver(Exception):

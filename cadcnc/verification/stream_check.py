@@ -57,11 +57,16 @@ class StreamChecker:
         self.count = np.zeros((3, 3), dtype=np.int64)
 
     def feed(self, rows) -> None:
-        """The next rows ((n, 3) mm)."""
-        x = np.asarray(rows, dtype=np.float64)
+        """The next rows ((n, 3) mm; read CHUNK rows at a time, so a mapped file's rows
+        need not be in memory at once)."""
+        x = np.asarray(rows)
         if x.ndim != 2 or x.shape[1] != 3:
             self.bad_shape = self.bad_shape or x.shape
             return
+        for lo in range(0, len(x), CHUNK):
+            self._block(np.asarray(x[lo:lo + CHUNK], dtype=np.float64))
+
+    def _block(self, x: np.ndarray) -> None:
         if not len(x) or self.bad_shape or self.not_finite is not None:
             self.rows += len(x)
             return
@@ -73,8 +78,7 @@ class StreamChecker:
         if self.first is None:
             self.first = x[0].copy()
         self.last = x[-1].copy()
-        for lo in range(0, len(x), CHUNK):
-            self._differences(x[lo:lo + CHUNK])
+        self._differences(x)
 
     def _differences(self, x: np.ndarray) -> None:
         both = np.concatenate([self.tail, x])

@@ -239,14 +239,3 @@ def test_on_plan_hears_the_plan_before_any_position():
     assert made == []
 
 
-def test_each_pieces_rows_are_found_by_their_order():
-    """The rows of piece k are one contiguous range found by search (the stream's rows
-    are in time order); a stream whose rows are not refuses rather than mixing pieces."""
-    from cadcnc.controller.stream import _first_rows
-
-    owner = np.array([0, 0, 0, 2, 2, 3, 3, 3, 3])
-    starts = _first_rows(owner, 5)
-    for k in range(5):
-        assert np.array_equal(np.arange(starts[k], starts[k + 1]), np.flatnonzero(owner == k))
-    with pytest.raises(ValueError):
-        _first_rows(np.array([0, 1, 0]), 2)

@@ -42,3 +42,22 @@ def test_a_printed_block_over_the_limits_is_refused(monkeypatch):
         list(chunks)
     assert "s.txt: acceleration of axis X" in over.value.problems[0]
     assert "at period 298" in over.value.problems[0]
+
+
+def test_a_mapped_streams_files_are_the_arrays_bytes(monkeypatch, tmp_path):
+    """A long stream's positions in a scratch file give the files of the same array in
+    memory, byte for byte."""
+    from cadcnc.controller import stream as stream_module
+
+    monkeypatch.setattr(stream_module, "IN_MEMORY_ROWS", 10)
+    monkeypatch.setattr(streaming, "WRITE_ROWS", 7)
+    t = np.arange(100) * 1e-3
+    positions = np.c_[np.sin(t), np.cos(t), 0.5 * t] * 0.1
+    mapped = stream_module._positions_array(len(positions), str(tmp_path))
+    mapped[:] = positions
+    assert isinstance(mapped, np.memmap)
+    assert b"".join(streaming._npy_chunks(mapped)) == b"".join(
+        streaming._npy_chunks(positions))
+    program = _program(positions)
+    assert "".join(streaming._txt_chunks(program, Machine.default(), mapped, "s.txt")) == \
+        stream_text(positions)

@@ -1,0 +1,156 @@
+"""A stream made a block of periods at a time: the targets, the positions, the rows of
+each segment and the limits' peaks are the same numbers as the whole arrays give, and a
+long stream's positions live in a scratch file, not in memory."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import cadcnc
+from cadcnc.controller import Machine, feed_plan, stream_program
+from cadcnc.controller import stream as stream_module
+from cadcnc.controller.stream import _over, _peaks, _segment_rows
+from cadcnc.ops.path.pair_path import pair_job
+from cadcnc.ops.path.pair_program import program_for_job
+from cadcnc.ops.stream_steppers import stepper_factory
+from helpers.fixtures import FIXTURES
+
+
+def _whole_targets(plan) -> tuple[np.ndarray, np.ndarray]:
+    """The targets as one array each (the specification the blocks must match)."""
+    n, period, starts = plan.periods, plan.machine.period, plan.starts
+    piece, s = np.empty(n + 1, dtype=np.int64), np.empty(n + 1)
+    times = np.arange(n + 1) * period
+    run_of = np.searchsorted(starts[1:-1], times, side="right")
+    for j, run in enumerate(plan.runs):
+        sel = np.flatnonzero(run_of == j)
+        if not len(sel):
+            continue
+        at = plan.profiles[j].position(times[sel] - starts[j])
+        k = np.clip(np.searchsorted(run.offsets, at, side="right") - 1, 0,
+                    len(run.pieces) - 1)
+        piece[sel] = run.first + k
+        s[sel] = np.clip(at - run.offsets[k], 0.0, np.diff(run.offsets)[k])
+    return piece, s
+
+
+def test_segment_rows_are_the_search_over_every_rows_segment():
+    """Each segment's first row from the pieces' first rows equals the search over the
+    segment of every row (row 0 counted in segment 0)."""
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        pieces = int(rng.integers(1, 12))
+        rows_per_piece = rng.integers(0, 4, pieces)
+        starts = np.r_[0, np.cumsum(rows_per_piece)]
+        segments = np.sort(rng.integers(0, 6, pieces))
+        count = int(segments[-1]) + 1 + int(rng.integers(0, 2))
+        seg_of_row = segments[np.repeat(np.arange(pieces), rows_per_piece)]
+        if not len(seg_of_row):
+            continue
+        seg_of_row[0] = 0
+        want = np.searchsorted(seg_of_row, np.arange(count + 1), side="left")
+        assert np.array_equal(_segment_rows(starts, list(segments), count), want)
+
+
+def test_peaks_are_the_whole_arrays_differences(monkeypatch):
+    """The blockwise peaks (blocks of 7 rows) are the largest |finite differences| of the
+    whole array over the limits, at the first row reaching them."""
+    monkeypatch.setattr(stream_module, "CHUNK", 7)
+    machine = Machine.default()
+    x = np.cumsum(np.random.default_rng(3).normal(size=(200, 3)) * 1e-3, axis=0)
+    share, where = _peaks(x, machine)
+    for k, lim in enumerate((machine.max_velocity, machine.max_acceleration,
+                             machine.max_jerk), start=1):
+        d = np.abs(np.diff(x, k, axis=0)) / machine.period ** k / np.asarray(lim)
+        assert np.allclose(share[k - 1], d.max(axis=0), rtol=1e-14, atol=0)
+        assert np.array_equal(where[k - 1], d.argmax(axis=0) + k)
+    over = _over(x, machine)
+    assert [o[0] for o in over] == [float(share[q].max()) for q in range(3)]
+
+
+@pytest.mark.slow
+def test_a_stream_in_small_blocks_and_a_scratch_file_is_the_same_stream(monkeypatch):
+    """The corner's stream made 97 periods at a time, its positions in a scratch file:
+    the targets equal the whole arrays', and the positions, the pieces' rows, the
+    segments' moves and the summary equal the stream made in memory, bit for bit."""
+    part = cadcnc.load_step(FIXTURES / "bspline_boss.step")
+    _, _, job = pair_job(part.face(4), part.face(5), radius=3.0, feed=1500.0, period=0.004)
+    program = program_for_job(part, job)
+    machine = Machine.default()
+    whole = stream_program(program, machine, stepper_factory(part))
+    assert not isinstance(whole.positions, np.memmap)
+
+    piece, s = _whole_targets(whole.plan)
+    blocks = list(whole.plan.blocks(size=97))
+    assert max(len(b) for _, _, b in blocks) <= 97
+    assert np.array_equal(np.concatenate([np.full(len(b), j) for j, _, b in blocks]), piece)
+    assert np.array_equal(np.concatenate([b for _, _, b in blocks]), s)
+    firsts = np.cumsum([0] + [len(b) for _, _, b in blocks[:-1]])
+    assert [r for _, r, _ in blocks] == firsts.tolist()
+
+    monkeypatch.setattr(feed_plan, "BLOCK_ROWS", 97)
+    monkeypatch.setattr(stream_module, "IN_MEMORY_ROWS", 100)
+    small = stream_program(program, machine, stepper_factory(part))
+    assert isinstance(small.positions, np.memmap)
+    assert np.array_equal(small.positions, whole.positions)
+    assert np.array_equal(small.starts, whole.starts)
+    assert np.array_equal(small.rows, piece)
+    assert (small.kernel_cuts, small.hermite_cuts) == (whole.kernel_cuts, whole.hermite_cuts)
+    for a, b in zip(small.segment_moves(program), whole.segment_moves(program)):
+        assert np.array_equal(a, b)
+    assert small.summary() == whole.summary()
+
+
+def test_rows_out_of_piece_order_are_refused(monkeypatch):
+    """A plan whose rows went back to an earlier piece refuses (no mixed pieces)."""
+    machine = Machine.default()
+    pieces = [_Line((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)), _Line((1.0, 0.0, 0.0), (2.0, 0.0, 0.0))]
+
+    class _Plan:
+        def checked_periods(self, max_periods):
+            return 3
+
+        def blocks(self, max_periods):
+            yield 1, 0, np.zeros(2)
+            yield 0, 2, np.zeros(2)
+
+    monkeypatch.setattr(stream_module, "plan_feed", lambda *a: _Plan())
+    with pytest.raises(ValueError, match="not in the order"):
+        stream_module._stream(None, machine, pieces, None, True, np.ones(3), 10, None)
+
+
+class _Line:
+    """A link's straight piece (what ``_stream`` reads of a piece)."""
+
+    cut = None
+
+    def __init__(self, a, b):
+        self.points = np.array([a, b], dtype=float)
+        self.length = float(np.linalg.norm(self.points[1] - self.points[0]))
+
+
+def test_a_scratch_file_without_room_is_an_output_error(monkeypatch, tmp_path):
+    """A long stream's scratch file where the disk has no room, or in a folder that is
+    not there, is refused with the folder and the size named (exit 4), not a fault."""
+    import errno
+    import os
+
+    from cadcnc.core.errors import OutputError
+
+    monkeypatch.setattr(stream_module, "IN_MEMORY_ROWS", 10)
+
+    def full(fd, offset, size):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "posix_fallocate", full)
+    with pytest.raises(OutputError, match=f"{tmp_path}.*No space left"):
+        stream_module._positions_array(1000, str(tmp_path))
+    with pytest.raises(OutputError, match="missing"):
+        stream_module._positions_array(1000, str(tmp_path / "missing"))
+    monkeypatch.undo()
+    monkeypatch.setattr(stream_module, "IN_MEMORY_ROWS", 10)
+    rows = stream_module._positions_array(1000, str(tmp_path))
+    rows[:] = 1.0
+    assert isinstance(rows, np.memmap) and rows.shape == (1000, 3) and rows.sum() == 3000
+    assert list(tmp_path.iterdir()) == []   # nameless: nothing left in the folder
