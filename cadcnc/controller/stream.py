@@ -81,8 +81,10 @@ class Stream:
     def shares(self) -> dict[str, tuple[float, float, float]]:
         """Per axis, the largest |v|, |a|, |j| of the positions as a share of the limits
         (a block of rows at a time)."""
-        peaks, _ = _peaks(self.positions, self.machine)
-        return {name: tuple(float(v) for v in peaks[k])
+        peak, _ = _peaks(self.positions)
+        limits, ts = _limits_of(self.machine), self.machine.period
+        return {name: tuple(float(p / ts ** (k + 1) / lim)
+                            for p, lim in zip(peak[k].tolist(), limits[k].tolist()))
                 for k, name in enumerate(("velocity", "acceleration", "jerk"))}
 
     @property
@@ -117,7 +119,10 @@ class Stream:
 def _segment_rows(starts: np.ndarray, segments: list[int], count: int) -> np.ndarray:
     """(count + 1,) where each program segment's rows start, from the pieces' first rows
     ``starts`` and their ``segments`` (non-decreasing): row 0 belongs to segment 0."""
-    first = np.searchsorted(np.asarray(segments), np.arange(count + 1), side="left")
+    segments = np.asarray(segments)
+    if (segments[1:] < segments[:-1]).any():
+        raise ValueError("the stream's pieces are not in the order of their segments")
+    first = np.searchsorted(segments, np.arange(count + 1), side="left")
     out = np.asarray(starts)[first]
     out[1:] = np.maximum(out[1:], 1)
     out[0] = 0
@@ -130,13 +135,17 @@ IN_MEMORY_ROWS = 1 << 18
 
 def _reserve(f, size: int) -> None:
     """The file's ``size`` bytes taken on the disk now (a full disk refuses here, not as
-    a fault while the positions are written), or merely set where the file system cannot."""
+    a fault while the positions are written), or merely set where the system or the file
+    system cannot."""
+    reserve = getattr(os, "posix_fallocate", None)   # (not on macOS or Windows)
     try:
-        os.posix_fallocate(f.fileno(), 0, size)
+        if reserve is not None:
+            reserve(f.fileno(), 0, size)
+            return
     except OSError as e:
         if e.errno not in (errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL):
             raise
-        f.truncate(size)
+    f.truncate(size)
 
 
 def _positions_array(rows: int, scratch: str | None) -> np.ndarray:
@@ -226,34 +235,48 @@ NOISE = 1.5       # ... unless it is broken this much: the positions' noise, not
 NOISY_PERIOD = 1e-4   # s: below it the positions' rounding can break the jerk
 
 
-def _peaks(positions: np.ndarray, machine: Machine) -> tuple[np.ndarray, np.ndarray]:
-    """(3, 3) shares and (3, 3) rows: per quantity (velocity, acceleration, jerk) and
-    axis, the largest finite-difference share of the limit and the period where it is
+def _peaks(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(3, 3) peaks and (3, 3) rows: per order k = 1, 2, 3 of finite difference and per
+    axis, the largest |k-th difference| of the positions (mm) and the period where it is
     first reached (CHUNK rows at a time: the differences' temporaries stay bounded
-    whatever the stream's length)."""
-    ts = machine.period
-    share, where = np.zeros((3, 3)), np.zeros((3, 3), dtype=np.int64)
+    whatever the stream's length; a block with a position that is not a number is
+    skipped, the stream's check names it)."""
+    peak, where = np.zeros((3, 3)), np.zeros((3, 3), dtype=np.int64)
     for start in range(0, max(len(positions) - 1, 1), CHUNK):
         block = positions[start:start + CHUNK + 3]
-        for k, lim in enumerate((machine.max_velocity, machine.max_acceleration,
-                                 machine.max_jerk), start=1):
+        for k in range(1, 4):
             if len(block) <= k:
                 continue
             d = np.abs(np.diff(block, k, axis=0))
-            d /= ts ** k * np.asarray(lim)
-            top, row = d.max(axis=0), d.argmax(axis=0)
-            better = top > share[k - 1]
-            share[k - 1][better] = top[better]
+            top = d.max(axis=0)
+            if np.isnan(top).any():
+                continue
+            row = d.argmax(axis=0)
+            better = top > peak[k - 1]
+            peak[k - 1][better] = top[better]
             where[k - 1][better] = start + row[better] + k
-    return share, where
+    return peak, where
+
+
+def _limits_of(machine: Machine) -> np.ndarray:
+    """(3, 3) the velocity, acceleration and jerk limits per axis."""
+    return np.array([machine.max_velocity, machine.max_acceleration, machine.max_jerk],
+                    dtype=np.float64)
 
 
 def _over(positions: np.ndarray, machine: Machine) -> list[tuple[float, int, int]]:
     """Per quantity (velocity, acceleration, jerk): the largest finite-difference share
-    of the axis's limit, its period and its axis (:func:`_peaks`)."""
-    share, where = _peaks(positions, machine)
-    axes = share.argmax(axis=1)
-    return [(float(share[q, a]), int(where[q, a]), int(a)) for q, a in enumerate(axes)]
+    of an axis's limit, its period and its axis (:func:`_peaks`; of axes at the same
+    share, the one reaching it first)."""
+    peak, where = _peaks(positions)
+    limits = _limits_of(machine)
+    out = []
+    for q in range(3):
+        share = peak[q] / (machine.period ** (q + 1) * limits[q])
+        top = share.max()
+        a = min((a for a in range(3) if share[a] == top), key=lambda a: where[q, a])
+        out.append((float(top), int(where[q, a]), a))
+    return out
 
 
 def _refusal(over: list[tuple[float, int, int]], machine: Machine) -> PlanError:
@@ -317,6 +340,7 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
     pieces = stream_pieces(program, machine, feed, blend, exact)
     derate = np.ones(3)
     for _ in range(REPLANS + 1):
+        stream = None   # a replan's positions replace these (one scratch file at a time)
         stream = _stream(program, machine, pieces, steppers, planned, derate, max_periods,
                          progress, on_plan, scratch)
         if not planned:

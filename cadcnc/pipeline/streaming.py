@@ -110,6 +110,7 @@ def _stream(program, part, machine, outs, tick, *, feed, planned, tolerances, al
         if gate.ok or not refused:
             break
         exact |= refused
+        stream = gate = None   # (their positions' scratch file freed before the next)
         if say is not None:
             say(f"cadcnc: stream: the gate refused {len(refused)} rounded link(s): "
                 "streamed again with their exact corners")

@@ -61,13 +61,13 @@ class StreamChecker:
         need not be in memory at once)."""
         x = np.asarray(rows)
         if x.ndim != 2 or x.shape[1] != 3:
-            self.bad_shape = self.bad_shape or x.shape
+            self.bad_shape = x.shape if self.bad_shape is None else self.bad_shape
             return
         for lo in range(0, len(x), CHUNK):
             self._block(np.asarray(x[lo:lo + CHUNK], dtype=np.float64))
 
     def _block(self, x: np.ndarray) -> None:
-        if not len(x) or self.bad_shape or self.not_finite is not None:
+        if not len(x) or self.bad_shape is not None or self.not_finite is not None:
             self.rows += len(x)
             return
         finite = np.isfinite(x).all(axis=1)
@@ -102,7 +102,7 @@ class StreamChecker:
         """The verdict on every row fed, its ends against ``start`` and ``end`` (mm)."""
         what = self.what
         if self.bad_shape is not None or self.rows < 1:
-            shape = self.bad_shape or (0, 3)
+            shape = (0, 3) if self.bad_shape is None else self.bad_shape
             return StreamCheck(False, [f"{what}: not an (N, 3) array of positions: {shape}"])
         if self.not_finite is not None:
             return StreamCheck(False, [f"{what}: position {self.not_finite} is not finite"])

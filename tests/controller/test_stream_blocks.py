@@ -55,18 +55,42 @@ def test_segment_rows_are_the_search_over_every_rows_segment():
 
 def test_peaks_are_the_whole_arrays_differences(monkeypatch):
     """The blockwise peaks (blocks of 7 rows) are the largest |finite differences| of the
-    whole array over the limits, at the first row reaching them."""
+    whole array, at the first row reaching them; the shares and the refusal's figures are
+    those of the whole arrays over the limits, bit for bit."""
     monkeypatch.setattr(stream_module, "CHUNK", 7)
     machine = Machine.default()
     x = np.cumsum(np.random.default_rng(3).normal(size=(200, 3)) * 1e-3, axis=0)
-    share, where = _peaks(x, machine)
+    peak, where = _peaks(x)
+    over = _over(x, machine)
     for k, lim in enumerate((machine.max_velocity, machine.max_acceleration,
                              machine.max_jerk), start=1):
-        d = np.abs(np.diff(x, k, axis=0)) / machine.period ** k / np.asarray(lim)
-        assert np.allclose(share[k - 1], d.max(axis=0), rtol=1e-14, atol=0)
+        d = np.abs(np.diff(x, k, axis=0))
+        assert np.array_equal(peak[k - 1], d.max(axis=0))
         assert np.array_equal(where[k - 1], d.argmax(axis=0) + k)
-    over = _over(x, machine)
-    assert [o[0] for o in over] == [float(share[q].max()) for q in range(3)]
+        share = d / (machine.period ** k * np.asarray(lim))
+        row, axis = np.unravel_index(int(np.argmax(share)), share.shape)
+        assert over[k - 1] == (float(share[row, axis]), int(row) + k, int(axis))
+
+
+def test_the_first_axis_to_reach_a_shared_peak_is_named():
+    """Two axes at the same share: the refusal names the one that reached it first (a Y
+    jump at row 5, then the same X jump at row 12), as the whole array's search does."""
+    machine = Machine.default()
+    assert machine.max_velocity[0] == machine.max_velocity[1]
+    x = np.zeros((20, 3))
+    x[5:, 1] += 1e-3
+    x[12:, 0] += 1e-3
+    share, row, axis = _over(x, machine)[0]
+    assert (row, axis) == (5, 1)
+
+
+def test_positions_that_are_not_numbers_are_left_to_the_check():
+    """A block with a NaN adds nothing to the peaks (the stream's check names it)."""
+    x = np.zeros((10, 3))
+    x[4, 0] = np.nan
+    x[6:, 1] = 1.0
+    peak, _ = _peaks(x)
+    assert not peak.any()
 
 
 @pytest.mark.slow
@@ -154,3 +178,29 @@ def test_a_scratch_file_without_room_is_an_output_error(monkeypatch, tmp_path):
     rows[:] = 1.0
     assert isinstance(rows, np.memmap) and rows.shape == (1000, 3) and rows.sum() == 3000
     assert list(tmp_path.iterdir()) == []   # nameless: nothing left in the folder
+
+
+def test_a_replan_lets_the_last_positions_go_first(monkeypatch):
+    """Each replan's positions are made after the last ones are let go: one scratch file
+    of a long stream at a time, not two."""
+    import weakref
+
+    from cadcnc.controller.feed_plan import PlanError
+
+    made, alive = [], []
+
+    class _Made:
+        positions = np.zeros((5, 3))
+
+    def fake_stream(*args):
+        alive.append(sum(ref() is not None for ref in made))
+        out = _Made()
+        made.append(weakref.ref(out))
+        return out
+
+    monkeypatch.setattr(stream_module, "stream_pieces", lambda *a: [])
+    monkeypatch.setattr(stream_module, "_stream", fake_stream)
+    monkeypatch.setattr(stream_module, "_over", lambda positions, machine: [(1.01, 1, 0)] * 3)
+    with pytest.raises(PlanError):
+        stream_program(None, Machine.default())
+    assert alive == [0] * (stream_module.REPLANS + 1)

@@ -59,3 +59,14 @@ def test_blocks_report_ends_and_a_non_finite_row_by_their_stream_row():
     assert checker.result(y[0], y[-1]).problems == ["the stream: position 150 is not finite"]
     assert check_stream(y, PERIOD, LIMITS, y[0], y[-1]).problems == \
         ["the stream: position 150 is not finite"]
+
+
+@pytest.mark.parametrize("rows, shape", [(5.0, "()"), ("abc", "()"), ([1.0, 2.0], "(2,)"),
+                                         (np.zeros((4, 2)), "(4, 2)"),
+                                         (np.zeros((0, 3)), "(0, 3)")])
+def test_what_is_not_rows_of_positions_is_named_by_its_shape(rows, shape):
+    """A scalar, text, a flat list or the wrong width: a verdict naming the shape given
+    (no exception, no made-up shape)."""
+    verdict = check_stream(rows, 0.001, ((1.0,) * 3,) * 3, (0, 0, 0), (0, 0, 0))
+    assert not verdict.ok
+    assert verdict.problems == [f"the stream: not an (N, 3) array of positions: {shape}"]
