@@ -44,10 +44,13 @@ def bare_literals(source: str) -> list[tuple[int, str]]:
              for sub in ast.walk(node.value)}
     commented = {tok.start[0] for tok in tokenize.generate_tokens(io.StringIO(source).readline)
                  if tok.type == tokenize.COMMENT}
+    lines = source.splitlines()
     out = []
     for node in ast.walk(tree):
         if not (isinstance(node, ast.Constant) and isinstance(node.value, float)):
             continue
+        if not EXPONENT.search(lines[node.lineno - 1]):
+            continue   # (a float literal is on one line: no "e-" there, none in it)
         text = ast.get_source_segment(source, node) or ""
         if EXPONENT.search(text) and id(node) not in named and node.lineno not in commented:
             out.append((node.lineno, text))
