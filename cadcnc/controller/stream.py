@@ -161,7 +161,7 @@ def _positions_array(rows: int, scratch: str | None) -> np.ndarray:
             _reserve(f, size)
             return np.memmap(f, dtype=np.float64, mode="w+", shape=(rows, 3))
     except OSError as e:
-        raise OutputError(f"the stream's scratch file of {size / 1e6:.0f} MB in {folder}: "
+        raise OutputError(f"the stream's scratch file of {size / 1e6:.3g} MB in {folder}: "
                           f"{e.strerror or e}; free some room there or stream fewer "
                           "periods") from None
 

@@ -68,6 +68,32 @@ def test_ctrl_c_leaves_no_file(program, tmp_path, monkeypatch, where):
     assert sorted(p.name for p in tmp_path.iterdir()) == []
 
 
+def test_a_long_stream_without_disk_room_is_exit_4_and_writes_nothing(program, tmp_path,
+                                                                     monkeypatch):
+    """A stream long enough for a scratch file, on a disk with no room for it: exit 4
+    naming the folder and the size, no traceback, nothing written (the files of a stream
+    in a scratch file: tests/pipeline/test_stream_files.py)."""
+    import errno
+    import os
+
+    from cadcnc.controller import stream as stream_module
+
+    monkeypatch.setattr(stream_module, "IN_MEMORY_ROWS", 100)
+
+    def full(fd, offset, size):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "posix_fallocate", full)
+    full_dir = tmp_path / "full"
+    full_dir.mkdir()
+    run = cadcnc_cli("stream", program, "-o", full_dir / "s.npy", "-q")
+    assert run.returncode == 4, (run.returncode, run.stderr)
+    assert run.stderr.startswith("cadcnc: error: the stream's scratch file of ")
+    assert str(full_dir) in run.stderr and "No space left" in run.stderr
+    assert "Traceback" not in run.stderr
+    assert list(full_dir.iterdir()) == []
+
+
 needs_hal = pytest.mark.skipif(shutil.which("halrun") is None,
                                reason="halrun not installed (apt install linuxcnc-uspace)")
 
