@@ -14,16 +14,14 @@ program's first point at t = 0, row n the position at n Ts.
 
 from __future__ import annotations
 
-import errno
-import os
-import tempfile
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 
-from ..core.errors import GeometryError, OutputError
+from ..core.errors import GeometryError
 from ..core.progress import Progress
+from ..core.scratch import rows_array
 from ..core.tolerances import STREAM_END
 from ..interp.cycle import CLOSED, END
 from ..interp.planned_follow import follow
@@ -127,43 +125,6 @@ def _segment_rows(starts: np.ndarray, segments: list[int], count: int) -> np.nda
     out[1:] = np.maximum(out[1:], 1)
     out[0] = 0
     return out
-
-
-IN_MEMORY_ROWS = 1 << 18
-"""A stream of more positions keeps them in a scratch file (:func:`_positions_array`)."""
-
-
-def _reserve(f, size: int) -> None:
-    """The file's ``size`` bytes taken on the disk now (a full disk refuses here, not as
-    a fault while the positions are written), or merely set where the system or the file
-    system cannot."""
-    reserve = getattr(os, "posix_fallocate", None)   # (not on macOS or Windows)
-    try:
-        if reserve is not None:
-            reserve(f.fileno(), 0, size)
-            return
-    except OSError as e:
-        if e.errno not in (errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL):
-            raise
-    f.truncate(size)
-
-
-def _positions_array(rows: int, scratch: str | None) -> np.ndarray:
-    """(rows, 3) float64 for the positions: in memory up to IN_MEMORY_ROWS, else mapped
-    from a nameless scratch file in the folder ``scratch`` (None: the system's temporary
-    folder), gone with the array: the stream's memory stays bounded, the OS pages it."""
-    if rows <= IN_MEMORY_ROWS:
-        return np.empty((rows, 3))
-    size = rows * 3 * 8
-    folder = scratch or tempfile.gettempdir()
-    try:
-        with tempfile.TemporaryFile(dir=folder) as f:
-            _reserve(f, size)
-            return np.memmap(f, dtype=np.float64, mode="w+", shape=(rows, 3))
-    except OSError as e:
-        raise OutputError(f"the stream's scratch file of {size / 1e6:.3g} MB in {folder}: "
-                          f"{e.strerror or e}; free some room there or stream fewer "
-                          "periods") from None
 
 
 def _line(piece: Piece, s: np.ndarray) -> np.ndarray:
@@ -336,7 +297,7 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
     in ``exact`` (:func:`.link_blends.stream_pieces`); a blend is positioned on its samples by
     the Hermite. ``on_plan(plan)`` hears of each plan before its positions are computed
     (to count, bound or announce the periods; a replan is heard again). ``scratch``: the
-    folder of a long stream's positions file (:func:`_positions_array`)."""
+    folder of a long stream's positions file (:func:`~cadcnc.core.scratch.rows_array`)."""
     pieces = stream_pieces(program, machine, feed, blend, exact)
     derate = np.ones(3)
     for _ in range(REPLANS + 1):
@@ -364,7 +325,7 @@ def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
     if on_plan is not None:
         on_plan(plan)
     total = plan.checked_periods(max_periods)
-    positions = _positions_array(total + 1, scratch)
+    positions = rows_array(total + 1, scratch, "the stream's positions")
     starts = np.full(len(pieces) + 1, total + 1, dtype=np.int64)
     counts = {"kernel": 0, "hermite": 0}
     current, rows_of = -1, None

@@ -76,9 +76,9 @@ def test_a_long_stream_without_disk_room_is_exit_4_and_writes_nothing(program, t
     import errno
     import os
 
-    from cadcnc.controller import stream as stream_module
+    from cadcnc.core import scratch
 
-    monkeypatch.setattr(stream_module, "IN_MEMORY_ROWS", 100)
+    monkeypatch.setattr(scratch, "IN_MEMORY_ROWS", 100)
 
     def full(fd, offset, size):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
@@ -88,7 +88,7 @@ def test_a_long_stream_without_disk_room_is_exit_4_and_writes_nothing(program, t
     full_dir.mkdir()
     run = cadcnc_cli("stream", program, "-o", full_dir / "s.npy", "-q")
     assert run.returncode == 4, (run.returncode, run.stderr)
-    assert run.stderr.startswith("cadcnc: error: the stream's scratch file of ")
+    assert run.stderr.startswith("cadcnc: error: the scratch file of the stream's positions, ")
     assert str(full_dir) in run.stderr and "No space left" in run.stderr
     assert "Traceback" not in run.stderr
     assert list(full_dir.iterdir()) == []

@@ -11,6 +11,7 @@ import cadcnc
 from cadcnc.controller import Machine, feed_plan, stream_program
 from cadcnc.controller import stream as stream_module
 from cadcnc.controller.stream import _over, _peaks, _segment_rows
+from cadcnc.core import scratch
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
 from cadcnc.ops.stream_steppers import stepper_factory
@@ -114,7 +115,7 @@ def test_a_stream_in_small_blocks_and_a_scratch_file_is_the_same_stream(monkeypa
     assert [r for _, r, _ in blocks] == firsts.tolist()
 
     monkeypatch.setattr(feed_plan, "BLOCK_ROWS", 97)
-    monkeypatch.setattr(stream_module, "IN_MEMORY_ROWS", 100)
+    monkeypatch.setattr(scratch, "IN_MEMORY_ROWS", 100)
     small = stream_program(program, machine, stepper_factory(part))
     assert isinstance(small.positions, np.memmap)
     assert np.array_equal(small.positions, whole.positions)
@@ -152,32 +153,6 @@ class _Line:
     def __init__(self, a, b):
         self.points = np.array([a, b], dtype=float)
         self.length = float(np.linalg.norm(self.points[1] - self.points[0]))
-
-
-def test_a_scratch_file_without_room_is_an_output_error(monkeypatch, tmp_path):
-    """A long stream's scratch file where the disk has no room, or in a folder that is
-    not there, is refused with the folder and the size named (exit 4), not a fault."""
-    import errno
-    import os
-
-    from cadcnc.core.errors import OutputError
-
-    monkeypatch.setattr(stream_module, "IN_MEMORY_ROWS", 10)
-
-    def full(fd, offset, size):
-        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-
-    monkeypatch.setattr(os, "posix_fallocate", full)
-    with pytest.raises(OutputError, match=f"{tmp_path}.*No space left"):
-        stream_module._positions_array(1000, str(tmp_path))
-    with pytest.raises(OutputError, match="missing"):
-        stream_module._positions_array(1000, str(tmp_path / "missing"))
-    monkeypatch.undo()
-    monkeypatch.setattr(stream_module, "IN_MEMORY_ROWS", 10)
-    rows = stream_module._positions_array(1000, str(tmp_path))
-    rows[:] = 1.0
-    assert isinstance(rows, np.memmap) and rows.shape == (1000, 3) and rows.sum() == 3000
-    assert list(tmp_path.iterdir()) == []   # nameless: nothing left in the folder
 
 
 def test_a_replan_lets_the_last_positions_go_first(monkeypatch):

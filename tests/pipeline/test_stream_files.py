@@ -47,13 +47,13 @@ def test_a_printed_block_over_the_limits_is_refused(monkeypatch):
 def test_a_mapped_streams_files_are_the_arrays_bytes(monkeypatch, tmp_path):
     """A long stream's positions in a scratch file give the files of the same array in
     memory, byte for byte."""
-    from cadcnc.controller import stream as stream_module
+    from cadcnc.core import scratch
 
-    monkeypatch.setattr(stream_module, "IN_MEMORY_ROWS", 10)
+    monkeypatch.setattr(scratch, "IN_MEMORY_ROWS", 10)
     monkeypatch.setattr(streaming, "WRITE_ROWS", 7)
     t = np.arange(100) * 1e-3
     positions = np.c_[np.sin(t), np.cos(t), 0.5 * t] * 0.1
-    mapped = stream_module._positions_array(len(positions), str(tmp_path))
+    mapped = scratch.rows_array(len(positions), str(tmp_path), "the positions")
     mapped[:] = positions
     assert isinstance(mapped, np.memmap)
     assert b"".join(streaming._npy_chunks(mapped)) == b"".join(

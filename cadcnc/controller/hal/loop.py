@@ -9,6 +9,7 @@ Ctrl-C. Units: mm, s. The library imports no HAL: everything runs in subprocesse
 
 from __future__ import annotations
 
+import itertools
 import string
 import subprocess
 import time
@@ -20,12 +21,14 @@ from typing import Any
 import numpy as np
 
 from ...core.errors import InputError
+from ...core.scratch import rows_array
 from ...core.work_limits import sigterm_as_interrupt
 from .session import HalError, HalInterrupted, HalSession, work_folder
 
 SAMPLE_RES = 1e-9  # mm: halsampler prints 6 decimals of the µm the sampler holds
 WIDE = 1e20  # limit3's own "no limit"
 MAX_DEPTH = 2_000_000  # FIFO rows held in shared memory (~48 MB for the streamer)
+BLOCK = 1 << 16  # rows checked, or sample lines read, at a time (a few MB)
 
 
 @dataclass(frozen=True)
@@ -49,7 +52,7 @@ class HalLoopResult:
     def executed_error(self) -> float:
         """max |executed - commanded| over the program's samples, mm."""
         m = min(self.streamed, len(self.executed))
-        return float(np.abs(self.executed[:m] - self.commanded[:m]).max()) if m else 0.0
+        return _max_gap(self.executed[:m], self.commanded[:m])
 
     @property
     def cycle_time(self) -> float:
@@ -64,18 +67,32 @@ def write_stream_txt(stream: np.ndarray, path: Path) -> Path:
 
 
 def read_stream(stream: Any) -> np.ndarray:
-    """An (N, 3) float64 array from an array, a ``.npy`` or a ``.txt`` stream."""
+    """An (N, 3) float64 array from an array, a ``.npy`` (mapped, not read into memory)
+    or a ``.txt`` stream; an array of float64 is used as it is."""
     if isinstance(stream, (str, Path)):
         p = Path(stream)
         try:
-            arr = np.load(p) if p.suffix == ".npy" else np.loadtxt(p, ndmin=2)
+            arr = (np.load(p, mmap_mode="r") if p.suffix == ".npy"
+                   else np.loadtxt(p, ndmin=2))
         except (OSError, ValueError) as e:
             raise InputError(f"cannot read the stream {p}: {e}") from None
     else:
-        arr = np.asarray(stream, dtype=np.float64)
-    if arr.ndim != 2 or arr.shape[1] != 3 or len(arr) < 2 or not np.isfinite(arr).all():
+        arr = stream
+    arr = np.asarray(arr, dtype=np.float64)
+    if arr.ndim != 2 or arr.shape[1] != 3 or len(arr) < 2 or not _finite(arr):
         raise HalError(f"a stream is an (N >= 2, 3) finite array of X Y Z mm; got {arr.shape}")
-    return arr.astype(np.float64)
+    return arr
+
+
+def _finite(rows: np.ndarray) -> bool:
+    """Whether every number of ``rows`` is finite (BLOCK rows at a time)."""
+    return all(np.isfinite(rows[a:a + BLOCK]).all() for a in range(0, len(rows), BLOCK))
+
+
+def _max_gap(a: np.ndarray, b: np.ndarray) -> float:
+    """max |a - b| over equal-shaped arrays (BLOCK rows at a time), 0 when empty."""
+    return max((float(np.abs(a[k:k + BLOCK] - b[k:k + BLOCK]).max())
+                for k in range(0, len(a), BLOCK)), default=0.0)
 
 
 def hal_text(machine: Any, n_rows: int, *, limits: str = "machine", tail: int = 0) -> str:
@@ -138,7 +155,8 @@ def run_hal_loop(stream: Any, machine: Any, *, limits: str = "machine",
                 on_started()
             _wait(reader, started + timeout, "halsampler", work / "halsampler.log")
             wall = time.monotonic() - started
-            samples = _parse(out_path, total)
+            result = _read_samples(out_path, rows, total, machine.period, wall,
+                                   None if workdir is None else str(work))
         except KeyboardInterrupt:
             session.stop()
             done = int((time.monotonic() - started) / machine.period) if started else 0
@@ -148,7 +166,7 @@ def run_hal_loop(stream: Any, machine: Any, *, limits: str = "machine",
             problems = session.stop()
         if problems:
             raise HalError("HAL stopped uncleanly: " + "; ".join(problems))
-    return _result(rows, samples, machine.period, wall)
+    return result
 
 
 def _prefill(session: HalSession, feeder: subprocess.Popen, want: int, work: Path) -> None:
@@ -178,29 +196,56 @@ def _wait(proc: subprocess.Popen, deadline: float, name: str, log: Path) -> None
                        + log.read_text(errors="replace")[-500:])
 
 
-def _parse(path: Path, total: int) -> np.ndarray:
-    """halsampler's tagged lines as a (total, 8) array: tag, cmd XYZ, exec XYZ, underruns."""
-    data = np.loadtxt(path, ndmin=2)
-    if data.shape != (total, 8):
-        raise HalError(f"halsampler gave {data.shape[0]} samples of {data.shape[1]} columns, "
-                       f"expected {total} of 8")
-    return data
-
-
-def _result(rows: np.ndarray, s: np.ndarray, period: float, wall: float) -> HalLoopResult:
-    """Facts of one run from its samples (row k of the program is sample k)."""
+def _read_samples(path: Path, rows: np.ndarray, total: int, period: float, wall: float,
+                  folder: str | None) -> HalLoopResult:
+    """The run's facts from halsampler's tagged lines (tag, commanded X Y Z µm, executed
+    X Y Z µm, underruns; sample k is the program's row k), read BLOCK lines at a time: the
+    commanded and executed positions go to (total, 3) arrays (a scratch file past
+    :data:`~cadcnc.core.scratch.IN_MEMORY_ROWS`), the rest is counted on the way."""
     n = len(rows)
-    tags = s[:, 0].astype(np.int64)
-    overruns = int(np.sum(np.diff(tags) - 1)) if len(tags) > 1 else 0
-    cmd, exe, under = s[:, 1:4] / 1e3, s[:, 4:7] / 1e3, s[:, 7].astype(np.int64)
-    m = min(n, len(s))
-    off = np.abs(exe - cmd).max(axis=1) > SAMPLE_RES * 0.5
+    cmd = rows_array(total, folder, "HAL's commanded positions")
+    exe = rows_array(total, folder, "HAL's executed positions")
+    read, columns, tags, under = 0, 8, [], [0, 0]   # (underruns at the first and the
+    # program's last sample)
+    clipped = clipped_tail = 0
+    command_error = tracking_error = 0.0
+    with open(path) as lines:
+        while True:
+            block = list(itertools.islice(lines, BLOCK))
+            if not block:
+                break
+            try:
+                data = np.loadtxt(block, ndmin=2)
+            except ValueError as e:
+                raise HalError(f"halsampler's samples ({path.name}) do not read: {e}") from None
+            if data.shape[1] != 8 or read + len(data) > total:
+                columns = data.shape[1] if data.shape[1] != 8 else columns
+                read += len(data)
+                continue
+            k = slice(read, read + len(data))
+            cmd[k], exe[k] = data[:, 1:4] / 1e3, data[:, 4:7] / 1e3
+            tags += [int(data[0, 0]), int(data[-1, 0])]
+            if read == 0:
+                under[0] = int(data[0, 7])
+            if read <= n - 1 < read + len(data):   # the program's last sample
+                under[1] = int(data[n - 1 - read, 7])
+            off = np.abs(exe[k] - cmd[k]).max(axis=1) > SAMPLE_RES * 0.5
+            mine = max(min(n - read, len(data)), 0)   # of these samples, the program's
+            clipped += int(off[:mine].sum())
+            clipped_tail += int(off[mine:].sum())
+            if mine:
+                here = slice(read, read + mine)
+                command_error = max(command_error, _max_gap(cmd[here], rows[here]))
+                tracking_error = max(tracking_error, _max_gap(exe[here], rows[here]))
+            read += len(data)
+    if read != total or columns != 8:
+        raise HalError(f"halsampler gave {read} samples of {columns} columns, "
+                       f"expected {total} of 8")
     return HalLoopResult(
-        period=period, streamed=n, read=len(s), underruns=int(under[m - 1] - under[0]),
-        overruns=overruns, commanded=cmd, executed=exe, clipped=int(off[:m].sum()),
-        clipped_tail=int(off[m:].sum()),
-        command_error=float(np.abs(cmd[:m] - rows[:m]).max()),
-        tracking_error=float(np.abs(exe[:m] - rows[:m]).max()), wall_time=wall)
+        period=period, streamed=n, read=read, underruns=under[1] - under[0],
+        overruns=(tags[-1] - tags[0]) - (read - 1), commanded=cmd, executed=exe,
+        clipped=clipped, clipped_tail=clipped_tail, command_error=command_error,
+        tracking_error=tracking_error, wall_time=wall)
 
 
 def summary(r: HalLoopResult) -> str:
