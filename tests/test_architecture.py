@@ -25,7 +25,7 @@ PKG = Path(__file__).resolve().parents[1] / "cadcnc"
 KERNEL_FREE_TOP = {"cadcnc.core", "cadcnc.core.errors", "cadcnc.core.tolerances", "cadcnc.core.job",
                    "cadcnc.core.operations", "cadcnc.core.tool", "cadcnc.core.progress",
                    "cadcnc.core.units", "cadcnc.core.work_limits", "cadcnc.core.trim_labels",
-                   "cadcnc.core.jsonable", "cadcnc.core.interrupts"}
+                   "cadcnc.core.jsonable", "cadcnc.core.interrupts", "cadcnc.core.scratch"}
 THIRD_PARTY_OK_IN_CORE = {"numpy", "numba"}
 
 
