@@ -84,3 +84,14 @@ def test_a_saved_stream_is_mapped_and_checked_in_blocks(monkeypatch, tmp_path):
     x[77, 1] = np.inf
     with pytest.raises(HalError, match="finite"):
         loop.read_stream(x)
+
+
+def test_the_stream_file_for_halstreamer_is_what_savetxt_printed(monkeypatch, tmp_path):
+    """Printed a block at a time, the same bytes as ``np.savetxt`` with 9 decimals (what
+    halstreamer read before), negative zeros and all."""
+    monkeypatch.setattr(loop, "BLOCK", 16)
+    x = np.random.default_rng(5).normal(scale=50.0, size=(100, 3))
+    x[3] = [-0.0, 0.0, -1e-12]
+    loop.write_stream_txt(x, tmp_path / "s.txt")
+    np.savetxt(tmp_path / "ref.txt", x, fmt="%.9f", delimiter=" ")
+    assert (tmp_path / "s.txt").read_bytes() == (tmp_path / "ref.txt").read_bytes()

@@ -23,6 +23,7 @@ import numpy as np
 from ...core.errors import InputError
 from ...core.scratch import rows_array
 from ...core.work_limits import sigterm_as_interrupt
+from ..stream import stream_text
 from .session import HalError, HalInterrupted, HalSession, work_folder
 
 SAMPLE_RES = 1e-9  # mm: halsampler prints 6 decimals of the µm the sampler holds
@@ -61,8 +62,12 @@ class HalLoopResult:
 
 
 def write_stream_txt(stream: np.ndarray, path: Path) -> Path:
-    """The ``.txt`` halstreamer reads for ``cfg=fff``: ``X Y Z`` per line, 9 decimals (mm)."""
-    np.savetxt(path, np.asarray(stream, dtype=np.float64), fmt="%.9f", delimiter=" ")
+    """The ``.txt`` halstreamer reads for ``cfg=fff``: ``X Y Z`` per line, 9 decimals (mm),
+    printed BLOCK rows at a time (:func:`~cadcnc.controller.stream.stream_text`)."""
+    rows = np.asarray(stream, dtype=np.float64)
+    with open(path, "w") as out:
+        for a in range(0, len(rows), BLOCK):
+            out.write(stream_text(rows[a:a + BLOCK]))
     return Path(path)
 
 
