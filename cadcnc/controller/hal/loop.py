@@ -210,8 +210,9 @@ def _read_samples(path: Path, rows: np.ndarray, total: int, period: float, wall:
     n = len(rows)
     cmd = rows_array(total, folder, "HAL's commanded positions")
     exe = rows_array(total, folder, "HAL's executed positions")
-    read, columns, tags, under = 0, 8, [], [0, 0]   # (underruns at the first and the
-    # program's last sample)
+    read, columns = 0, 8
+    tags, under = [0, 0], [0, 0]   # at the first sample and at the last (tags), or the
+    # program's last (underruns)
     clipped = clipped_tail = 0
     command_error = tracking_error = 0.0
     with open(path) as lines:
@@ -229,9 +230,9 @@ def _read_samples(path: Path, rows: np.ndarray, total: int, period: float, wall:
                 continue
             k = slice(read, read + len(data))
             cmd[k], exe[k] = data[:, 1:4] / 1e3, data[:, 4:7] / 1e3
-            tags += [int(data[0, 0]), int(data[-1, 0])]
             if read == 0:
-                under[0] = int(data[0, 7])
+                tags[0], under[0] = int(data[0, 0]), int(data[0, 7])
+            tags[1] = int(data[-1, 0])
             if read <= n - 1 < read + len(data):   # the program's last sample
                 under[1] = int(data[n - 1 - read, 7])
             off = np.abs(exe[k] - cmd[k]).max(axis=1) > SAMPLE_RES * 0.5
