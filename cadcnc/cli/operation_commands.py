@@ -1,7 +1,7 @@
 """``path``, ``pencil`` and ``finish``: options to a Job, one pipeline call
-(:func:`cadcnc.pipeline.operation.run_operation`, or
-:func:`cadcnc.pipeline.setup_programs.run_setups` for ``pencil --setups``), the verdict
-and the summary printed, the pipeline's exit code.
+(:func:`cadcnc.pipeline.operation.run_operation`; ``pencil --setups`` in
+:mod:`.setups_command`, loaded through the command table), the verdict and the summary
+printed, the pipeline's exit code.
 """
 
 from __future__ import annotations
@@ -9,16 +9,16 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from cadcnc.core.errors import InputError
-from cadcnc.core.units import parse_length
 from cadcnc.geometry.setup import setup_in
 from cadcnc.pipeline.operation import OperationRun, StreamRequest, run_operation
-from cadcnc.pipeline.setup_programs import SetupsRun, run_setups
 
+from .commands import load
 from .feedback import progress, say_error, stage_progress
 from .options import finish_job, machine_of, path_job, pencil_job, settings_of
-from .stream_command import print_stream
+from .stream_report import print_stream
 
+SETUPS = "cadcnc.cli.setups_command:setups"
+"""``pencil --setups``' handler: its pencil and setup modules imported only then."""
 PROGRESS_EVERY_S = 1.0  # s between two progress lines of finish on stderr
 
 
@@ -30,7 +30,7 @@ def path(args) -> int:
 
 def pencil(args) -> int:
     if args.setups is not None:
-        return _setups(args)
+        return load(SETUPS)(args)
     report = None if args.quiet else (
         lambda done, total, what: say_error(f"cadcnc: pencil: corner {done}/{total} ({what})"))
     return _operation(args, "pencil", pencil_job(args, args.step), progress=report, times={})
@@ -74,41 +74,6 @@ def _print_operation(args, run: OperationRun, times: dict | None) -> None:
             print(f"  wrote      {', '.join(run.written)}")
     for line in run.messages:
         say_error(line)
-
-
-def _setups(args) -> int:
-    """``pencil --setups``: one program per setup (:mod:`cadcnc.pipeline.setup_programs`)."""
-    if getattr(args, "axis", None) is not None:
-        raise InputError("give --axis or --setups, not both")
-    if getattr(args, "stream", None):
-        raise InputError("--stream takes one program: stream a setup's with --axis")
-    overlap = parse_length(args.setup_overlap, "--setup-overlap")
-    run = run_setups(args.step, pencil_job(args, args.step), args.setups, overlap,
-                     args.output, settings_of(args),
-                     progress=None if args.quiet else (lambda done, total, what: None),
-                     gate_progress=lambda what: stage_progress(
-                         args, f"{what}: gouge check", after_s=1.0))
-    _print_setups(args, run)
-    return run.code
-
-
-def _print_setups(args, run: SetupsRun) -> None:
-    """The messages on stderr; each setup's summary, the choice, verdict and times."""
-    for line in run.messages:
-        say_error(line)
-    if args.quiet:
-        return
-    name = Path(args.step).name
-    for done in run.programs:
-        if done.program is not None:
-            print(done.program.summary(f"{name} setup {done.setup.name}"))
-            print("  setup      " + "; ".join(done.setup.describe()))
-    for line in run.result.summary_lines():
-        print(line)
-    print("verdict    " + ("written: " + ", ".join(run.written) if run.written else
-                           "nothing written") + ("" if run.code == 0 else f" (exit {run.code})"))
-    print(f"time       computed in {run.seconds_computed:.1f} s, gated in "
-          f"{run.seconds_gated:.1f} s")
 
 
 def _finish_progress(args):

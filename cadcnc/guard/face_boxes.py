@@ -26,6 +26,8 @@ from OCP.BndLib import BndLib_AddSurface
 from OCP.GeomAbs import GeomAbs_BSplineCurve, GeomAbs_BSplineSurface
 from OCP.gp import gp_Pnt, gp_Vec
 
+from ..geometry import bspline_blob
+
 CELL_MM = 1.0
 """About this many mm of surface per cell side (at most ``MAX_CELLS`` cells)."""
 MAX_CELLS = 20_000
@@ -48,6 +50,14 @@ def face_cells(face, cell_mm: float) -> tuple[np.ndarray, np.ndarray]:
         f = math.sqrt(nu * nw / MAX_CELLS)
         nu, nw = max(1, int(nu / f)), max(1, int(nw / f))
     return np.linspace(u0, u1, nu + 1), np.linspace(w0, w1, nw + 1)
+
+
+def _net(surface) -> np.ndarray:
+    """(rows, cols, 3) the poles of a Geom_BSplineSurface: read in one call where
+    :func:`~cadcnc.geometry.bspline_blob.surface` can (checked against OCCT), else pole
+    by pole (the same numbers)."""
+    read = bspline_blob.surface(surface)
+    return read[0] if read is not None else _poles_2d(surface.Poles())
 
 
 def _poles_2d(array) -> np.ndarray:
@@ -139,7 +149,7 @@ class FaceBoxes:
             return self._box(u0, u1, w0, w1)
         except Exception:   # noqa: BLE001 - OCCT refused the cut (a range past the knots)
             if self.offset is not None:   # OCCT's box of an offset is sampled: the whole net's
-                return self._net_box(_poles_2d(self.surface.Poles()))
+                return self._net_box(_net(self.surface))
             return self._generic_box(u0, u1, w0, w1)
 
     def _net_box(self, net: np.ndarray) -> tuple:
@@ -167,7 +177,7 @@ class FaceBoxes:
         if self.surface is not None:
             piece = self.surface.Copy()
             piece.Segment(u0, u1, w0, w1)
-            return self._net_box(_poles_2d(piece.Poles()))
+            return self._net_box(_net(piece))
         if self.curve is not None:
             piece = self.curve.Copy()
             piece.Segment(u0, u1)
@@ -209,7 +219,7 @@ class FaceBoxes:
                 knots.SetValue(k, float(c))
                 mults.SetValue(k, degree)
             insert(knots, mults, 0.0, False)
-        poles = _poles_2d(piece.Poles())
+        poles = _net(piece)
         fu, lu = pole_support(flat_knots(piece.UKnotSequence()), piece.UDegree(), us)
         fw, lw = pole_support(flat_knots(piece.VKnotSequence()), piece.VDegree(), ws)
         out = np.empty((len(us) - 1, len(ws) - 1, 6))

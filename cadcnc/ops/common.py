@@ -11,6 +11,8 @@ from ..program.program import CutSegment, Program
 from ..program.toolpath import Toolpath, toolpath_from_record
 from .path.pair_path import PathPlan, stepper_for
 
+CHAIN_GAP = 1e-3
+"""mm: a pencil cut starting this near another's end continues it (no lift)."""
 FINISH_JOIN = 1e-6
 """mm: a finishing cut starting this near the last one's end continues it (one pass or
 level, chained); also the gap of a finishing program relinked once cut back."""

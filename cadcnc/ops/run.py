@@ -21,9 +21,7 @@ from ..geometry.part import Part
 from ..geometry.setup import setup_part
 from ..parallel.pool import kept_pools, start
 from ..program.program import Program
-from .common import FINISH_JOIN
-from .path.pair_program import program_for_job
-from .pencil.pencil_program import CHAIN_GAP, pencil_program
+from .common import CHAIN_GAP, FINISH_JOIN
 
 
 @dataclass(frozen=True)
@@ -117,10 +115,14 @@ def check_clearance(part: Part, job: Job) -> None:
 
 
 def _pair(part: Part, job: Job, o: RunOptions) -> Program:
+    from .path.pair_program import program_for_job  # noqa: PLC0415
+
     return program_for_job(part, job, progress=o.progress, max_cycles=o.max_cycles)
 
 
 def _pencil(part: Part, job: Job, o: RunOptions) -> Program:
+    from .pencil.pencil_program import pencil_program  # noqa: PLC0415
+
     return pencil_program(part, job, progress=o.progress, times=o.times,
                           max_cycles=o.max_cycles, processes=o.processes)
 

@@ -14,8 +14,6 @@ from ..io.output_set import OutputSet, check_destination
 from ..io.outputs import SUFFIXES
 from ..parallel.pool import kept_pools
 from .operate import Outcome, Settings, operate, rendered
-from .streaming import SUFFIXES as STREAM_SUFFIXES
-from .streaming import StreamRun, stream_to
 
 
 @dataclass(frozen=True)
@@ -35,7 +33,7 @@ class OperationRun:
 
     outcome: Outcome
     written: list[str] = field(default_factory=list)
-    stream: StreamRun | None = None
+    stream: object = None
     messages: list[str] = field(default_factory=list)
     code: int = EXIT_OK
 
@@ -56,6 +54,7 @@ def _run(step, job, what, outputs, settings, stream, *, progress, times, gate_pr
          say) -> OperationRun:
     written = OutputSet(outputs, SUFFIXES, inputs=[step])  # checked before computing
     for out in stream.outputs if stream is not None else ():
+        from .streaming import SUFFIXES as STREAM_SUFFIXES
         check_destination(out, STREAM_SUFFIXES, [step])
     done = operate(step, job, what, settings, progress=progress, times=times,
                    gate_progress=gate_progress, outputs=outputs)
@@ -69,6 +68,7 @@ def _run(step, job, what, outputs, settings, stream, *, progress, times, gate_pr
         run.messages.append(f"cadcnc: {done.what}: not streamed: only a complete, verified "
                             "program is")
         return run
+    from .streaming import stream_to
     run.stream = stream_to(done.program, done.part, stream.machine, stream.outputs,
                            tolerances=job.tolerances, say=say, inputs=[step])
     run.code = run.stream.code

@@ -48,6 +48,24 @@ def test_faces_loads_neither_numba_nor_the_interpolation_core():
     assert run.stdout.splitlines()[-1] == "False False"
 
 
+def test_finish_loads_neither_the_other_operations_nor_the_feed_planner(tmp_path):
+    """An operation imports what it runs (issue 37, item 5): ``finish`` neither the pencil
+    and path programs (``pencil --setups`` included) nor the stream's planner, which only
+    ``--stream`` needs; the program is still written."""
+    out = tmp_path / "p.ngc"
+    code = ("import sys; from cadcnc.cli import main; "
+            f"code = main(['finish', {str(FIXTURES / 'finish_slab.step')!r}, '--faces', '5', "
+            f"'--radius', '3', '--stepover', '8', '-q', '-o', {str(out)!r}]); "
+            "print(code, sorted(m for m in sys.modules if m.startswith(("
+            "'cadcnc.ops.pencil', 'cadcnc.ops.path.pair_program', 'cadcnc.controller.feed_plan', "
+            "'cadcnc.controller.stream', 'cadcnc.pipeline.streaming', "
+            "'cadcnc.pipeline.setup_programs'))))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.splitlines()[-1] == "0 []" and "M2" in out.read_text()
+
+
 def test_a_long_stage_reports_at_least_every_five_seconds():
     """The gate's stages (and any caller of stage_progress) are never silent longer than
     the heartbeat, by a fake clock: one line when a stage starts, then one per 5 s."""

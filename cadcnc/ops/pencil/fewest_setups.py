@@ -32,11 +32,10 @@ from ...geometry.setup import Setup, original_part, setup_in, setup_part
 from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program, Skipped
 from ...program.transform import in_part_coordinates
-from ..common import safe_height
+from ..common import CHAIN_GAP, safe_height
 from ..entries import entered_program_segments
 from ..path.pair_program import NO_STRETCH
 from ..run import RunOptions, operation_of
-from .pencil_program import CHAIN_GAP
 from .reach_samples import BallSamples, axis_reach, ball_samples, stretch_lines, true_runs
 from .setup_positions import SPACING, corner_positions, cut_keys, edge_positions, line_keys
 

@@ -34,7 +34,7 @@ from ...guard import guard_for
 from ...parallel.tasks import on_workers
 from ...program.linking import order_cuts
 from ...program.program import CutSegment, Program, Skipped
-from ..common import refuse_cycles, require_ball, run_stretch, safe_height
+from ..common import CHAIN_GAP, refuse_cycles, require_ball, run_stretch, safe_height
 from ..entries import UNREACHABLE, entered_program_segments
 from ..path.feasibility import Feasibility
 from ..path.limit_search import limit_samples
@@ -42,9 +42,6 @@ from ..path.pair_path import plan_path
 from ..path.pair_program import stretch_cuts
 from ..path.stretches import MIN_SAMPLES, SPACING, edge_stretches, pair_stretches
 from .corners import BLEND, EDGE, Corner, find_corners
-
-CHAIN_GAP = 1e-3
-"""mm: a cut starting this near another's end continues it (no lift)."""
 
 
 def pencil_program(part: Part, job: Job, *, progress: Progress | None = None,
