@@ -5,6 +5,8 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import pytest
+
 from helpers.fixtures import FIXTURES
 
 
@@ -48,6 +50,7 @@ def test_faces_loads_neither_numba_nor_the_interpolation_core():
     assert run.stdout.splitlines()[-1] == "False False"
 
 
+@pytest.mark.slow   # a fresh process runs a whole finish command (~2.5 s)
 def test_finish_loads_neither_the_other_operations_nor_the_feed_planner(tmp_path):
     """An operation imports what it runs (issue 37, item 5): ``finish`` neither the pencil
     and path programs (``pencil --setups`` included) nor the stream's planner, which only
