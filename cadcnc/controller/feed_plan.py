@@ -37,7 +37,7 @@ import numpy as np
 from numba import njit
 
 from ..core.errors import EXIT_GOUGE, CadcncError, InputError
-from . import plan_once, topp
+from . import averaged_jerk, plan_once, topp
 from .machine import Machine
 from .pieces import Piece, constant_speed
 from .runs import JOIN_SHARE, Run, runs_of
@@ -50,6 +50,9 @@ CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most (0.5 and 0.75 were slower 
                         # on every run of the three programs: the window grows instead)
 D_SHARE = 0.25          # of J_i: D_i v^3 at most
 SHARE_STEP, SHARE_STEPS = 0.025, 3   # the Coriolis share searched per curved run
+CAP_FACTORS = (0.95,)   # a bending run's top speed capped at these shares of its plan's
+BENT_SHARE = 0.65       # ... and on a run that bends, this share too (its jerk measured)
+WINDOW_GROWTH = 1.02    # a bending run's window lengthened by at least this factor a round
 WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window grown
 FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
 TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
@@ -57,6 +60,7 @@ TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened th
 MAX_PERIODS = 50_000_000
 BLOCK_ROWS = 1 << 16   # periods of targets made at a time (FeedPlan.blocks): a few MB
 SAME_RUN = 1e-11
+BEND_K = 1e-6           # 1/mm: p'' above this somewhere: a run that bends (1 km radius)
 """Runs whose path derivatives agree within this (absolute, in their units, and relative)
 share one plan: the limits are then met within about 1e-7 of themselves on the other
 run, far inside MARGIN."""
@@ -156,6 +160,23 @@ def _tightened(run: Run, wl, limits, period: float, window: float, coriolis: flo
     return first
 
 
+def _bends(run: Run) -> bool:
+    """Whether the run's path bends (p'' over BEND_K somewhere): only then do the
+    curvature terms make :func:`.topp.window_needed` an overestimate worth measuring."""
+    return bool(np.max(np.abs(run.K), initial=0.0) > BEND_K)
+
+
+def _measured(run: Run, plan: tuple, window: float, J, period: float) -> float:
+    """The largest share of J that the plan averaged over ``window`` takes, measured on the
+    averaged motion itself (:func:`.averaged_jerk.peak_share`) on a run that bends (inf
+    on one that does not: its :func:`.topp.window_needed` is already exact)."""
+    if not _bends(run):
+        return math.inf
+    t, w, u, v, a, S, need = plan
+    return averaged_jerk.peak_share(t, run.s, v, a, S, window, run.s, run.T, run.K, run.D,
+                                    run.jump, run.kink, J, period)
+
+
 def _first_window(run: Run, A, J) -> float:
     """The first averaging window (s): the shortest A_i / J_i of the axes the run moves;
     the plan lengthens it where the profile needs more."""
@@ -178,11 +199,13 @@ class _Windowed:
         return float(self.plan[0][-1]) + self.window
 
 
-def _windowed(run: Run, machine: Machine, limits, coriolis: float) -> _Windowed:
-    """The run's plan with the Coriolis term's share ``coriolis`` (see the module doc):
-    turns flattened, or the window grown, until the window is long enough."""
+def _windowed(run: Run, machine: Machine, limits, coriolis: float,
+              cap: float = math.inf) -> _Windowed:
+    """The run's plan with the Coriolis term's share ``coriolis`` (see the module doc), its
+    speed at most ``cap`` (mm/s): turns flattened, or the window grown, until the window is
+    long enough."""
     V, A, J = limits
-    wl = _speed_limits(run, V, J, machine.period)
+    wl = np.minimum(_speed_limits(run, V, J, machine.period), cap * cap)
     window = _first_window(run, A, J)
     flattening, last = True, math.inf
     for round_ in range(WINDOW_ROUNDS):
@@ -193,13 +216,26 @@ def _windowed(run: Run, machine: Machine, limits, coriolis: float) -> _Windowed:
             return _Windowed(coriolis, window, wl, plan)
         flattening = flattening and round_ < FLATTEN_ROUNDS and top < last   # progress
         last = top
+        # the motion measured as it comes, and once the flattening stops: not between
+        measured = math.inf
+        if round_ == 0 or not flattening:
+            measured = _measured(run, plan, window, J, machine.period)
+            if measured <= 1.0:
+                return _Windowed(coriolis, window, wl, plan)
         if flattening and topp.flatten(run.s, t, w, u, wl, need, window):
             continue
+        if round_ > 0 and flattening:   # nothing left to flatten: measured now
+            measured = _measured(run, plan, window, J, machine.period)
+            if measured <= 1.0:
+                return _Windowed(coriolis, window, wl, plan)
         if not math.isfinite(top):
             raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: the "
                             "curvature leaves no jerk for the feed to change (limits "
                             f"{machine.summary()})")
-        window = top
+        # where the motion is measured (a run that bends), the window grows as much as the
+        # measured jerk asks (the tangential part goes as 1 / window), the bound at most
+        window = min(top, window * max(measured, WINDOW_GROWTH)) if math.isfinite(
+            measured) else top
     raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: no "
                     f"averaging window keeps the jerk within {machine.summary()}")
 
@@ -208,7 +244,7 @@ def _profile(run: Run, machine: Machine, limits, chosen: _Windowed) -> Profile:
     """The chosen plan with, on a curved run, the derivatives taken only where the motion
     goes (a straight run's are the same everywhere), as a profile."""
     plan = chosen.plan
-    if run.curved:
+    if run.curved and not _bends(run):   # a bending run's jerk is measured as it is
         plan = _tightened(run, chosen.wl, limits, machine.period, chosen.window,
                           chosen.coriolis, plan)
     t, w, u, v, a, S, need = plan
@@ -235,20 +271,47 @@ def _best_share(run: Run, machine: Machine, limits) -> Profile:
     past the first one, the share moved by SHARE_STEP while that shortens the run (a larger
     share lets the feed change faster on a curve but asks for a longer window). The shares
     are compared before the derivatives are tightened, and only the chosen one is."""
+    if _bends(run):
+        try:
+            return _profile(run, machine, limits, _capped(run, machine, limits))
+        except PlanError:   # no window for that share: the usual one
+            pass
     first = _windowed(run, machine, limits, CORIOLIS_SHARE)
     if first.window <= _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9):  # round-off
         return _profile(run, machine, limits, first)
-    for step in (-SHARE_STEP, SHARE_STEP):
+    for step, steps in ((-SHARE_STEP, SHARE_STEPS), (SHARE_STEP, SHARE_STEPS)):
         best, share = first, CORIOLIS_SHARE
-        for _ in range(SHARE_STEPS):
+        for _ in range(steps):
             share += step
-            other = _windowed(run, machine, limits, share)
+            try:
+                other = _windowed(run, machine, limits, share)
+            except PlanError:   # no window for that share: the search ends there
+                break
             if other.duration >= best.duration:
                 break
             best = other
         if best is not first:
             return _profile(run, machine, limits, best)
     return _profile(run, machine, limits, first)
+
+
+def _capped(run: Run, machine: Machine, limits) -> _Windowed:
+    """A bending run at BENT_SHARE; where its window had to grow, also with its top speed
+    capped at each of CAP_FACTORS of the plan's (a slower top asks for less window), the
+    fastest kept: a looser limit that lets the feed higher never lengthens the run more
+    than these caps can give back."""
+    best = _windowed(run, machine, limits, BENT_SHARE)
+    if best.window <= _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9):  # round-off
+        return best
+    top = float(np.max(best.plan[3]))
+    for factor in CAP_FACTORS:
+        try:
+            other = _windowed(run, machine, limits, BENT_SHARE, factor * top)
+        except PlanError:
+            continue
+        if other.duration < best.duration:
+            best = other
+    return best
 
 
 def _even_ratio(run: Run, A: np.ndarray, J: np.ndarray) -> np.ndarray | None:

@@ -131,7 +131,7 @@ def boxes(s, x, lo_s, hi_s):
 
 
 @njit(cache=True, error_model="numpy")
-def _knot_at(t, tau: float, k: int) -> int:
+def knot_at(t, tau: float, k: int) -> int:
     """The knot holding ``tau``: the last k <= n - 2 with t[k] <= tau (0 before the
     start), searched forward from ``k`` (a knot at or before it: callers whose times
     only grow keep it, so that a sweep is linear)."""
@@ -145,12 +145,12 @@ def _knot_at(t, tau: float, k: int) -> int:
 @njit(cache=True, error_model="numpy")
 def _integral(t, s, v, a, S, tau: float, k: int) -> float:
     """The time integral of s(t) from 0 to tau (s = 0 before 0, s[-1] after the end);
-    ``k``: a knot at or before tau's (:func:`_knot_at`)."""
+    ``k``: a knot at or before tau's (:func:`knot_at`)."""
     if tau <= 0.0:
         return 0.0
     n = len(t)
     end = t[n - 1]
-    k = _knot_at(t, tau, k)
+    k = knot_at(t, tau, k)
     x = min(tau, end) - t[k]
     return (S[k] + s[k] * x + v[k] * x * x / 2.0 + a[k] * x ** 3 / 6.0
             + s[n - 1] * max(tau - end, 0.0))
@@ -162,10 +162,10 @@ def averaged(t, s, v, a, S, window: float, tau: float, k: int = 0) -> float:
     ``k``: a knot at or before that of tau - window (0: search from the start)."""
     if window <= 0.0:
         n = len(t)
-        k = _knot_at(t, tau, k)
+        k = knot_at(t, tau, k)
         y = min(max(tau, 0.0), t[n - 1]) - t[k]
         return min(max(s[k] + v[k] * y + a[k] * y * y / 2.0, 0.0), s[n - 1])
-    early = _knot_at(t, tau - window, k)
+    early = knot_at(t, tau - window, k)
     x = (_integral(t, s, v, a, S, tau, early)
          - _integral(t, s, v, a, S, tau - window, early)) / window
     return min(max(x, 0.0), s[len(s) - 1])
@@ -178,7 +178,7 @@ def averaged_sweep(t, s, v, a, S, window: float, tau, out) -> None:
     k = 0
     for i in range(len(tau)):
         out[i] = averaged(t, s, v, a, S, window, tau[i], k)
-        k = _knot_at(t, tau[i] - window, k)
+        k = knot_at(t, tau[i] - window, k)
 
 
 @njit(cache=True, error_model="numpy")
@@ -192,8 +192,8 @@ def ranges(t, s, v, a, S, window: float):
     for k in range(n):   # t only grows: both searches sweep forward
         lo[k] = min(averaged(t, s, v, a, S, window, t[k], k0), s[k])
         hi[k] = max(averaged(t, s, v, a, S, window, t[k] + window, k1), s[k])
-        k0 = _knot_at(t, t[k] - window, k0)   # the knots these calls started from
-        k1 = _knot_at(t, (t[k] + window) - window, k1)
+        k0 = knot_at(t, t[k] - window, k0)   # the knots these calls started from
+        k1 = knot_at(t, (t[k] + window) - window, k1)
     return lo, hi
 
 
