@@ -96,7 +96,7 @@ def _step_caps(seg, machine: Machine, mask: np.ndarray,
     full = job.step
     commanded = np.asarray(path.commanded, dtype=float)
     n = len(commanded)
-    limit = np.full(n, full if machine.period > job.period else math.inf)
+    limit = np.full(n, full)   # no step longer than the program's was ever tried
     if path.accuracy_cycles:
         short = commanded[1:-1] < full * (1.0 - 1e-9)   # step k -> k + 1 shortened
         steps = np.where(short, commanded[1:-1], math.inf)

@@ -150,3 +150,19 @@ def test_steps_the_accuracy_rule_would_shorten_are_never_planned():
                 (69361.7, 6966593.4, 6054.66))
     stream = stream_program(prog, m, stepper_factory(part), feed=11504.45)
     assert (_shares(stream.positions, m) <= 1.0 + SLACK).all()
+
+
+def test_a_cut_never_steps_further_than_its_program_did():
+    """A fast machine at 40 000 mm/min: a period's step on a cut stays within the
+    program's own step (0.1 mm: 1 500 mm/min at 4 ms), the longest the kernel's accuracy
+    rule was tried at; the stream keeps every limit. (Was: a machine period shorter than
+    the program's lifted the cap, and at a higher feed the kernel fell behind the plan:
+    505x the jerk limit on the free-form slab's raster.)"""
+    part, prog = _corner()
+    m = Machine(0.001, (1000.0,) * 3, (20_000.0,) * 3, (400_000.0,) * 3, "fast")
+    stream = stream_program(prog, m, stepper_factory(part), feed=40_000.0)
+    assert (_shares(stream.positions, m) <= 1.0 + SLACK).all()
+    cut = stream.positions[stream.rows == 2]
+    steps = np.linalg.norm(np.diff(cut, axis=0), axis=1)
+    assert steps.max() <= prog.job.step * (1.0 + 1e-9)
+    assert steps.max() > 0.5 * prog.job.step   # the cap binds: the feed asked for more
