@@ -19,7 +19,12 @@ from rest to rest:
    W the shortest that leaves every axis the room the curvature terms do not take
    (:func:`.topp.window_needed`; about A / J on a straight run, once per rest);
 4. the speed limits eroded (each held over +-v W) and the derivatives taken over the
-   window's reach, so that the averaged motion keeps every limit where it is.
+   window's reach, so that the averaged motion keeps every limit where it is;
+5. on a run that bends, the averaged motion's jerk measured as it is
+   (:mod:`.averaged_jerk`) rather than bounded from the window's extremes: the run is
+   planned at BENT_SHARE of J for the Coriolis term, its window grown only as much as
+   the measured jerk asks (and, where it grew, its top speed also capped at CAP_FACTORS
+   of the plan's, the faster kept).
 
 The acceleration used is at most sqrt(V J) per axis, and (J² L)^(1/3) on a run of length
 L: with more, the window would cost more time than the acceleration saves, and a looser
@@ -46,12 +51,15 @@ MARGIN = 0.995
 """Share of every limit the plan uses; the rest covers the path's derivatives between the
 kernel's points, the averaged squared speed (v² of the mean is at most the mean of v²)
 and the kernel's step landing within a few nm of the plan."""
-CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most (0.5 and 0.75 were slower or equal
-                        # on every run of the three programs: the window grows instead)
+CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most where the window's bound judges the
+                        # jerk (larger shares only lengthened its window)
 D_SHARE = 0.25          # of J_i: D_i v^3 at most
 SHARE_STEP, SHARE_STEPS = 0.025, 3   # the Coriolis share searched per curved run
-CAP_FACTORS = (0.95,)   # a bending run's top speed capped at these shares of its plan's
-BENT_SHARE = 0.65       # ... and on a run that bends, this share too (its jerk measured)
+BEND_K = 1e-6           # 1/mm: p'' over this somewhere: a run that bends (1 km radius)
+BENT_SHARE = 0.65       # of J_i for 3 K_i v s'' on a run that bends (its jerk measured):
+                        # the arcs' durations fall up to about 0.65 and are flat beyond
+CAP_FACTORS = (0.95,)   # a bending run whose window grew: also its top speed capped at
+                        # these shares of its plan's
 WINDOW_GROWTH = 1.02    # a bending run's window lengthened by at least this factor a round
 WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window grown
 FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
@@ -60,7 +68,6 @@ TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened th
 MAX_PERIODS = 50_000_000
 BLOCK_ROWS = 1 << 16   # periods of targets made at a time (FeedPlan.blocks): a few MB
 SAME_RUN = 1e-11
-BEND_K = 1e-6           # 1/mm: p'' above this somewhere: a run that bends (1 km radius)
 """Runs whose path derivatives agree within this (absolute, in their units, and relative)
 share one plan: the limits are then met within about 1e-7 of themselves on the other
 run, far inside MARGIN."""
