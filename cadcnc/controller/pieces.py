@@ -23,6 +23,7 @@ DUPLICATE = 1e-12   # mm: consecutive points this close are one point
 ACCURACY_SHARE = 0.9
 """The planned step stays within this share of the step the accuracy rule allowed the
 program (``accuracy_cycles``): the kernel then never shortens a planned step."""
+STRAIGHT_K = 1e-6      # 1/mm: a path this little curved is straight (a 1 mm step's sag 1e-7 mm)
 
 
 @dataclass
@@ -96,13 +97,16 @@ def _step_caps(seg, machine: Machine, mask: np.ndarray,
     full = job.step
     commanded = np.asarray(path.commanded, dtype=float)
     n = len(commanded)
-    limit = np.full(n, full)   # no step longer than the program's was ever tried
+    limit = np.full(n, math.inf)
     if path.accuracy_cycles:
         short = commanded[1:-1] < full * (1.0 - 1e-9)   # step k -> k + 1 shortened
         steps = np.where(short, commanded[1:-1], math.inf)
         limit[:-2] = np.minimum(limit[:-2], steps)
         limit[1:-1] = np.minimum(limit[1:-1], steps)
     limit = limit[mask]
+    # where the path bends, no step longer than the program's was ever tried (a straight
+    # stretch's step lands on the path whatever its length)
+    limit = np.where(kappa > STRAIGHT_K, np.minimum(limit, full), limit)
     with np.errstate(divide="ignore"):
         chord = np.minimum(np.sqrt(4.0 * job.tolerances.accuracy / kappa), MAX_TURN / kappa)
     limit = np.minimum(limit, chord)

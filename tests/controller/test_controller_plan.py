@@ -13,6 +13,7 @@ import pytest
 import cadcnc
 from cadcnc.controller import Machine, stream_program
 from cadcnc.controller.feed_plan import PlanError
+from cadcnc.controller.pieces import pieces_of
 from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
@@ -166,3 +167,15 @@ def test_a_cut_never_steps_further_than_its_program_did():
     steps = np.linalg.norm(np.diff(cut, axis=0), axis=1)
     assert steps.max() <= prog.job.step * (1.0 + 1e-9)
     assert steps.max() > 0.5 * prog.job.step   # the cap binds: the feed asked for more
+
+
+def test_a_straight_cut_is_not_held_to_its_programs_step():
+    """The pencil's straight cut (curvature 1e-12 /mm) at 40 000 mm/min: a step of any
+    length lands on the path, so its periods may step further than the program did
+    (the L-bracket's straight pencil on the high-speed mill: 1.21 s, 1.76 s when every cut
+    was held to its program's step); the curved corner's cut is held to 0.9 of it."""
+    fast = Machine(0.001, (1000.0,) * 3, (20_000.0,) * 3, (400_000.0,) * 3, "fast")
+    (straight,) = [p for p in pieces_of(_pencil()[1], fast, 40_000.0) if p.cut is not None]
+    (curved,) = [p for p in pieces_of(_corner()[1], fast, 40_000.0) if p.cut is not None]
+    assert straight.step_cap is None or straight.step_cap.min() > 1000.0   # mm/s: not held
+    assert curved.step_cap.max() == pytest.approx(0.9 * 0.1 / fast.period)
