@@ -55,7 +55,6 @@ CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most where the window's bound j
                         # jerk (larger shares only lengthened its window)
 D_SHARE = 0.25          # of J_i: D_i v^3 at most
 SHARE_STEP, SHARE_STEPS = 0.025, 3   # the Coriolis share searched per curved run
-BEND_K = 1e-6           # 1/mm: p'' over this somewhere: a run that bends (1 km radius)
 BENT_SHARE = 0.65       # of J_i for 3 K_i v s'' on a run that bends (its jerk measured):
                         # the arcs' durations fall up to about 0.65 and are flat beyond
 CAP_FACTORS = (0.95,)   # a bending run whose window grew: also its top speed capped at
@@ -167,21 +166,21 @@ def _tightened(run: Run, wl, limits, period: float, window: float, coriolis: flo
     return first
 
 
-def _bends(run: Run) -> bool:
-    """Whether the run's path bends (p'' over BEND_K somewhere): only then do the
-    curvature terms make :func:`.topp.window_needed` an overestimate worth measuring."""
-    return bool(np.max(np.abs(run.K), initial=0.0) > BEND_K)
-
-
 def _measured(run: Run, plan: tuple, window: float, J, period: float) -> float:
     """The largest share of J that the plan averaged over ``window`` takes, measured on the
     averaged motion itself (:func:`.averaged_jerk.peak_share`) on a run that bends (inf
-    on one that does not: its :func:`.topp.window_needed` is already exact)."""
-    if not _bends(run):
+    on one that does not: there the curvature terms leave :func:`.topp.window_needed`
+    nothing to overestimate)."""
+    if not run.bends:
         return math.inf
     t, w, u, v, a, S, need = plan
     return averaged_jerk.peak_share(t, run.s, v, a, S, window, run.s, run.T, run.K, run.D,
                                     run.jump, run.kink, J, period)
+
+
+def _grew(run: Run, limits, plan: _Windowed) -> bool:
+    """Whether the plan's window is longer than the first one (beyond round-off)."""
+    return plan.window > _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9)
 
 
 def _first_window(run: Run, A, J) -> float:
@@ -224,14 +223,13 @@ def _windowed(run: Run, machine: Machine, limits, coriolis: float,
         flattening = flattening and round_ < FLATTEN_ROUNDS and top < last   # progress
         last = top
         # the motion measured as it comes, and once the flattening stops: not between
-        measured = math.inf
-        if round_ == 0 or not flattening:
-            measured = _measured(run, plan, window, J, machine.period)
-            if measured <= 1.0:
-                return _Windowed(coriolis, window, wl, plan)
+        early = round_ == 0 or not flattening
+        measured = _measured(run, plan, window, J, machine.period) if early else math.inf
+        if measured <= 1.0:
+            return _Windowed(coriolis, window, wl, plan)
         if flattening and topp.flatten(run.s, t, w, u, wl, need, window):
             continue
-        if round_ > 0 and flattening:   # nothing left to flatten: measured now
+        if not early:   # nothing left to flatten: measured now
             measured = _measured(run, plan, window, J, machine.period)
             if measured <= 1.0:
                 return _Windowed(coriolis, window, wl, plan)
@@ -251,7 +249,7 @@ def _profile(run: Run, machine: Machine, limits, chosen: _Windowed) -> Profile:
     """The chosen plan with, on a curved run, the derivatives taken only where the motion
     goes (a straight run's are the same everywhere), as a profile."""
     plan = chosen.plan
-    if run.curved and not _bends(run):   # a bending run's jerk is measured as it is
+    if run.curved and not run.bends:   # a bending run's jerk is measured as it is
         plan = _tightened(run, chosen.wl, limits, machine.period, chosen.window,
                           chosen.coriolis, plan)
     t, w, u, v, a, S, need = plan
@@ -277,14 +275,16 @@ def _best_share(run: Run, machine: Machine, limits) -> Profile:
     """The run planned at CORIOLIS_SHARE; where the curvature terms lengthened its window
     past the first one, the share moved by SHARE_STEP while that shortens the run (a larger
     share lets the feed change faster on a curve but asks for a longer window). The shares
-    are compared before the derivatives are tightened, and only the chosen one is."""
-    if _bends(run):
+    are compared before the derivatives are tightened, and only the chosen one is. A run
+    that bends is planned by :func:`_capped` instead (its jerk measured), this way only
+    where no window serves BENT_SHARE."""
+    if run.bends:
         try:
             return _profile(run, machine, limits, _capped(run, machine, limits))
         except PlanError:   # no window for that share: the usual one
             pass
     first = _windowed(run, machine, limits, CORIOLIS_SHARE)
-    if first.window <= _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9):  # round-off
+    if not _grew(run, limits, first):
         return _profile(run, machine, limits, first)
     for step, steps in ((-SHARE_STEP, SHARE_STEPS), (SHARE_STEP, SHARE_STEPS)):
         best, share = first, CORIOLIS_SHARE
@@ -308,7 +308,7 @@ def _capped(run: Run, machine: Machine, limits) -> _Windowed:
     fastest kept: a looser limit that lets the feed higher never lengthens the run more
     than these caps can give back."""
     best = _windowed(run, machine, limits, BENT_SHARE)
-    if best.window <= _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9):  # round-off
+    if not _grew(run, limits, best):
         return best
     top = float(np.max(best.plan[3]))
     for factor in CAP_FACTORS:

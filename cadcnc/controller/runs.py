@@ -19,12 +19,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numba import njit
 
 from .machine import Machine
-from .pieces import Piece
+from .pieces import STRAIGHT_K, Piece
 
 LINE_KNOT = 0.25       # mm: the largest knot of a straight move (the plan's resolution)
 LINE_KNOTS_MAX = 4000  # knots of one straight move at most
@@ -56,6 +57,11 @@ class Run:
     @property
     def length(self) -> float:
         return float(self.offsets[-1])
+
+    @cached_property
+    def bends(self) -> bool:
+        """Whether the path bends (p'' over STRAIGHT_K somewhere), not only by round-off."""
+        return bool(np.max(np.abs(self.K), initial=0.0) > STRAIGHT_K)
 
     @property
     def curved(self) -> bool:
