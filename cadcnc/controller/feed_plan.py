@@ -180,7 +180,7 @@ def _measured(run: Run, plan: tuple, window: float, J, period: float) -> float:
 
 def _grew(run: Run, limits, plan: _Windowed) -> bool:
     """Whether the plan's window is longer than the first one (beyond round-off)."""
-    return plan.window > _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9)
+    return plan.window > _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9)  # round-off
 
 
 def _first_window(run: Run, A, J) -> float:
