@@ -24,6 +24,10 @@ ACCURACY_SHARE = 0.9
 """The planned step stays within this share of the step the accuracy rule allowed the
 program (``accuracy_cycles``): the kernel then never shortens a planned step."""
 STRAIGHT_K = 1e-6      # 1/mm: a path this little curved is straight (a 1 mm step's sag 1e-7 mm)
+MAX_SUBSTEPS = 8
+"""Kernel cycles a machine period at most on a cut whose accurate step is shorter than the
+feed's step a period (one count a cut: the kernel's point error then varies smoothly with
+the speed, as the jerk by finite differences needs)."""
 
 
 @dataclass
@@ -31,9 +35,10 @@ class Piece:
     """One cut or one straight link move, planned as one motion from rest to rest.
 
     ``cap`` (mm/s): the programmed speed (inf for a rapid: the axes' limits alone);
-    ``step_cap`` (n,) mm/s or None: per point, the speed at which the machine's period
-    stays within the step the accuracy rule allowed; ``segment`` the index in
-    ``program.segments``, ``cut`` the index among ``program.cuts`` (None for a link)."""
+    ``step_cap`` (n,) mm/s or None: per point, the speed at which each of the period's
+    ``substeps`` kernel cycles stays within the step the accuracy rule allowed;
+    ``segment`` the index in ``program.segments``, ``cut`` the index among
+    ``program.cuts`` (None for a link)."""
 
     points: np.ndarray
     s: np.ndarray
@@ -42,7 +47,7 @@ class Piece:
     cut: int | None = None
     step_cap: np.ndarray | None = None
     kappa: np.ndarray | None = None   # (n,) curvature 1/mm through each point and its two
-
+    substeps: int = 1   # kernel cycles a machine period (a cut's, :func:`substeps_for`)
 
     @property
     def length(self) -> float:
@@ -115,6 +120,21 @@ def _step_caps(seg, machine: Machine, mask: np.ndarray,
     return ACCURACY_SHARE * limit / machine.period
 
 
+def substeps_for(points: np.ndarray, s: np.ndarray, caps: np.ndarray | None, feed: float,
+                 machine: Machine) -> int:
+    """Kernel cycles a period (1..MAX_SUBSTEPS) for a cut whose accurate step ``caps``
+    ((n,) mm/s a cycle a period) holds the speed under what the feed (mm/s) and the axes'
+    velocities along its tangent allow: the fewest that lift every cap."""
+    if caps is None:
+        return 1
+    tangent = np.gradient(points, s, axis=0)
+    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+    with np.errstate(divide="ignore"):
+        axes = np.min(np.asarray(machine.max_velocity) / np.abs(tangent), axis=1)
+    need = float(np.max(np.minimum(axes, feed) / caps))
+    return int(min(max(math.ceil(need - 1e-9), 1), MAX_SUBSTEPS))   # round-off of need
+
+
 def pieces_of(program: Program, machine: Machine, feed: float | None = None, *,
               blend: float = 0.0, rounded: frozenset[int] = frozenset()) -> list[Piece]:
     """The program's pieces in machining order. ``feed`` (mm/min) replaces the program's
@@ -130,7 +150,9 @@ def pieces_of(program: Program, machine: Machine, feed: float | None = None, *,
             pts, s, kappa, mask = _distinct(np.asarray(seg.points, dtype=float))
             if s[-1] > DUPLICATE:
                 caps = _step_caps(seg, machine, mask, kappa)
-                pieces.append(Piece(pts, s, feed / 60.0, k, cut, caps, kappa))
+                m = substeps_for(pts, s, caps, feed / 60.0, machine)
+                pieces.append(Piece(pts, s, feed / 60.0, k, cut,
+                                    None if caps is None else m * caps, kappa, m))
             cut += 1
             continue
         if k in rounded:

@@ -4,7 +4,9 @@
 position on the exact path: a cut's by its own stepper re-run with the per-cycle feed
 override (the kernel computes every position, following the plan in its compiled loop,
 :mod:`cadcnc.interp.planned_follow`; the step commanded each period is the planned arc length
-minus the distance the kernel has travelled), a link move's in closed form. The steppers
+minus the distance the kernel has travelled; where the accurate step is shorter than a
+period's advance, the piece's ``substeps`` equal cycles a period), a link move's in
+closed form. The steppers
 come from the caller (``steppers(cut_index, segment, period)``, built
 where the part's faces are, e.g. :func:`cadcnc.ops.stream_steppers.stepper_factory`); a
 cut without one (a convex roll-over arc) is interpolated from its own points by a cubic
@@ -165,6 +167,16 @@ def follow_plan(piece: Piece, s: np.ndarray, before: float = 0.0,
     return plan
 
 
+def substep_lengths(s: np.ndarray, before: float, m: int) -> np.ndarray:
+    """(len(s) * m,) the arc lengths of m kernel cycles a period: each period's advance
+    from the row before (``before`` for s[0]) in m equal parts, the period's own last."""
+    edges = np.r_[before, s]
+    parts = np.arange(1, m + 1) / m
+    out = edges[:-1, None] + np.diff(edges)[:, None] * parts
+    out[:, -1] = s
+    return out.ravel()
+
+
 def _landed(stepper, piece: Piece, what: str) -> None:
     """Nothing once the stepper has landed on the cut's last point (GeometryError if it
     stopped on the way or missed it): the kernel's path is a few 1e-7 of its length longer
@@ -267,12 +279,13 @@ class _CutRows:
         self.before = self.travelled = 0.0
 
     def __call__(self, s: np.ndarray) -> np.ndarray:
-        piece = self.piece
-        plan = follow_plan(piece, s, self.before, self.travelled)
+        piece, m = self.piece, self.piece.substeps
+        cycles = s if m == 1 else substep_lengths(s, self.before, m)
+        plan = follow_plan(piece, cycles, self.before, self.travelled)
         out = follow(self.stepper, plan, piece.points[-1], float(piece.kappa[-1]), LANDING)
         if len(s):
             self.before, self.travelled = float(s[-1]), float(plan[-1, 0])
-        return out
+        return out if m == 1 else out[m - 1::m]
 
     def close(self) -> None:
         _landed(self.stepper, self.piece, self.what)

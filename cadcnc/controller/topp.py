@@ -322,6 +322,7 @@ def flatten(s, t, w, u, wl, need, window: float) -> int:
             if p >= 0 and _flatten_at(s, w, u, wl, p, q, window):
                 done += 1
                 end = t[q] + window   # the next turn lies past this one's window
+                k += 1   # and past k (a cruise before k can put q's window behind it)
                 while k < n - 1 and t[k] <= end:
                     k += 1
                 continue

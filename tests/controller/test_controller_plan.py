@@ -153,29 +153,47 @@ def test_steps_the_accuracy_rule_would_shorten_are_never_planned():
     assert (_shares(stream.positions, m) <= 1.0 + SLACK).all()
 
 
-def test_a_cut_never_steps_further_than_its_program_did():
-    """A fast machine at 40 000 mm/min: a period's step on a cut stays within the
-    program's own step (0.1 mm: 1 500 mm/min at 4 ms), the longest the kernel's accuracy
-    rule was tried at; the stream keeps every limit. (Was: a machine period shorter than
-    the program's lifted the cap, and at a higher feed the kernel fell behind the plan:
-    505x the jerk limit on the free-form slab's raster.)"""
+def test_a_fast_cut_steps_several_cycles_a_period_none_longer_than_its_program_did():
+    """A fast machine at 40 000 mm/min: the corner's cut takes several kernel cycles a
+    period, each within the program's own step (0.1 mm: 1 500 mm/min at 4 ms, the longest
+    the kernel's accuracy rule was tried at), and the stream keeps every limit. (Was: a
+    machine period shorter than the program's lifted the cap, and at a higher feed the
+    kernel fell behind the plan: 505x the jerk limit on the free-form slab's raster; then
+    one cycle a period held such a cut to 90 mm/s at 1 ms.)"""
     part, prog = _corner()
     m = Machine(0.001, (1000.0,) * 3, (20_000.0,) * 3, (400_000.0,) * 3, "fast")
-    stream = stream_program(prog, m, stepper_factory(part), feed=40_000.0)
+    made = []
+    factory = stepper_factory(part)
+
+    def steppers(k, segment, period):
+        made.append(factory(k, segment, period))
+        return made[-1]
+
+    stream = stream_program(prog, m, steppers, feed=40_000.0)
     assert (_shares(stream.positions, m) <= 1.0 + SLACK).all()
+    (piece,) = [p for p in stream.plan.pieces if p.cut is not None]
+    assert piece.substeps > 1
     cut = stream.positions[stream.rows == 2]
     steps = np.linalg.norm(np.diff(cut, axis=0), axis=1)
-    assert steps.max() <= prog.job.step * (1.0 + 1e-9)
-    assert steps.max() > 0.5 * prog.job.step   # the cap binds: the feed asked for more
+    assert steps.max() > 1.5 * prog.job.step   # a period goes further than one cycle may
+    assert steps.max() <= piece.substeps * prog.job.step * (1.0 + 1e-9)
+    # the kernel's cycles: none shortened by its accuracy rule, on average no longer
+    # than the program's step
+    (stepper,) = made
+    assert stepper.accuracy_cycles == 0
+    assert stepper.cycles >= piece.length / prog.job.step
+    assert stepper.cycles >= piece.substeps * (len(cut) - 2)
 
 
 def test_a_straight_cut_is_not_held_to_its_programs_step():
     """The pencil's straight cut (curvature 1e-12 /mm) at 40 000 mm/min: a step of any
     length lands on the path, so its periods may step further than the program did
     (the L-bracket's straight pencil on the high-speed mill: 1.21 s, 1.76 s when every cut
-    was held to its program's step); the curved corner's cut is held to 0.9 of it."""
+    was held to its program's step); each cycle of the curved corner's cut is held to 0.9
+    of it."""
     fast = Machine(0.001, (1000.0,) * 3, (20_000.0,) * 3, (400_000.0,) * 3, "fast")
     (straight,) = [p for p in pieces_of(_pencil()[1], fast, 40_000.0) if p.cut is not None]
     (curved,) = [p for p in pieces_of(_corner()[1], fast, 40_000.0) if p.cut is not None]
     assert straight.step_cap is None or straight.step_cap.min() > 1000.0   # mm/s: not held
-    assert curved.step_cap.max() == pytest.approx(0.9 * 0.1 / fast.period)
+    assert curved.substeps > 1   # the period's cycles each held to 0.9 of it
+    assert curved.step_cap.max() == pytest.approx(curved.substeps * 0.9 * 0.1 / fast.period)
