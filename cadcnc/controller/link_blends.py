@@ -3,7 +3,7 @@
 
 A blend lets the machine pass a link's corner without stopping, but at the speed the
 curve's curvature allows, and the planner holds that speed a little before and after it
-(:mod:`.feed_plan`, the speed limits eroded over the averaging window). On a slow machine
+(:mod:`.run_plan`, the speed limits eroded over the averaging window). On a slow machine
 a small blend can so cost more than the stop it replaces. Each link is therefore planned
 on its own both ways, from rest to rest, and rounded only when that is faster: a blend
 never lengthens a link's plan. Cuts and the corners where a link meets a cut are never

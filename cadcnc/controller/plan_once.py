@@ -1,7 +1,7 @@
 """One plan of one run (compiled): the erosion, the path's derivative boxes, the
 phase-plane passes, the time law and the window each knot needs, in one call.
 
-:func:`plan_once` is what :mod:`.feed_plan` repeats while it searches a run's window and
+:func:`plan_once` is what :mod:`.run_plan` repeats while it searches a run's window and
 Coriolis share; done in one compiled call it has no temporaries and no interpreter cost per
 step, and computes exactly what the same steps in NumPy would. :func:`speed_limits` is the
 run's squared speed limit before erosion. Arrays: ``s`` (n,) mm, ``T``, ``K``, ``D``,

@@ -61,6 +61,7 @@ def test_finish_loads_neither_the_other_operations_nor_the_feed_planner(tmp_path
             f"'--radius', '3', '--stepover', '8', '-q', '-o', {str(out)!r}]); "
             "print(code, sorted(m for m in sys.modules if m.startswith(("
             "'cadcnc.ops.pencil', 'cadcnc.ops.path.pair_program', 'cadcnc.controller.feed_plan', "
+            "'cadcnc.controller.run_plan', "
             "'cadcnc.controller.stream', 'cadcnc.pipeline.streaming', "
             "'cadcnc.pipeline.setup_programs'))))")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,

@@ -71,8 +71,8 @@ def test_a_straight_move_is_within_2_percent_of_ruckig(L):
     from ruckig import InputParameter, Result, Ruckig, Trajectory
 
     from cadcnc.controller import Machine
-    from cadcnc.controller.feed_plan import MARGIN, plan_run
     from cadcnc.controller.pieces import Piece
+    from cadcnc.controller.run_plan import MARGIN, plan_run
     from cadcnc.controller.runs import runs_of
 
     v, a, j = 57.15, 381.0, 7620.0

@@ -142,8 +142,9 @@ def test_a_repeated_run_is_planned_once_as_it_would_be_alone():
     """Three straight moves meeting at right angles (three runs), the first and last
     the same move: planned once, shared, and equal to each run planned on its own."""
     from cadcnc.controller import Machine
-    from cadcnc.controller.feed_plan import plan_feed, plan_run
+    from cadcnc.controller.feed_plan import plan_feed
     from cadcnc.controller.pieces import Piece
+    from cadcnc.controller.run_plan import plan_run
 
     corners = np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 0.0, 5.0],
                         [20.0, 0.0, 5.0]])
@@ -163,8 +164,9 @@ def test_runs_equal_but_for_round_off_share_a_plan_and_others_do_not():
     """The same R 9 quarter arc at two places (its tangents then differ by round-off)
     shares one plan, within 1e-9 of the second's own; the arc at R 9.001 has its own."""
     from cadcnc.controller import Machine
-    from cadcnc.controller.feed_plan import plan_feed, plan_run
+    from cadcnc.controller.feed_plan import plan_feed
     from cadcnc.controller.pieces import Piece
+    from cadcnc.controller.run_plan import plan_run
 
     def arc(radius: float, at) -> np.ndarray:
         phi = np.linspace(0.0, 0.5 * np.pi, 60)

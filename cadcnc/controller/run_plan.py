@@ -1,0 +1,325 @@
+"""One run's feed, planned near time-optimally to the axes' velocity,
+acceleration and jerk limits.
+
+The path p(s) is fixed; the plan chooses only s(t). Per axis i, with T = p', K = p'',
+D = p''' (in arc length, from the kernel's points):
+
+- velocity      |T_i v|                                  <= V_i
+- acceleration  |T_i s'' + K_i v^2|                      <= A_i
+- jerk          |T_i s''' + 3 K_i v s'' + D_i v^3|        <= J_i
+
+each used where it binds, at MARGIN of the limit. A run (:mod:`.runs`) is moved through
+from rest to rest:
+
+1. the speed limits: the feed, V_i / |T_i|, the jerk's D_i v^3 term (D_SHARE of J_i), and
+   the one-period jolt of a curvature jump or a join (``runs.JOIN_SHARE``);
+2. the time-optimal profile under the acceleration limits (:func:`.topp.passes`), with
+   the jerk's Coriolis term 3 K_i v s'' within CORIOLIS_SHARE of J_i;
+3. that s(t) averaged over a moving window W: its jerk T_i (s''(t) - s''(t - W)) / W,
+   W the shortest that leaves every axis the room the curvature terms do not take
+   (:func:`.topp.window_needed`; about A / J on a straight run, once per rest);
+4. the speed limits eroded (each held over +-v W) and the derivatives taken over the
+   window's reach, so that the averaged motion keeps every limit where it is;
+5. on a run that bends, the averaged motion's jerk measured as it is
+   (:mod:`.averaged_jerk`) rather than bounded from the window's extremes: the run is
+   planned at BENT_SHARE of J for the Coriolis term, its window grown only as much as
+   the measured jerk asks (and, where it grew, its top speed also capped at CAP_FACTORS
+   of the plan's, the faster kept).
+
+The acceleration used is at most sqrt(V J) per axis, and (J² L)^(1/3) on a run of length
+L: with more, the window would cost more time than the acceleration saves, and a looser
+limit could lengthen the plan. Times
+s, lengths mm.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from ..core.errors import EXIT_GOUGE, CadcncError
+from . import averaged_jerk, plan_once, topp
+from .machine import Machine
+from .runs import JOIN_SHARE, Run
+
+MARGIN = 0.995
+"""Share of every limit the plan uses; the rest covers the path's derivatives between the
+kernel's points, the averaged squared speed (v² of the mean is at most the mean of v²)
+and the kernel's step landing within a few nm of the plan."""
+CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most where the window's bound judges the
+                        # jerk (larger shares only lengthened its window)
+D_SHARE = 0.25          # of J_i: D_i v^3 at most
+SHARE_STEP, SHARE_STEPS = 0.025, 3   # the Coriolis share searched per curved run
+BENT_SHARE = 0.65       # of J_i for 3 K_i v s'' on a run that bends (its jerk measured):
+                        # the arcs' durations fall up to about 0.65 and are flat beyond
+CAP_FACTORS = (0.95,)   # a bending run whose window grew: also its top speed capped at
+                        # these shares of its plan's
+WINDOW_GROWTH = 1.02    # a bending run's window lengthened by at least this factor a round
+WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window grown
+FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
+TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
+TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened this much
+
+
+class PlanError(CadcncError):
+    """No stream within the machine's limits: nothing is written (names the run or the
+    period and the limit; exit 5, as any stream over the limits)."""
+
+    exit_code = EXIT_GOUGE
+
+
+@dataclass
+class Profile:
+    """One run's planned motion s(t), t from 0 (at rest at s = 0) to ``duration`` (at
+    rest at s = L): the profile on ``t``, ``s``, ``v``, ``a`` (the interval k from t[k]
+    has acceleration a[k]) and ``S`` = its time integral, averaged over ``window`` s."""
+
+    t: np.ndarray
+    s: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    S: np.ndarray
+    window: float
+
+    @property
+    def length(self) -> float:
+        return float(self.s[-1])
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1]) + self.window
+
+    def position(self, tau: np.ndarray) -> np.ndarray:
+        """s (mm) at local times ``tau`` (s), clipped to [0, L]."""
+        tau = np.ascontiguousarray(tau, dtype=float)
+        out = np.empty(tau.shape)
+        _positions(self.t, self.s, self.v, self.a, self.S, self.window, tau.ravel(),
+                   out.ravel())
+        return out
+
+
+@njit(cache=True, error_model="numpy")
+def _positions(t, s, v, a, S, window: float, tau, out) -> None:
+    """Profile.position into ``out``: s(t) averaged over ``window`` (or s(t) if 0),
+    ``tau`` non-decreasing or not (sorted sweeps are linear)."""
+    if len(tau) and (tau[1:] >= tau[:-1]).all():
+        topp.averaged_sweep(t, s, v, a, S, window, tau, out)
+        return
+    for i in range(len(tau)):
+        out[i] = topp.averaged(t, s, v, a, S, window, tau[i], 0)
+
+
+def _limits(machine: Machine, derate=(1.0, 1.0, 1.0)):
+    """V, A, J used by the plan: MARGIN (times ``derate``) of each, the acceleration at
+    most sqrt(V J)."""
+    V = MARGIN * derate[0] * np.asarray(machine.max_velocity)
+    J = MARGIN * derate[2] * np.asarray(machine.max_jerk)
+    A = np.minimum(MARGIN * derate[1] * np.asarray(machine.max_acceleration), np.sqrt(V * J))
+    return V, A, J
+
+
+def _speed_limits(run: Run, V, J, period: float) -> np.ndarray:
+    """(n,) the squared speed limit at each grid point (before erosion)."""
+    return plan_once.speed_limits(run.cap, run.T, run.D, run.jump, V, J, period, D_SHARE,
+                                  JOIN_SHARE)
+
+
+def _plan_once(run: Run, wl: np.ndarray, V, A, J, period: float, window: float,
+               coriolis: float, reach=None):
+    """One plan of the run with averaging ``window`` and the Coriolis term's share
+    ``coriolis`` of J, the path's derivatives taken over ``reach`` ((lo, hi) (n,) arc
+    lengths around each point; None: +- the top speed times the window): t, w, u, v, a,
+    S and per knot the window needed (:func:`.plan_once.plan_once`)."""
+    lo, hi = (run.s, run.s) if reach is None else reach
+    return plan_once.plan_once(run.s, wl, run.T, run.K, run.D, run.jump, run.kink, A, J,
+                               period, window, coriolis, lo, hi, reach is not None)
+
+
+def _tightened(run: Run, wl, limits, period: float, window: float, coriolis: float, first):
+    """The plan again with the derivatives taken only where the averaged motion goes
+    (the first plan assumed the top speed everywhere); kept if its own ranges lie within
+    the ranges it assumed and its window suffices, else ``first`` (sound as it is)."""
+    V, A, J = limits
+    s = run.s
+    lo, hi = topp.ranges(first[0], s, first[3], first[4], first[5], window)
+    for _ in range(TIGHTEN_ROUNDS):
+        grow = TIGHTEN_SLACK * (hi - lo)
+        assumed = (lo - grow, hi + grow)
+        plan = _plan_once(run, wl, V, A, J, period, window, coriolis, assumed)
+        if float(np.max(plan[6], initial=0.0)) > window:
+            return first
+        lo2, hi2 = topp.ranges(plan[0], s, plan[3], plan[4], plan[5], window)
+        if (lo2 >= assumed[0]).all() and (hi2 <= assumed[1]).all():
+            return plan
+        lo, hi = np.minimum(lo, lo2), np.maximum(hi, hi2)
+    return first
+
+
+def _measured(run: Run, plan: tuple, window: float, J, period: float) -> float:
+    """The largest share of J that the plan averaged over ``window`` takes, measured on the
+    averaged motion itself (:func:`.averaged_jerk.peak_share`) on a run that bends (inf
+    on one that does not: there the curvature terms leave :func:`.topp.window_needed`
+    nothing to overestimate)."""
+    if not run.bends:
+        return math.inf
+    t, w, u, v, a, S, need = plan
+    return averaged_jerk.peak_share(t, run.s, v, a, S, window, run.s, run.T, run.K, run.D,
+                                    run.jump, run.kink, J, period)
+
+
+def _grew(run: Run, limits, plan: _Windowed) -> bool:
+    """Whether the plan's window is longer than the first one (beyond round-off)."""
+    return plan.window > _first_window(run, limits[1], limits[2]) * (1.0 + 1e-9)  # round-off
+
+
+def _first_window(run: Run, A, J) -> float:
+    """The first averaging window (s): the shortest A_i / J_i of the axes the run moves;
+    the plan lengthens it where the profile needs more."""
+    t = np.max(np.abs(run.T), axis=0)
+    return float(np.min(np.where(t > 0.0, A / J, np.inf)))
+
+
+@dataclass
+class _Windowed:
+    """A run's plan at one Coriolis share once its window suffices, before the derivatives
+    are tightened: ``plan`` as :func:`.plan_once.plan_once` returns it."""
+
+    coriolis: float
+    window: float
+    wl: np.ndarray
+    plan: tuple
+
+    @property
+    def duration(self) -> float:
+        return float(self.plan[0][-1]) + self.window
+
+
+def _windowed(run: Run, machine: Machine, limits, coriolis: float,
+              cap: float = math.inf) -> _Windowed:
+    """The run's plan with the Coriolis term's share ``coriolis`` (see the module doc), its
+    speed at most ``cap`` (mm/s): turns flattened, or the window grown, until the window is
+    long enough."""
+    V, A, J = limits
+    wl = np.minimum(_speed_limits(run, V, J, machine.period), cap * cap)
+    window = _first_window(run, A, J)
+    flattening, last = True, math.inf
+    for round_ in range(WINDOW_ROUNDS):
+        plan = _plan_once(run, wl, V, A, J, machine.period, window, coriolis)
+        t, w, u, v, a, S, need = plan
+        top = float(np.max(need, initial=0.0))
+        if top <= window:
+            return _Windowed(coriolis, window, wl, plan)
+        flattening = flattening and round_ < FLATTEN_ROUNDS and top < last   # progress
+        last = top
+        # the motion measured as it comes, and once the flattening stops: not between
+        early = round_ == 0 or not flattening
+        measured = _measured(run, plan, window, J, machine.period) if early else math.inf
+        if measured <= 1.0:
+            return _Windowed(coriolis, window, wl, plan)
+        if flattening and topp.flatten(run.s, t, w, u, wl, need, window):
+            continue
+        if not early:   # nothing left to flatten: measured now
+            measured = _measured(run, plan, window, J, machine.period)
+            if measured <= 1.0:
+                return _Windowed(coriolis, window, wl, plan)
+        if not math.isfinite(top):
+            raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: the "
+                            "curvature leaves no jerk for the feed to change (limits "
+                            f"{machine.summary()})")
+        # where the motion is measured (a run that bends), the window grows as much as the
+        # measured jerk asks (the tangential part goes as 1 / window), the bound at most
+        window = min(top, window * max(measured, WINDOW_GROWTH)) if math.isfinite(
+            measured) else top
+    raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: no "
+                    f"averaging window keeps the jerk within {machine.summary()}")
+
+
+def _profile(run: Run, machine: Machine, limits, chosen: _Windowed) -> Profile:
+    """The chosen plan with, on a curved run, the derivatives taken only where the motion
+    goes (a straight run's are the same everywhere), as a profile."""
+    plan = chosen.plan
+    if run.curved and not run.bends:   # a bending run's jerk is measured as it is
+        plan = _tightened(run, chosen.wl, limits, machine.period, chosen.window,
+                          chosen.coriolis, plan)
+    t, w, u, v, a, S, need = plan
+    keep = np.r_[np.diff(run.s) > 0.0, True]
+    return Profile(t[keep], run.s[keep], v[keep], a[keep], S[keep], chosen.window)
+
+
+def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
+    """The jerk-limited, near time-optimal profile of one run (see the module doc);
+    ``derate`` (3,) scales the velocity, acceleration and jerk used."""
+    V, A, J = _limits(machine, derate)
+    # a short run: the acceleration a jerk ramp up and down over its length reaches
+    A = np.minimum(A, np.cbrt(J * J * run.length))
+    plan = _best_share(run, machine, (V, A, J))
+    even = _even_ratio(run, A, J)
+    if even is None:
+        return plan
+    other = _best_share(run, machine, (V, even, J))
+    return other if other.duration < plan.duration else plan
+
+
+def _best_share(run: Run, machine: Machine, limits) -> Profile:
+    """The run planned at CORIOLIS_SHARE; where the curvature terms lengthened its window
+    past the first one, the share moved by SHARE_STEP while that shortens the run (a larger
+    share lets the feed change faster on a curve but asks for a longer window). The shares
+    are compared before the derivatives are tightened, and only the chosen one is. A run
+    that bends is planned by :func:`_capped` instead (its jerk measured), this way only
+    where no window serves BENT_SHARE."""
+    if run.bends:
+        try:
+            return _profile(run, machine, limits, _capped(run, machine, limits))
+        except PlanError:   # no window for that share: the usual one
+            pass
+    first = _windowed(run, machine, limits, CORIOLIS_SHARE)
+    if not _grew(run, limits, first):
+        return _profile(run, machine, limits, first)
+    for step, steps in ((-SHARE_STEP, SHARE_STEPS), (SHARE_STEP, SHARE_STEPS)):
+        best, share = first, CORIOLIS_SHARE
+        for _ in range(steps):
+            share += step
+            try:
+                other = _windowed(run, machine, limits, share)
+            except PlanError:   # no window for that share: the search ends there
+                break
+            if other.duration >= best.duration:
+                break
+            best = other
+        if best is not first:
+            return _profile(run, machine, limits, best)
+    return _profile(run, machine, limits, first)
+
+
+def _capped(run: Run, machine: Machine, limits) -> _Windowed:
+    """A bending run at BENT_SHARE; where its window had to grow, also with its top speed
+    capped at each of CAP_FACTORS of the plan's (a slower top asks for less window), the
+    fastest kept: a looser limit that lets the feed higher never lengthens the run more
+    than these caps can give back."""
+    best = _windowed(run, machine, limits, BENT_SHARE)
+    if not _grew(run, limits, best):
+        return best
+    top = float(np.max(best.plan[3]))
+    for factor in CAP_FACTORS:
+        try:
+            other = _windowed(run, machine, limits, BENT_SHARE, factor * top)
+        except PlanError:
+            continue
+        if other.duration < best.duration:
+            best = other
+    return best
+
+
+def _even_ratio(run: Run, A: np.ndarray, J: np.ndarray) -> np.ndarray | None:
+    """(3,) the accelerations with no moving axis asking for a longer jerk ramp than the
+    quickest one (A_i <= J_i min_k A_k / J_k), or None where they already do. The window
+    serves every axis at once, so an axis with more acceleration than that lengthens it:
+    planned both ways, the faster kept, a looser acceleration limit never slows a run."""
+    moving = np.max(np.abs(run.T), axis=0) > 0.0
+    if not moving.any():
+        return None
+    even = np.minimum(A, J * float(np.min((A / J)[moving])))
+    return None if np.array_equal(even[moving], A[moving]) else even
