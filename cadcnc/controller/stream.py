@@ -280,12 +280,12 @@ class _CutRows:
 
     def __call__(self, s: np.ndarray) -> np.ndarray:
         piece, m = self.piece, self.piece.substeps
-        cycles = s if m == 1 else substep_lengths(s, self.before, m)
-        plan = follow_plan(piece, cycles, self.before, self.travelled)
+        plan = follow_plan(piece, substep_lengths(s, self.before, m), self.before,
+                           self.travelled)
         out = follow(self.stepper, plan, piece.points[-1], float(piece.kappa[-1]), LANDING)
         if len(s):
             self.before, self.travelled = float(s[-1]), float(plan[-1, 0])
-        return out if m == 1 else out[m - 1::m]
+        return out[m - 1::m]
 
     def close(self) -> None:
         _landed(self.stepper, self.piece, self.what)
