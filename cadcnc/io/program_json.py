@@ -156,8 +156,12 @@ def json_pieces(program: Program, setup: Setup | None, jobs: int) -> tuple[str, 
 
 
 def join_pieces(head: str, tail: str, texts: list[str]) -> str:
-    """The JSON of :func:`json_pieces`' runs, their texts in order."""
-    return head + "[" + ",".join(texts) + "]" + tail
+    """The JSON of :func:`json_pieces`' runs, their texts in order (one copy of the
+    text: a finishing program's JSON is tens of MB)."""
+    parts = [head, "["]
+    for k, text in enumerate(texts):
+        parts += [",", text] if k else [text]
+    return "".join(parts + ["]", tail])
 
 
 _SEPARATORS = (",", ":")
