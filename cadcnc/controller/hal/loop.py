@@ -154,7 +154,7 @@ def run_hal_loop(stream: Any, machine: Any, *, limits: str = "machine",
             with open(out_path, "wb") as out, open(work / "halsampler.log", "wb") as log:
                 reader = session.spawn(["halsampler", "-c", "0", "-t", "-n", str(total)],
                                        stdout=out, stderr=log)
-            session.halcmd("sets", "cadcnc-run", "TRUE")
+            session.halcmd("sets", "cadcnc-start", "TRUE")
             started = time.monotonic()
             if on_started is not None:
                 on_started()
