@@ -208,8 +208,9 @@ def _negative_points_joined(argv: list[str]) -> list[str]:
 
 def main(argv: list[str] | None = None, ending: bool = False) -> int:
     """Parse ``argv`` and run its command; its exit code. ``ending``: this process ends
-    when the command does (the console program): what the imports made is then kept out
-    of the garbage collector's walks (it lives to the end anyway)."""
+    when the command does (the console program): what the imports make is then kept out
+    of the garbage collector's walks, while they run and after (it lives to the end
+    anyway)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(_negative_points_joined(argv))
     debug = getattr(args, "debug", False)
@@ -220,9 +221,14 @@ def main(argv: list[str] | None = None, ending: bool = False) -> int:
         with sigint_deferred():
             if getattr(args, "processes", 1) != 1:   # its imports run beside ours
                 pool.start(args.processes)
-            run = handler(args.command)   # the library imported now (commands.py)
-            if ending:
-                gc.freeze()
+            if ending:   # no collection meanwhile: what the imports make stays (0.1 s)
+                gc.disable()
+            try:
+                run = handler(args.command)   # the library imported now (commands.py)
+            finally:
+                if ending:
+                    gc.freeze()
+                    gc.enable()
         return int(run(args) or 0)
     except KeyboardInterrupt:
         print("cadcnc: interrupted", file=sys.stderr)

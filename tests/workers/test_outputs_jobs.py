@@ -100,3 +100,41 @@ def test_an_output_failing_ahead_of_the_verdict_does_not_pre_empt_it(tmp_path, m
         done = operate(step, job, "pencil", two, outputs=outs)
     assert done.verdict.write and done.contents is None
     assert set(rendered(done, outs, done.what, two)) == set(outs)
+
+
+def test_the_json_made_a_segment_at_a_time_is_the_whole_programs_text(programs):
+    """One process makes the segments' text one at a time, the collector held off: the
+    same bytes as the whole program made into Python objects and dumped at once, and the
+    collector's state left as it was."""
+    import gc
+
+    from cadcnc.io.program_json import program_json, program_to_dict
+
+    part, program = programs[None]
+    whole = json.dumps(program_to_dict(program), separators=(",", ":")) + "\n"
+    assert gc.isenabled()
+    assert program_json(program) == whole
+    assert gc.isenabled()
+    gc.disable()
+    try:
+        assert program_json(program) == whole
+        assert not gc.isenabled()
+    finally:
+        gc.enable()
+
+
+def test_the_console_program_freezes_its_imports_and_collects_after(tmp_path):
+    """The console program (``ending``): no collection while the library is imported,
+    what it made frozen, the collector on again for the command."""
+    import subprocess
+    import sys
+
+    code = ("import gc, sys\n"
+            "from cadcnc.cli.app import main\n"
+            "seen = []\n"
+            "gc.callbacks.append(lambda phase, info: seen.append(info['generation']))\n"
+            f"code = main(['faces', {str(FIXTURES / 'step_block.step')!r}], ending=True)\n"
+            "print(code, gc.isenabled(), gc.get_freeze_count() > 10000, file=sys.stderr)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert out.stderr.strip().splitlines()[-1] == "0 True True", out.stderr
