@@ -62,6 +62,8 @@ WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window
 FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
 TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
 TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened this much
+NEED_ROUNDOFF = 1e-7    # a window the plan needs to within this share of itself suffices
+                        # (round-off; MARGIN covers it): no round of flattening for it
 
 
 class PlanError(CadcncError):
@@ -210,7 +212,7 @@ def _windowed(run: Run, machine: Machine, limits, coriolis: float,
         plan = _plan_once(run, wl, V, A, J, machine.period, window, coriolis)
         t, w, u, v, a, S, need = plan
         top = float(np.max(need, initial=0.0))
-        if top <= window:
+        if top <= window * (1.0 + NEED_ROUNDOFF):
             return _Windowed(coriolis, window, wl, plan)
         flattening = flattening and round_ < FLATTEN_ROUNDS and top < last   # progress
         last = top
