@@ -19,6 +19,11 @@ every timing):
 ``--long``: one stream of about 1e6 periods (the corner at a crawl): its time per period
 and its peak memory per period, then the same for its gate (what ``cadcnc stream`` checks
 before writing).
+
+``--hsm``: the high-speed mill (``compare.high_speed_mill``, 1 ms) at 1 500, 10 000 and
+40 000 mm/min, where a cut may take m kernel cycles a period: ``stream`` per period,
+``m`` the kernel's cycles per period over the whole stream, and ``on top`` = stream - m
+step (the stream's own planning and streaming beside its kernel cycles).
 """
 
 from __future__ import annotations
@@ -175,7 +180,38 @@ def main() -> None:
                   f"{1e6 * py_s / py_n:>8.2f}")
 
 
+def kernel_cycles(program, machine, feed) -> tuple[int, int]:
+    """(periods, kernel cycles) of the stream: each cut's periods times its substeps."""
+    plan = plan_feed(pieces_of(program, machine, feed), machine)
+    rows, _ = plan.targets()
+    cycles = sum(int((rows == j).sum()) * piece.substeps
+                 for j, piece in enumerate(plan.pieces) if piece.cut is not None)
+    return len(rows), cycles
+
+
+def fast_machine() -> None:
+    """The stream's cost per period on the high-speed mill (``--hsm``, module doc)."""
+    from benchmarks.controller.compare import high_speed_mill
+
+    machine = high_speed_mill()
+    print(f"machine: {machine.summary()}")
+    print(f"{'program':<26} {'feed':>6} {'periods':>8} {'m':>5} {'stream':>7} {'step':>6} "
+          f"{'on top':>7}   (us per period; step per cycle)")
+    for name, part, program in programs():
+        factory = stepper_factory(part)
+        stream_program(program, machine, factory)   # warm the compiled code
+        for feed in (1500.0, 10_000.0, 40_000.0):
+            n = stream_program(program, machine, factory, feed=feed).periods
+            w = min(whole(program, factory, machine, feed) for _ in range(RUNS))
+            step_s, step_n = min(bare_steps(program, factory, machine) for _ in range(RUNS))
+            periods, cycles = kernel_cycles(program, machine, feed)
+            stream_us, step_us, m = 1e6 * w / n, 1e6 * step_s / step_n, cycles / periods
+            print(f"{name:<26} {feed:>6g} {n:>8} {m:>5.2f} {stream_us:>7.2f} {step_us:>6.2f} "
+                  f"{stream_us - m * step_us:>7.2f}")
+
+
 if __name__ == "__main__":
     import sys
 
-    long_stream() if "--long" in sys.argv else main()
+    long_stream() if "--long" in sys.argv else fast_machine() if "--hsm" in sys.argv \
+        else main()
