@@ -63,7 +63,8 @@ FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
 TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
 TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened this much
 NEED_ROUNDOFF = 1e-7    # a window the plan needs to within this share of itself suffices
-                        # (round-off; MARGIN covers it): no round of flattening for it
+                        # (round-off; MARGIN covers it), and flattening that shortens the
+                        # need by less is no progress: no plan made again for round-off
 
 
 class PlanError(CadcncError):
@@ -214,7 +215,8 @@ def _windowed(run: Run, machine: Machine, limits, coriolis: float,
         top = float(np.max(need, initial=0.0))
         if top <= window * (1.0 + NEED_ROUNDOFF):
             return _Windowed(coriolis, window, wl, plan)
-        flattening = flattening and round_ < FLATTEN_ROUNDS and top < last   # progress
+        flattening = flattening and round_ < FLATTEN_ROUNDS and \
+            top < last * (1.0 - NEED_ROUNDOFF)   # progress beyond round-off
         last = top
         # the motion measured as it comes, and once the flattening stops: not between
         early = round_ == 0 or not flattening
