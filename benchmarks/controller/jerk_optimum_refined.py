@@ -162,7 +162,7 @@ def solve(P, x0, maxiter=300):
     return r
 
 
-def run_stretch(group, machine: Machine, ncoef0=32, levels=3, per=8, log=print):
+def run_stretch(group, machine: Machine, ncoef0=32, levels=3, per=8, log=print) -> list:
     knots = uniform_knots(ncoef0)
     res: list[dict] = []
     x = kold = cold = None
@@ -194,7 +194,7 @@ def run_stretch(group, machine: Machine, ncoef0=32, levels=3, per=8, log=print):
         x = xr.copy(); x[0] = tv
         kold, cold = knots, P.coef(x)
         knots = halve(knots)
-    return res, (kold, cold, x[0])
+    return res
 
 
 def straight_time(L: float, V: float, A: float, J: float) -> float:
@@ -236,7 +236,7 @@ def main() -> None:
         for k, group in enumerate(stretches(program, FEED)):
             bound = stretch_time(group, machine)
             print(f"stretch {k}: bound {bound:.4f} s", flush=True)
-            levels, _ = run_stretch(group, machine, levels=args.levels,
+            levels = run_stretch(group, machine, levels=args.levels,
                                     log=lambda m: print(m, flush=True))
             best = min(r["T_valid"] for r in levels)
             exact = exact_if_straight(group, machine)

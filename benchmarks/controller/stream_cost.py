@@ -155,14 +155,23 @@ def long_stream(periods: int = 1_000_000) -> None:
           f"({peak / n:.0f} bytes per period)")
 
 
-def main() -> None:
-    machine = Machine.default()
+def warmed(machine: Machine, columns: str):
+    """Print the machine and the table's header; yield (name, program, stepper factory)
+    of every program, its compiled code warmed by one stream."""
     print(f"machine: {machine.summary()}")
-    print(f"{'program':<26} {'feed':>6} {'periods':>8} {'plan':>6} {'drive':>6} {'step':>6} "
-          f"{'on top':>7} {'ratio':>6} {'stream':>7} {'py step':>8}   (us per period)")
+    print(columns)
     for name, part, program in programs():
         factory = stepper_factory(part)
-        stream_program(program, machine, factory)   # warm the compiled code
+        stream_program(program, machine, factory)
+        yield name, program, factory
+
+
+def main() -> None:
+    machine = Machine.default()
+    for name, program, factory in warmed(machine, (
+            f"{'program':<26} {'feed':>6} {'periods':>8} {'plan':>6} {'drive':>6} "
+            f"{'step':>6} {'on top':>7} {'ratio':>6} {'stream':>7} {'py step':>8}   "
+            "(us per period)")):
         for feed in (None, 10_000.0):
             n = stream_program(program, machine, factory, feed=feed).periods
             plan = best(lambda: sum(len(s) for _, _, s in plan_feed(
@@ -194,12 +203,9 @@ def fast_machine() -> None:
     from benchmarks.controller.compare import high_speed_mill
 
     machine = high_speed_mill()
-    print(f"machine: {machine.summary()}")
-    print(f"{'program':<26} {'feed':>6} {'periods':>8} {'m':>5} {'stream':>7} {'step':>6} "
-          f"{'on top':>7}   (us per period; step per cycle)")
-    for name, part, program in programs():
-        factory = stepper_factory(part)
-        stream_program(program, machine, factory)   # warm the compiled code
+    for name, program, factory in warmed(machine, (
+            f"{'program':<26} {'feed':>6} {'periods':>8} {'m':>5} {'stream':>7} {'step':>6} "
+            f"{'on top':>7}   (us per period; step per cycle)")):
         for feed in (1500.0, 10_000.0, 40_000.0):
             n = stream_program(program, machine, factory, feed=feed).periods
             w = min(whole(program, factory, machine, feed) for _ in range(RUNS))
