@@ -1,6 +1,6 @@
 """Planning + stream cost per servo period, as a ratio to the bare step (same process).
 
-    .venv/bin/python benchmarks/controller/stream_cost.py [--long]
+    python -m benchmarks.controller.stream_cost [--long | --hsm]
 
 Per program and feed, µs per period (best of 5, interleaved; steppers built outside
 every timing):

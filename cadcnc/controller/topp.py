@@ -67,21 +67,49 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
 @njit(cache=True, error_model="numpy")
 def erode(s, wl, window: float):
     """Each limit w_k applied over s_k +- sqrt(w_k) window: a motion averaged over
-    ``window`` s whose every speed kept the limits is then within them where it is."""
+    ``window`` s whose every speed kept the limits is then within them where it is.
+    ``s`` non-decreasing: each reach is an index range found by bisection, and the ranges'
+    minima are kept in a segment tree (O(n log n) however far a limit reaches)."""
     n = len(s)
     out = wl.copy()
+    tree = np.full(2 * n, np.inf)   # tree[n + j]: leaf j; a node's tag covers its leaves
     for k in range(n):
         r = math.sqrt(wl[k]) * window
         if not math.isfinite(r):
             continue
-        j = k - 1
-        while j >= 0 and s[k] - s[j] <= r:
-            out[j] = min(out[j], wl[k])
-            j -= 1
-        j = k + 1
-        while j < n and s[j] - s[k] <= r:
-            out[j] = min(out[j], wl[k])
-            j += 1
+        lo, hi = 0, k   # the first j <= k with s[k] - s[j] <= r
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if s[k] - s[mid] <= r:
+                hi = mid
+            else:
+                lo = mid + 1
+        first = lo
+        lo, hi = k, n - 1   # the last j >= k with s[j] - s[k] <= r
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            if s[mid] - s[k] <= r:
+                lo = mid
+            else:
+                hi = mid - 1
+        a, b = first + n, lo + n + 1
+        while a < b:
+            if a & 1:
+                tree[a] = min(tree[a], wl[k])
+                a += 1
+            if b & 1:
+                b -= 1
+                tree[b] = min(tree[b], wl[k])
+            a >>= 1
+            b >>= 1
+    for j in range(n):
+        x = np.inf
+        node = j + n
+        while node >= 1:
+            x = min(x, tree[node])
+            node >>= 1
+        if x < np.inf:
+            out[j] = min(out[j], x)
     return out
 
 
@@ -219,18 +247,43 @@ def window_needed(t, v, a, Tabs, Kmax, static, J, C, window: float):
     within J in the windows ending on knot k once the profile (t, v, a) is averaged over
     ``window``: the tangential part |T_i| (a(t) - a(t - W)) / W takes what the curvature
     terms leave, the Coriolis term 3 K v a and ``static`` (n, 3), D v³ and a join's or a
-    curvature jump's one-period jolt at the speed limits (inf: no room)."""
+    curvature jump's one-period jolt at the speed limits (inf: no room). The extremes of
+    a and v over knots lo..k come from sliding-window queues (O(n))."""
     n = len(t)
     need = np.zeros(n - 1)
+    qlo = np.empty(n, dtype=np.int64)   # knots with rising a (the window's minimum first)
+    qhi = np.empty(n, dtype=np.int64)   # knots with falling a (its maximum first)
+    qv = np.empty(n, dtype=np.int64)    # grid points with falling v
+    h1 = t1 = h2 = t2 = h3 = t3 = 0
     lo = 0
     for k in range(n - 1):   # the windows ending on knot k: knots lo..k
         while t[lo + 1] <= t[k] - window:
             lo += 1
+        while t1 > h1 and a[qlo[t1 - 1]] >= a[k]:
+            t1 -= 1
+        qlo[t1] = k
+        t1 += 1
+        while t2 > h2 and a[qhi[t2 - 1]] <= a[k]:
+            t2 -= 1
+        qhi[t2] = k
+        t2 += 1
+        while t3 > h3 and v[qv[t3 - 1]] <= v[k]:
+            t3 -= 1
+        qv[t3] = k
+        t3 += 1
+        while h1 < t1 and qlo[h1] < lo:
+            h1 += 1
+        while h2 < t2 and qhi[h2] < lo:
+            h2 += 1
+        while h3 < t3 and qv[h3] < lo:
+            h3 += 1
         amin, amax, vmax = a[k], a[k], max(v[k], v[k + 1])
-        for j in range(lo, k):
-            amin = min(amin, a[j])
-            amax = max(amax, a[j])
-            vmax = max(vmax, v[j])
+        if h1 < t1:
+            amin = min(amin, a[qlo[h1]])
+        if h2 < t2:
+            amax = max(amax, a[qhi[h2]])
+        if h3 < t3:
+            vmax = max(vmax, v[qv[h3]])
         da = amax - amin
         if da <= 0.0:
             continue
