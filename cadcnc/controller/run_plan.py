@@ -23,8 +23,9 @@ from rest to rest:
 5. on a run that bends, the averaged motion's jerk measured as it is
    (:mod:`.averaged_jerk`) rather than bounded from the window's extremes: the run is
    planned at BENT_SHARE of J for the Coriolis term, its window grown only as much as
-   the measured jerk asks (and, where it grew, its top speed also capped at CAP_FACTORS
-   of the plan's, the faster kept).
+   the measured jerk asks (from the second growth on, where the secant of the measured
+   share through the last two windows reaches 1: :func:`_secant`; and, where it grew,
+   its top speed also capped at CAP_FACTORS of the plan's, the faster kept).
 
 The acceleration used is at most sqrt(V J) per axis, and (J² L)^(1/3) on a run of length
 L: with more, the window would cost more time than the acceleration saves, and a looser
@@ -58,6 +59,8 @@ BENT_SHARE = 0.65       # of J_i for 3 K_i v s'' on a run that bends (its jerk m
 CAP_FACTORS = (0.95,)   # a bending run whose window grew: also its top speed capped at
                         # these shares of its plan's
 WINDOW_GROWTH = 1.02    # a bending run's window lengthened by at least this factor a round
+SECANT_OVER = 1.0005   # a window grown by the secant: this much past where it predicts 1
+SECANT_GROWTH = 1.002  # and at least this much longer than the last
 WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window grown
 FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
 TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
@@ -209,6 +212,7 @@ def _windowed(run: Run, machine: Machine, limits, coriolis: float,
     wl = np.minimum(_speed_limits(run, V, J, machine.period), cap * cap)
     window = _first_window(run, A, J)
     flattening, last = True, math.inf
+    grown = None   # (window, measured) of the last window grown from
     for round_ in range(WINDOW_ROUNDS):
         plan = _plan_once(run, wl, V, A, J, machine.period, window, coriolis)
         t, w, u, v, a, S, need = plan
@@ -235,10 +239,28 @@ def _windowed(run: Run, machine: Machine, limits, coriolis: float,
                             f"{machine.summary()})")
         # where the motion is measured (a run that bends), the window grows as much as the
         # measured jerk asks (the tangential part goes as 1 / window), the bound at most
-        window = min(top, window * max(measured, WINDOW_GROWTH)) if math.isfinite(
-            measured) else top
+        if not math.isfinite(measured):
+            window = top
+            continue
+        step = _secant(grown, window, measured)
+        grown = (window, measured)
+        window = min(top, window * max(measured, WINDOW_GROWTH) if step is None else step)
     raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: no "
                     f"averaging window keeps the jerk within {machine.summary()}")
+
+
+def _secant(before, window: float, measured: float) -> float | None:
+    """The window at which the measured share would reach 1, taking it as c + d / W
+    through the last two windows measured (the tangential part goes as 1 / W, the
+    curvature terms stay), a little beyond; None without two such windows or where the
+    line does not reach 1 beyond ``window``."""
+    if before is None or not before[0] < window or not before[1] > measured:
+        return None
+    d = (before[1] - measured) / (1.0 / before[0] - 1.0 / window)
+    c = measured - d / window
+    if not (d > 0.0 and c < 1.0):
+        return None
+    return max(d / (1.0 - c) * SECANT_OVER, window * SECANT_GROWTH)
 
 
 def _profile(run: Run, machine: Machine, limits, chosen: _Windowed) -> Profile:

@@ -1,8 +1,11 @@
 """A run's plan is not made again for round-off: a window that the plan needs to within
-1e-7 of itself is enough, and flattening that shortens the need by less is no progress
-(the planning cost per period on a fast machine, issue 35)."""
+1e-7 of itself is enough, and flattening that shortens the need by less is no progress;
+a bending run's window grows by the secant of its measured jerk (the planning cost per
+period on a fast machine, issue 35)."""
 
 from __future__ import annotations
+
+import pytest
 
 import cadcnc
 from cadcnc.controller import Machine, run_plan
@@ -41,10 +44,28 @@ def test_a_straight_cut_on_a_fast_machine_is_planned_in_few_rounds(monkeypatch):
 
 def test_a_bending_run_is_not_flattened_for_round_off(monkeypatch):
     """The finish's R 9 arcs on the fast machine: 133 plans before (16 rounds of
-    flattening a call that shortened the need by 2e-12 s each), about 45 now."""
+    flattening a call that shortened the need by 2e-12 s each), 43 with the window grown
+    by the measured share, 34 with its secant."""
     part = cadcnc.load_step(FIXTURES / "finish_fillet.step")
     program = finish(part, [6, 3], radius=3.0, stepover=10.0)
     calls = _counted(monkeypatch)
     plan = plan_feed(pieces_of(program, HSM, 10_000.0), HSM)
-    assert len(calls) <= 60, len(calls)
+    assert len(calls) <= 38, len(calls)
     assert 2.5 < plan.duration < 2.7
+
+
+def test_the_secant_lands_where_a_share_of_c_plus_d_over_w_reaches_one():
+    c, d = 0.4, 0.08   # the share measured at window W: c + d / W (reaches 1 at 0.1333 s)
+    share = lambda w: c + d / w   # noqa: E731
+    root = d / (1.0 - c)
+    got = run_plan._secant((0.1, share(0.1)), 0.12, share(0.12))
+    assert got == pytest.approx(root * run_plan.SECANT_OVER, rel=1e-12)
+    assert share(got) < 1.0 < share(0.12)
+    # no line to follow: the first window grown, a share that did not fall, or one whose
+    # curvature part alone is over 1 (c >= 1: no window serves)
+    assert run_plan._secant(None, 0.12, share(0.12)) is None
+    assert run_plan._secant((0.1, 1.1), 0.12, 1.2) is None
+    assert run_plan._secant((0.1, 1.5), 0.12, 1.45) is None   # c = 1.2
+    # nearly there: still at least SECANT_GROWTH longer than the last window
+    assert run_plan._secant((0.1, share(0.1)), 0.1333, share(0.1333)) == \
+        pytest.approx(0.1333 * run_plan.SECANT_GROWTH, rel=1e-12)
