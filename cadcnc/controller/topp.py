@@ -65,34 +65,57 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
 
 
 @njit(cache=True, error_model="numpy")
+def _reach(s, k: int, r: float, ordered: bool) -> tuple:
+    """(first, last): the run of grid points around k whose distance from s[k] is within
+    ``r``, stopping at the first one that is not (by bisection when ``ordered``)."""
+    n = len(s)
+    if not ordered:
+        first = k
+        while first > 0 and s[k] - s[first - 1] <= r:
+            first -= 1
+        last = k
+        while last < n - 1 and s[last + 1] - s[k] <= r:
+            last += 1
+        return first, last
+    lo, hi = 0, k   # the first j <= k with s[k] - s[j] <= r
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if s[k] - s[mid] <= r:
+            hi = mid
+        else:
+            lo = mid + 1
+    first = lo
+    lo, hi = k, n - 1   # the last j >= k with s[j] - s[k] <= r
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if s[mid] - s[k] <= r:
+            lo = mid
+        else:
+            hi = mid - 1
+    return first, lo
+
+
+@njit(cache=True, error_model="numpy")
 def erode(s, wl, window: float):
     """Each limit w_k applied over s_k +- sqrt(w_k) window: a motion averaged over
     ``window`` s whose every speed kept the limits is then within them where it is.
-    ``s`` non-decreasing: each reach is an index range found by bisection, and the ranges'
-    minima are kept in a segment tree (O(n log n) however far a limit reaches)."""
+    Each reach is the run of points from k within the distance (found by bisection where
+    ``s`` is non-decreasing, as a run's grid is, else walked), and the ranges' minima are
+    kept in a segment tree (O(n log n) however far a limit reaches)."""
     n = len(s)
     out = wl.copy()
     tree = np.full(2 * n, np.inf)   # tree[n + j]: leaf j; a node's tag covers its leaves
+    ordered = True
+    for k in range(n - 1):
+        if s[k + 1] < s[k]:
+            ordered = False
+            break
     for k in range(n):
         r = math.sqrt(wl[k]) * window
         if not math.isfinite(r):
             continue
-        lo, hi = 0, k   # the first j <= k with s[k] - s[j] <= r
-        while lo < hi:
-            mid = (lo + hi) // 2
-            if s[k] - s[mid] <= r:
-                hi = mid
-            else:
-                lo = mid + 1
-        first = lo
-        lo, hi = k, n - 1   # the last j >= k with s[j] - s[k] <= r
-        while lo < hi:
-            mid = (lo + hi + 1) // 2
-            if s[mid] - s[k] <= r:
-                lo = mid
-            else:
-                hi = mid - 1
-        a, b = first + n, lo + n + 1
+        first, last = _reach(s, k, r, ordered)
+        a, b = first + n, last + n + 1
         while a < b:
             if a & 1:
                 tree[a] = min(tree[a], wl[k])

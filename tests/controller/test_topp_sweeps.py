@@ -1,7 +1,8 @@
 """The phase plane's sliding computations against the plain loops they replace.
 
 :func:`cadcnc.controller.topp.erode` applies each speed limit over +- v W with a segment
-tree, and :func:`~cadcnc.controller.topp.window_needed` takes the extremes of the
+tree (its reach bisected on an ordered grid), and
+:func:`~cadcnc.controller.topp.window_needed` takes the extremes of the
 acceleration and the speed over each window from sliding queues. Both must give the very
 floats of the direct loops written here (every point's reach walked point by point; every
 window's knots scanned), on grids with repeated points (joins), limits that reach past
@@ -80,6 +81,9 @@ def test_erosion_equals_the_walked_reach(seed):
         want = _erode_walked(s, wl, window)
         assert np.array_equal(got, want), window
     assert (topp.erode(s, wl, 0.05) < wl).any()   # the limits did reach others
+    s[n // 2] = s[n // 2 + 5]   # out of order (no run's grid is): its reach walked
+    for window in (0.05, 0.5):
+        assert np.array_equal(topp.erode(s, wl, window), _erode_walked(s, wl, window))
 
 
 @pytest.mark.parametrize("seed", range(6))
