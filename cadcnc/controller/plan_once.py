@@ -15,7 +15,7 @@ import math
 import numpy as np
 from numba import njit
 
-from . import topp
+from . import reach, topp
 
 _BIG = np.finfo(np.float64).max   # what np.nan_to_num puts for an infinity
 
@@ -53,7 +53,7 @@ def plan_once(s, wl, T, K, D, jump, kink, A, J, period: float, window: float,
     point (``reach_given`` False: +- the top speed times the window): t, w, u, v, a, S and
     per knot the window needed (:func:`.topp.window_needed`)."""
     n = len(s)
-    wl_e = topp.erode(s, wl, window)
+    wl_e = reach.erode(s, wl, window)
     top2 = 0.0
     for k in range(n):
         if math.isfinite(wl_e[k]):
@@ -62,8 +62,8 @@ def plan_once(s, wl, T, K, D, jump, kink, A, J, period: float, window: float,
     if not reach_given:
         reach_lo = s - top * window
         reach_hi = s + top * window
-    t_lo, t_hi = topp.boxes(s, T, reach_lo, reach_hi)
-    k_lo, k_hi = topp.boxes(s, K, reach_lo, reach_hi)
+    t_lo, t_hi = reach.boxes(s, T, reach_lo, reach_hi)
+    k_lo, k_hi = reach.boxes(s, K, reach_lo, reach_hi)
     Tc, Tr = 0.5 * (t_lo + t_hi), 0.5 * (t_hi - t_lo)
     Kc, Kr = 0.5 * (k_lo + k_hi), 0.5 * (k_hi - k_lo)
     Kmax = np.maximum(np.abs(k_lo), np.abs(k_hi))
@@ -83,7 +83,7 @@ def plan_once(s, wl, T, K, D, jump, kink, A, J, period: float, window: float,
             elif x == -math.inf:
                 x = -_BIG
             static[k, i] = x
-    static = topp.boxes(s, static, reach_lo, reach_hi)[1]
+    static = reach.boxes(s, static, reach_lo, reach_hi)[1]
     Tabs = np.maximum(np.abs(t_lo), np.abs(t_hi))
     need = topp.window_needed(t, v, a, Tabs, Kmax, static, J, C, window)
     return t, w, u, v, a, S, need

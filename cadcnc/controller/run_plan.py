@@ -11,7 +11,8 @@ D = p''' (in arc length, from the kernel's points):
 each used where it binds, at MARGIN of the limit. A run (:mod:`.runs`) is moved through
 from rest to rest:
 
-1. the speed limits: the feed, V_i / |T_i|, the jerk's D_i v^3 term (D_SHARE of J_i), and
+1. the speed limits: the feed, V_i / |T_i|, the jerk's D_i v^3 term (D_SHARE of J_i;
+   where that term binds, the run is also planned at D_SHARE_HIGH, the faster kept), and
    the one-period jolt of a curvature jump or a join (``runs.JOIN_SHARE``);
 2. the time-optimal profile under the acceleration limits (:func:`.topp.passes`), with
    the jerk's Coriolis term 3 K_i v s'' within CORIOLIS_SHARE of J_i;
@@ -27,10 +28,11 @@ from rest to rest:
    share through the last two windows reaches 1: :func:`_secant`; and, where it grew,
    its top speed also capped at CAP_FACTORS of the plan's, the faster kept).
 
-The acceleration used is at most sqrt(V J) per axis, and (J² L)^(1/3) on a run of length
-L: with more, the window would cost more time than the acceleration saves, and a looser
-limit could lengthen the plan. Times
-s, lengths mm.
+A plan tried against another is given up as soon as one of its rounds lasts as long
+(:class:`_Slower`): its rounds only get longer. The acceleration used is at most
+sqrt(V J) per axis, and (J² L)^(1/3) on a run of length L: with more, the window would
+cost more time than the acceleration saves, and a looser limit could lengthen the plan.
+Times s, lengths mm.
 """
 
 from __future__ import annotations
@@ -53,6 +55,9 @@ and the kernel's step landing within a few nm of the plan."""
 CORIOLIS_SHARE = 0.25   # of J_i: 3 K_i v s'' at most where the window's bound judges the
                         # jerk (larger shares only lengthened its window)
 D_SHARE = 0.25          # of J_i: D_i v^3 at most
+D_SHARE_HIGH = 0.6      # ... or this much, on a run where that term binds the speed (a
+                        # path with a large p''' cruising: more speed, a longer window),
+                        # the faster kept
 SHARE_STEP, SHARE_STEPS = 0.025, 3   # the Coriolis share searched per curved run
 BENT_SHARE = 0.65       # of J_i for 3 K_i v s'' on a run that bends (its jerk measured):
                         # the arcs' durations fall up to about 0.65 and are flat beyond
@@ -68,6 +73,12 @@ TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened th
 NEED_ROUNDOFF = 1e-7    # a window the plan needs to within this share of itself suffices
                         # (round-off; MARGIN covers it), and flattening that shortens the
                         # need by less is no progress: no plan made again for round-off
+
+
+class _Slower(Exception):
+    """A plan given up once it can no longer beat the one it is to beat: each round of
+    :func:`_windowed` only lowers the speed limits or lengthens the window, so a round's
+    duration is a lower bound of the plan's."""
 
 
 class PlanError(CadcncError):
@@ -127,10 +138,17 @@ def _limits(machine: Machine, derate=(1.0, 1.0, 1.0)):
     return V, A, J
 
 
-def _speed_limits(run: Run, V, J, period: float) -> np.ndarray:
-    """(n,) the squared speed limit at each grid point (before erosion)."""
-    return plan_once.speed_limits(run.cap, run.T, run.D, run.jump, V, J, period, D_SHARE,
+def _speed_limits(run: Run, V, J, period: float, d_share: float = D_SHARE) -> np.ndarray:
+    """(n,) the squared speed limit at each grid point (before erosion), the jerk's
+    D v³ term within ``d_share`` of J."""
+    return plan_once.speed_limits(run.cap, run.T, run.D, run.jump, V, J, period, d_share,
                                   JOIN_SHARE)
+
+
+def _d_binds(run: Run, V, J, period: float) -> bool:
+    """Whether the D v³ term at D_SHARE lowers the run's speed limit anywhere."""
+    return bool(np.any(_speed_limits(run, V, J, period)
+                       < _speed_limits(run, V, J, period, math.inf)))
 
 
 def _plan_once(run: Run, wl: np.ndarray, V, A, J, period: float, window: float,
@@ -204,18 +222,22 @@ class _Windowed:
 
 
 def _windowed(run: Run, machine: Machine, limits, coriolis: float,
-              cap: float = math.inf) -> _Windowed:
-    """The run's plan with the Coriolis term's share ``coriolis`` (see the module doc), its
-    speed at most ``cap`` (mm/s): turns flattened, or the window grown, until the window is
-    long enough."""
+              cap: float = math.inf, d_share: float = D_SHARE,
+              beat: float = math.inf) -> _Windowed:
+    """The run's plan with the Coriolis term's share ``coriolis`` and the D v³ term's
+    ``d_share`` of J (see the module doc), its speed at most ``cap`` (mm/s): turns
+    flattened, or the window grown, until the window is long enough. _Slower as soon as
+    a round lasts ``beat`` s or more."""
     V, A, J = limits
-    wl = np.minimum(_speed_limits(run, V, J, machine.period), cap * cap)
+    wl = np.minimum(_speed_limits(run, V, J, machine.period, d_share), cap * cap)
     window = _first_window(run, A, J)
     flattening, last = True, math.inf
     grown = None   # (window, measured) of the last window grown from
     for round_ in range(WINDOW_ROUNDS):
         plan = _plan_once(run, wl, V, A, J, machine.period, window, coriolis)
         t, w, u, v, a, S, need = plan
+        if float(t[-1]) + window >= beat:
+            raise _Slower
         top = float(np.max(need, initial=0.0))
         if top <= window * (1.0 + NEED_ROUNDOFF):
             return _Windowed(coriolis, window, wl, plan)
@@ -283,25 +305,41 @@ def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
     A = np.minimum(A, np.cbrt(J * J * run.length))
     plan = _best_share(run, machine, (V, A, J))
     even = _even_ratio(run, A, J)
-    if even is None:
-        return plan
-    other = _best_share(run, machine, (V, even, J))
-    return other if other.duration < plan.duration else plan
+    tries = [] if even is None else [(even, D_SHARE)]
+    if _d_binds(run, V, J, machine.period):
+        tries += [(A, D_SHARE_HIGH)] + ([] if even is None else [(even, D_SHARE_HIGH)])
+    for acceleration, d_share in tries:
+        # a run that bends is not tightened after: its rounds bound the profile's duration
+        beat = plan.duration if run.bends else math.inf
+        try:
+            other = _best_share(run, machine, (V, acceleration, J), d_share, beat)
+        except _Slower:
+            continue
+        except PlanError:   # no jerk left for the feed to change at that share
+            if d_share == D_SHARE:
+                raise
+            continue
+        if other.duration < plan.duration:
+            plan = other
+    return plan
 
 
-def _best_share(run: Run, machine: Machine, limits) -> Profile:
+def _best_share(run: Run, machine: Machine, limits, d_share: float = D_SHARE,
+                beat: float = math.inf) -> Profile:
     """The run planned at CORIOLIS_SHARE; where the curvature terms lengthened its window
     past the first one, the share moved by SHARE_STEP while that shortens the run (a larger
     share lets the feed change faster on a curve but asks for a longer window). The shares
     are compared before the derivatives are tightened, and only the chosen one is. A run
     that bends is planned by :func:`_capped` instead (its jerk measured), this way only
-    where no window serves BENT_SHARE."""
+    where no window serves BENT_SHARE. ``beat``: _Slower once no share can beat it (a
+    run that bends only: the others' durations fall when tightened)."""
     if run.bends:
         try:
-            return _profile(run, machine, limits, _capped(run, machine, limits))
+            return _profile(run, machine, limits,
+                            _capped(run, machine, limits, d_share, beat))
         except PlanError:   # no window for that share: the usual one
             pass
-    first = _windowed(run, machine, limits, CORIOLIS_SHARE)
+    first = _windowed(run, machine, limits, CORIOLIS_SHARE, d_share=d_share, beat=beat)
     if not _grew(run, limits, first):
         return _profile(run, machine, limits, first)
     for step, steps in ((-SHARE_STEP, SHARE_STEPS), (SHARE_STEP, SHARE_STEPS)):
@@ -309,9 +347,10 @@ def _best_share(run: Run, machine: Machine, limits) -> Profile:
         for _ in range(steps):
             share += step
             try:
-                other = _windowed(run, machine, limits, share)
-            except PlanError:   # no window for that share: the search ends there
-                break
+                other = _windowed(run, machine, limits, share, d_share=d_share,
+                                  beat=best.duration)
+            except (PlanError, _Slower):   # no window for that share, or no faster: the
+                break                      # search ends there
             if other.duration >= best.duration:
                 break
             best = other
@@ -320,19 +359,21 @@ def _best_share(run: Run, machine: Machine, limits) -> Profile:
     return _profile(run, machine, limits, first)
 
 
-def _capped(run: Run, machine: Machine, limits) -> _Windowed:
+def _capped(run: Run, machine: Machine, limits, d_share: float = D_SHARE,
+            beat: float = math.inf) -> _Windowed:
     """A bending run at BENT_SHARE; where its window had to grow, also with its top speed
     capped at each of CAP_FACTORS of the plan's (a slower top asks for less window), the
     fastest kept: a looser limit that lets the feed higher never lengthens the run more
     than these caps can give back."""
-    best = _windowed(run, machine, limits, BENT_SHARE)
+    best = _windowed(run, machine, limits, BENT_SHARE, d_share=d_share, beat=beat)
     if not _grew(run, limits, best):
         return best
     top = float(np.max(best.plan[3]))
     for factor in CAP_FACTORS:
         try:
-            other = _windowed(run, machine, limits, BENT_SHARE, factor * top)
-        except PlanError:
+            other = _windowed(run, machine, limits, BENT_SHARE, factor * top, d_share,
+                              best.duration)
+        except (PlanError, _Slower):
             continue
         if other.duration < best.duration:
             best = other

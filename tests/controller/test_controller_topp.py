@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from cadcnc.controller import knot, runs, topp
+from cadcnc.controller import knot, reach, runs, topp
 
 
 def _line(L: float, n: int, v: float, a: float):
@@ -44,7 +44,7 @@ def test_boxes_hold_every_value_in_their_range():
         s = np.sort(rng.uniform(0, 10, n))
         x = rng.normal(size=(n, 3))
         lo_s, hi_s = s - rng.uniform(0, 2, n), s + rng.uniform(0, 2, n)
-        lo, hi = topp.boxes(s, x, lo_s, hi_s)
+        lo, hi = reach.boxes(s, x, lo_s, hi_s)
         for k in range(n):
             sel = (s >= lo_s[k]) & (s <= hi_s[k])
             assert (lo[k] <= x[sel].min(axis=0)).all() and (hi[k] >= x[sel].max(axis=0)).all()

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from numba import njit
 
-from cadcnc.controller import plan_once, topp
+from cadcnc.controller import plan_once, reach, topp
 from cadcnc.controller.runs import JOIN_SHARE
 
 V = np.array([57.15, 57.15, 42.3])
@@ -54,11 +54,11 @@ def _speed_limits_numpy(s, T, D, jump, cap, d_share: float):
 
 
 def _plan_numpy(s, wl, T, K, D, jump, kink, window: float, coriolis: float):
-    wl_e = topp.erode(s, wl, window)
+    wl_e = reach.erode(s, wl, window)
     top = float(np.sqrt(np.max(wl_e[np.isfinite(wl_e)], initial=0.0)))
-    reach = (s - top * window, s + top * window)
-    t_lo, t_hi = topp.boxes(s, T, *reach)
-    k_lo, k_hi = topp.boxes(s, K, *reach)
+    span = (s - top * window, s + top * window)
+    t_lo, t_hi = reach.boxes(s, T, *span)
+    k_lo, k_hi = reach.boxes(s, K, *span)
     Kmax = np.maximum(np.abs(k_lo), np.abs(k_hi))
     C = coriolis * J
     w, u = topp.passes(s, wl_e, 0.5 * (t_lo + t_hi), 0.5 * (t_hi - t_lo),
@@ -67,7 +67,7 @@ def _plan_numpy(s, wl, T, K, D, jump, kink, window: float, coriolis: float):
     cap = np.minimum(wl_e, top * top)[:, None]
     with np.errstate(invalid="ignore", over="ignore"):
         static = D * cap ** 1.5 + jump * cap / PERIOD + kink * np.sqrt(cap) / PERIOD ** 2
-    static = topp.boxes(s, np.nan_to_num(static, nan=0.0), *reach)[1]
+    static = reach.boxes(s, np.nan_to_num(static, nan=0.0), *span)[1]
     Tabs = np.maximum(np.abs(t_lo), np.abs(t_hi))
     need = topp.window_needed(t, v, a, Tabs, Kmax, static, J, C, window)
     return t, w, u, v, a, S, need

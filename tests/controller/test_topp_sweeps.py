@@ -1,6 +1,6 @@
 """The phase plane's sliding computations against the plain loops they replace.
 
-:func:`cadcnc.controller.topp.erode` applies each speed limit over +- v W with a segment
+:func:`cadcnc.controller.reach.erode` applies each speed limit over +- v W with a segment
 tree (its reach bisected on an ordered grid), and
 :func:`~cadcnc.controller.topp.window_needed` takes the extremes of the
 acceleration and the speed over each window from sliding queues. Both must give the very
@@ -16,7 +16,7 @@ import math
 import numpy as np
 import pytest
 
-from cadcnc.controller import topp
+from cadcnc.controller import reach, topp
 
 
 def _erode_walked(s, wl, window: float) -> np.ndarray:
@@ -77,13 +77,13 @@ def test_erosion_equals_the_walked_reach(seed):
     wl[5] = 0.0
     wl[7] = -np.finfo(float).max   # as speed_limits gives -inf
     for window in (0.0, 1e-3, 0.05, 0.5, 50.0):
-        got = topp.erode(s, wl, window)
+        got = reach.erode(s, wl, window)
         want = _erode_walked(s, wl, window)
         assert np.array_equal(got, want), window
-    assert (topp.erode(s, wl, 0.05) < wl).any()   # the limits did reach others
+    assert (reach.erode(s, wl, 0.05) < wl).any()   # the limits did reach others
     s[n // 2] = s[n // 2 + 5]   # out of order (no run's grid is): its reach walked
     for window in (0.05, 0.5):
-        assert np.array_equal(topp.erode(s, wl, window), _erode_walked(s, wl, window))
+        assert np.array_equal(reach.erode(s, wl, window), _erode_walked(s, wl, window))
 
 
 @pytest.mark.parametrize("seed", range(6))
