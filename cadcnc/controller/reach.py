@@ -3,7 +3,8 @@ path's derivatives' extremes over it, as :mod:`.topp` and :mod:`.plan_once` need
 
 :func:`erode` holds each squared speed limit w_k over s_k +- sqrt(w_k) W (a motion
 averaged over W s that kept every limit where it was is then within them where it is);
-:func:`boxes` gives the smallest and largest of a quantity over each point's range of s.
+:func:`boxes` gives the smallest and largest of a quantity over each point's range of s,
+from sliding-window queues (:func:`enqueue`, :func:`dequeue`; also :mod:`.topp`'s).
 Both are linear or n log n in the grid, however far a point reaches. Lengths mm,
 squared speeds mm²/s², windows s.
 """
@@ -89,6 +90,26 @@ def erode(s, wl, window: float):
 
 
 @njit(cache=True, error_model="numpy")
+def enqueue(q, head: int, tail: int, values, k: int, sign: float) -> int:
+    """Put point k at the tail of the sliding-window queue ``q`` (indices, holding
+    ``q[head:tail]``), first dropping the points it outlasts: with ``sign`` 1 those whose
+    value is at most ``values[k]`` (the queue's head is then the window's largest), with
+    -1 those at least it (the smallest). The new tail."""
+    while tail > head and sign * values[q[tail - 1]] <= sign * values[k]:
+        tail -= 1
+    q[tail] = k
+    return tail + 1
+
+
+@njit(cache=True, error_model="numpy")
+def dequeue(q, head: int, tail: int, first: int) -> int:
+    """Drop the points before ``first`` from the head of the queue ``q``; the new head."""
+    while head < tail and q[head] < first:
+        head += 1
+    return head
+
+
+@njit(cache=True, error_model="numpy")
 def boxes(s, x, lo_s, hi_s):
     """(lo, hi) (n, 3): the smallest and largest x over s in [lo_s[k], hi_s[k]] (each
     range holding s[k]; ranges widened to a monotone sequence, then a sliding window)."""
@@ -111,23 +132,16 @@ def boxes(s, x, lo_s, hi_s):
     qmin = np.empty(n, dtype=np.int64)
     qmax = np.empty(n, dtype=np.int64)
     for i in range(3):
-        h1 = t1 = h2 = t2 = 0   # deque heads and tails (exclusive)
+        xi = x[:, i]
+        h1 = t1 = h2 = t2 = 0   # queue heads and tails (exclusive)
         nxt = 0
         for k in range(n):
             while nxt <= last[k]:
-                while t1 > h1 and x[qmin[t1 - 1], i] >= x[nxt, i]:
-                    t1 -= 1
-                qmin[t1] = nxt
-                t1 += 1
-                while t2 > h2 and x[qmax[t2 - 1], i] <= x[nxt, i]:
-                    t2 -= 1
-                qmax[t2] = nxt
-                t2 += 1
+                t1 = enqueue(qmin, h1, t1, xi, nxt, -1.0)
+                t2 = enqueue(qmax, h2, t2, xi, nxt, 1.0)
                 nxt += 1
-            while qmin[h1] < first[k]:
-                h1 += 1
-            while qmax[h2] < first[k]:
-                h2 += 1
-            lo[k, i] = x[qmin[h1], i]
-            hi[k, i] = x[qmax[h2], i]
+            h1 = dequeue(qmin, h1, t1, first[k])
+            h2 = dequeue(qmax, h2, t2, first[k])
+            lo[k, i] = xi[qmin[h1]]
+            hi[k, i] = xi[qmax[h2]]
     return lo, hi

@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit
 
 from .knot import ROWS, bounds, coefficients, feasible, largest
+from .reach import dequeue, enqueue
 
 
 @njit(cache=True, error_model="numpy")
@@ -154,7 +155,7 @@ def window_needed(t, v, a, Tabs, Kmax, static, J, C, window: float):
     ``window``: the tangential part |T_i| (a(t) - a(t - W)) / W takes what the curvature
     terms leave, the Coriolis term 3 K v a and ``static`` (n, 3), D v³ and a join's or a
     curvature jump's one-period jolt at the speed limits (inf: no room). The extremes of
-    a and v over knots lo..k come from sliding-window queues (O(n))."""
+    a and v over knots lo..k come from sliding-window queues (:mod:`.reach`, O(n))."""
     n = len(t)
     need = np.zeros(n - 1)
     qlo = np.empty(n, dtype=np.int64)   # knots with rising a (the window's minimum first)
@@ -165,24 +166,12 @@ def window_needed(t, v, a, Tabs, Kmax, static, J, C, window: float):
     for k in range(n - 1):   # the windows ending on knot k: knots lo..k
         while t[lo + 1] <= t[k] - window:
             lo += 1
-        while t1 > h1 and a[qlo[t1 - 1]] >= a[k]:
-            t1 -= 1
-        qlo[t1] = k
-        t1 += 1
-        while t2 > h2 and a[qhi[t2 - 1]] <= a[k]:
-            t2 -= 1
-        qhi[t2] = k
-        t2 += 1
-        while t3 > h3 and v[qv[t3 - 1]] <= v[k]:
-            t3 -= 1
-        qv[t3] = k
-        t3 += 1
-        while h1 < t1 and qlo[h1] < lo:
-            h1 += 1
-        while h2 < t2 and qhi[h2] < lo:
-            h2 += 1
-        while h3 < t3 and qv[h3] < lo:
-            h3 += 1
+        t1 = enqueue(qlo, h1, t1, a, k, -1.0)
+        t2 = enqueue(qhi, h2, t2, a, k, 1.0)
+        t3 = enqueue(qv, h3, t3, v, k, 1.0)
+        h1 = dequeue(qlo, h1, t1, lo)
+        h2 = dequeue(qhi, h2, t2, lo)
+        h3 = dequeue(qv, h3, t3, lo)
         amin, amax, vmax = a[k], a[k], max(v[k], v[k + 1])
         if h1 < t1:
             amin = min(amin, a[qlo[h1]])
