@@ -1,6 +1,6 @@
 """Planning + stream cost per servo period, as a ratio to the bare step (same process).
 
-    python -m benchmarks.controller.stream_cost [--long | --hsm]
+    python -m benchmarks.controller.stream_cost [--long | --hsm | --free-form]
 
 Per program and feed, µs per period (best of 5, interleaved; steppers built outside
 every timing):
@@ -24,6 +24,11 @@ before writing).
 40 000 mm/min, where a cut may take m kernel cycles a period: ``stream`` per period,
 ``m`` the kernel's cycles per period over the whole stream, and ``on top`` = stream - m
 step (the stream's own planning and streaming beside its kernel cycles).
+
+``--free-form``: the same columns (and ``plan``, the plan alone) for the race's long
+free-form programs (the slab's raster and waterline, ``compare.long_programs``: 60 000 to
+180 000 periods, 50 to 70 runs that bend) on the default machine and the high-speed mill
+at 10 000 mm/min, best of 3.
 """
 
 from __future__ import annotations
@@ -198,26 +203,50 @@ def kernel_cycles(program, machine, feed) -> tuple[int, int]:
     return len(rows), cycles
 
 
+def _on_top(machine: Machine, cases, feeds, runs: int = RUNS) -> None:
+    """Per case and feed: the plan alone and the whole stream per period, the kernel's
+    cycles a period (m), the bare step per cycle and the stream on top of m steps."""
+    print(f"machine: {machine.summary()}")
+    print(f"{'program':<26} {'feed':>6} {'periods':>8} {'m':>5} {'plan':>6} {'stream':>7} "
+          f"{'step':>6} {'on top':>7}   (us per period; step per cycle)")
+    for name, part, program in cases:
+        factory = stepper_factory(part)
+        stream_program(program, machine, factory)   # compiled code warmed
+        for feed in feeds:
+            n = stream_program(program, machine, factory, feed=feed).periods
+            plan = best(lambda: sum(len(s) for _, _, s in plan_feed(
+                pieces_of(program, machine, feed), machine).blocks()), runs)
+            w = min(whole(program, factory, machine, feed) for _ in range(runs))
+            step_s, step_n = min(bare_steps(program, factory, machine) for _ in range(runs))
+            periods, cycles = kernel_cycles(program, machine, feed)
+            stream_us, step_us, m = 1e6 * w / n, 1e6 * step_s / step_n, cycles / periods
+            print(f"{name[:26]:<26} {feed:>6g} {n:>8} {m:>5.2f} {1e6 * plan / n:>6.2f} "
+                  f"{stream_us:>7.2f} {step_us:>6.2f} {stream_us - m * step_us:>7.2f}",
+                  flush=True)
+
+
 def fast_machine() -> None:
     """The stream's cost per period on the high-speed mill (``--hsm``, module doc)."""
     from benchmarks.controller.compare import high_speed_mill
 
-    machine = high_speed_mill()
-    for name, program, factory in warmed(machine, (
-            f"{'program':<26} {'feed':>6} {'periods':>8} {'m':>5} {'stream':>7} {'step':>6} "
-            f"{'on top':>7}   (us per period; step per cycle)")):
-        for feed in (1500.0, 10_000.0, 40_000.0):
-            n = stream_program(program, machine, factory, feed=feed).periods
-            w = min(whole(program, factory, machine, feed) for _ in range(RUNS))
-            step_s, step_n = min(bare_steps(program, factory, machine) for _ in range(RUNS))
-            periods, cycles = kernel_cycles(program, machine, feed)
-            stream_us, step_us, m = 1e6 * w / n, 1e6 * step_s / step_n, cycles / periods
-            print(f"{name:<26} {feed:>6g} {n:>8} {m:>5.2f} {stream_us:>7.2f} {step_us:>6.2f} "
-                  f"{stream_us - m * step_us:>7.2f}")
+    _on_top(high_speed_mill(), programs(), (1500.0, 10_000.0, 40_000.0))
+
+
+def free_form() -> None:
+    """The long free-form programs of the race (``--free-form``, module doc) at
+    10 000 mm/min on the default machine and the high-speed mill."""
+    import tempfile
+
+    from benchmarks.controller.compare import high_speed_mill, long_programs
+
+    with tempfile.TemporaryDirectory() as folder:
+        cases = list(long_programs(Path(folder), None))
+        for machine in (Machine.default(), high_speed_mill()):
+            _on_top(machine, cases, (10_000.0,), runs=3)
 
 
 if __name__ == "__main__":
     import sys
 
     long_stream() if "--long" in sys.argv else fast_machine() if "--hsm" in sys.argv \
-        else main()
+        else free_form() if "--free-form" in sys.argv else main()

@@ -36,6 +36,23 @@ def _raw(t, s, v, a, S, k: int, x: float) -> tuple:
 
 
 @njit(cache=True, error_model="numpy")
+def _merged(t, window: float):
+    """(2n,) the times t (non-decreasing) and t + window in order: two sorted
+    sequences merged (O(n), the same values a sort gives)."""
+    n = len(t)
+    out = np.empty(2 * n)
+    i = j = 0
+    for q in range(2 * n):
+        if j >= n or (i < n and t[i] <= t[j] + window):
+            out[q] = t[i]
+            i += 1
+        else:
+            out[q] = t[j] + window
+            j += 1
+    return out
+
+
+@njit(cache=True, error_model="numpy")
 def peak_share(t, s, v, a, S, window: float, grid, T, K, D, jump, kink, J,
                period: float) -> float:
     """The largest (|T_i j + 3 K_i v a| + D_i v^3) / J_i of the profile (t, s, v, a, S:
@@ -44,10 +61,7 @@ def peak_share(t, s, v, a, S, window: float, grid, T, K, D, jump, kink, J,
     derivatives and joins (a join's one-period jolt, |jump_i| v^2 / period + |kink_i| v /
     period^2, added where the averaged motion passes it, at its speed there)."""
     n = len(t)
-    times = np.empty(2 * n)
-    times[:n] = t
-    times[n:] = t + window
-    times.sort()
+    times = _merged(t, window)
     worst = 0.0
     k1 = k0 = g = 0
     end = t[n - 1]

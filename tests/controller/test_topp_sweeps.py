@@ -3,9 +3,10 @@
 :func:`cadcnc.controller.reach.erode` applies each speed limit over +- v W with a segment
 tree (its reach bisected on an ordered grid), and
 :func:`~cadcnc.controller.topp.window_needed` takes the extremes of the
-acceleration and the speed over each window from sliding queues. Both must give the very
-floats of the direct loops written here (every point's reach walked point by point; every
-window's knots scanned), on grids with repeated points (joins), limits that reach past
+acceleration and the speed over each window from sliding queues, and
+:func:`~cadcnc.controller.averaged_jerk.peak_share` merges its interval ends instead of
+sorting them. Each must give the very floats of the direct computations written here
+(every point's reach walked point by point; every window's knots scanned; a sort), on grids with repeated points (joins), limits that reach past
 either end, none (inf) and a negative one, and windows from none to the whole run.
 """
 
@@ -16,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from cadcnc.controller import reach, topp
+from cadcnc.controller import averaged_jerk, reach, topp
 
 
 def _erode_walked(s, wl, window: float) -> np.ndarray:
@@ -107,3 +108,16 @@ def test_window_needed_equals_the_scanned_windows(seed):
         want = _needed_scanned(t, v, a, Tabs, Kmax, static, J, C, window)
         assert np.array_equal(got, want), window
         assert np.isinf(got).any() and (got > 0.0).any()
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_measured_jerk_times_equal_the_sorted_times(seed):
+    """The averaged jerk's interval ends (the knots' times and the same a window later)
+    merged in order equal the sorted union, repeated times (joins) included."""
+    rng = np.random.default_rng(200 + seed)
+    t = np.cumsum(rng.uniform(0.0, 2e-3, 500))
+    t[0] = 0.0
+    t[80:84] = t[80]
+    for window in (0.0, 1e-5, 0.05, 0.13, 10.0):
+        assert np.array_equal(averaged_jerk._merged(t, window),
+                              np.sort(np.r_[t, t + window])), window
