@@ -21,11 +21,12 @@ and its peak memory per period, then the same for its gate (what ``cadcnc stream
 before writing).
 
 ``--hsm``: the high-speed mill (``compare.high_speed_mill``, 1 ms) at 1 500, 10 000 and
-40 000 mm/min, where a cut may take m kernel cycles a period: ``stream`` per period,
+40 000 mm/min, where a cut may take m kernel cycles a period: ``plan`` (as above),
+``stream`` per period,
 ``m`` the kernel's cycles per period over the whole stream, and ``on top`` = stream - m
 step (the stream's own planning and streaming beside its kernel cycles).
 
-``--free-form``: the same columns (and ``plan``, the plan alone) for the race's long
+``--free-form``: the same columns for the race's long
 free-form programs (the slab's raster and waterline, ``compare.long_programs``: 60 000 to
 180 000 periods, 50 to 70 runs that bend) on the default machine and the high-speed mill
 at 10 000 mm/min, best of 3.
@@ -160,12 +161,12 @@ def long_stream(periods: int = 1_000_000) -> None:
           f"({peak / n:.0f} bytes per period)")
 
 
-def warmed(machine: Machine, columns: str):
+def warmed(machine: Machine, columns: str, cases=None):
     """Print the machine and the table's header; yield (name, program, stepper factory)
-    of every program, its compiled code warmed by one stream."""
+    of every case (default: :func:`programs`), its compiled code warmed by one stream."""
     print(f"machine: {machine.summary()}")
     print(columns)
-    for name, part, program in programs():
+    for name, part, program in programs() if cases is None else cases:
         factory = stepper_factory(part)
         stream_program(program, machine, factory)
         yield name, program, factory
@@ -206,12 +207,9 @@ def kernel_cycles(program, machine, feed) -> tuple[int, int]:
 def _on_top(machine: Machine, cases, feeds, runs: int = RUNS) -> None:
     """Per case and feed: the plan alone and the whole stream per period, the kernel's
     cycles a period (m), the bare step per cycle and the stream on top of m steps."""
-    print(f"machine: {machine.summary()}")
-    print(f"{'program':<26} {'feed':>6} {'periods':>8} {'m':>5} {'plan':>6} {'stream':>7} "
-          f"{'step':>6} {'on top':>7}   (us per period; step per cycle)")
-    for name, part, program in cases:
-        factory = stepper_factory(part)
-        stream_program(program, machine, factory)   # compiled code warmed
+    for name, program, factory in warmed(machine, (
+            f"{'program':<26} {'feed':>6} {'periods':>8} {'m':>5} {'plan':>6} {'stream':>7} "
+            f"{'step':>6} {'on top':>7}   (us per period; step per cycle)"), cases):
         for feed in feeds:
             n = stream_program(program, machine, factory, feed=feed).periods
             plan = best(lambda: sum(len(s) for _, _, s in plan_feed(

@@ -6,8 +6,9 @@ tree (its reach bisected on an ordered grid), and
 acceleration and the speed over each window from sliding queues, and
 :func:`~cadcnc.controller.averaged_jerk.peak_share` merges its interval ends instead of
 sorting them. Each must give the very floats of the direct computations written here
-(every point's reach walked point by point; every window's knots scanned; a sort), on grids with repeated points (joins), limits that reach past
-either end, none (inf) and a negative one, and windows from none to the whole run.
+(every point's reach walked point by point; every window's knots scanned; a sort), on
+grids with repeated points (joins), limits that reach past either end, none (inf) and a
+negative one, and windows from none to the whole run.
 """
 
 from __future__ import annotations
