@@ -70,6 +70,8 @@ WINDOW_ROUNDS = 32      # plans of a run at most: turns flattened, or the window
 FLATTEN_ROUNDS = 16     # of which at most this many flatten turns
 TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
 TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened this much
+TIE = 1e-12            # plans of a run whose durations agree within this share are a tie:
+                       # the first kept (which one an early give-up skips is then moot)
 NEED_ROUNDOFF = 1e-7    # a window the plan needs to within this share of itself suffices
                         # (round-off; MARGIN covers it), and flattening that shortens the
                         # need by less is no progress: no plan made again for round-off
@@ -319,7 +321,7 @@ def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
             if d_share == D_SHARE:
                 raise
             continue
-        if other.duration < plan.duration:
+        if other.duration < plan.duration * (1.0 - TIE):   # an ulp shorter: a tie
             plan = other
     return plan
 

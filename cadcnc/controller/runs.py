@@ -28,6 +28,11 @@ from .machine import Machine
 from .pieces import STRAIGHT_K, Piece
 
 LINE_KNOT = 0.25       # mm: the largest knot of a straight move (the plan's resolution)
+CUT_KNOT = 0.5         # mm: the longest knot of a cut's grid. A cut's points are as close
+                       # as the 1 um accuracy rule asks (often 0.1 mm) and the plan's cost
+                       # goes with its knots: points its derivatives pass linearly merge
+KNOT_SHARE = 1e-3      # ... where T and K stay within this share of their scale of the
+                       # line between two knots (MARGIN's room: 5e-3)
 LINE_KNOTS_MAX = 4000  # knots of one straight move at most
 MIN_KNOT = 1e-4        # mm: the shortest knot of a cut's grid
 STOP_SPEED = 10.0      # mm/s: a join slower than this is a stop at rest (a corner, or a
@@ -168,27 +173,84 @@ def _piece_grid(piece: Piece, machine: Machine):
     cap = np.full(len(piece.s), piece.cap)
     if piece.step_cap is not None:
         cap = np.minimum(cap, piece.step_cap)
-    keep = _knots(piece.s)
-    return piece.s[keep], T[keep], K[keep], D[keep], jump[keep], cap[keep]
+    eps_t, eps_k = _linear_room(K)
+    keep = _linear_knots(piece.s, T, K, CUT_KNOT, eps_t, eps_k)
+    D, jump, cap = _held(keep, D, jump, cap)
+    return piece.s[keep], T[keep], K[keep], D, jump, cap
+
+
+def _linear_room(K: np.ndarray) -> tuple[float, float]:
+    """(eps_T, eps_K 1/mm): how far a cut's T and K may stray from the line between two
+    knots: KNOT_SHARE of the unit tangent, and of the cut's largest curvature (the speed
+    on a bend is at most sqrt(A / K), where K v^2 then strays by at most that share of
+    A). From the path alone, so that a machine's limits never change the grid."""
+    top = max(float(np.max(np.abs(K), initial=0.0)), STRAIGHT_K)
+    return KNOT_SHARE, KNOT_SHARE * top
 
 
 @njit(cache=True)
-def _knots(s: np.ndarray) -> np.ndarray:
-    """Indices of the points kept as knots: none closer than MIN_KNOT to the one before
-    (a cut's last step may be a few nm: from rest to rest over it takes no finite time
-    on the grid), the first and the last always (compiled: a cut has thousands)."""
+def _linear_knots(s: np.ndarray, T: np.ndarray, K: np.ndarray, longest: float,
+                  eps_t: float, eps_k: float) -> np.ndarray:
+    """Indices of the points kept as knots: from each knot the farthest point within
+    ``longest`` mm such that T and K at every point between stay within eps_t, eps_k of
+    the straight line between the two knots' values, and at least MIN_KNOT on (a cut's
+    last step may be a few nm: from rest to rest over it takes no finite time on the
+    grid); the first and the last point always (compiled: a cut has thousands)."""
     n = len(s)
     keep = np.empty(max(n, 2), dtype=np.int64)
     keep[0] = 0
-    m = 1
-    for i in range(1, n - 1):
-        if s[i] - s[keep[m - 1]] >= MIN_KNOT:
-            keep[m] = i
-            m += 1
-    if m > 1 and s[n - 1] - s[keep[m - 1]] < MIN_KNOT:
+    m, a = 1, 0
+    while a < n - 1:
+        c = a + 1
+        while c + 1 < n and (s[c] - s[a] < MIN_KNOT or (
+                s[c + 1] - s[a] <= longest and _straight(s, T, K, a, c + 1, eps_t, eps_k))):
+            c += 1
+        keep[m] = c
+        m += 1
+        a = c
+    if m > 2 and s[n - 1] - s[keep[m - 2]] < MIN_KNOT:   # the last knot too short
+        keep[m - 2] = n - 1
         m -= 1
-    keep[m] = n - 1
-    return keep[:m + 1].copy()
+    return keep[:m].copy()
+
+
+@njit(cache=True)
+def _straight(s, T, K, a: int, c: int, eps_t: float, eps_k: float) -> bool:
+    """Whether T and K at the points strictly between a and c are within eps_t, eps_k of
+    the lines through their values at a and c (in arc length)."""
+    h = s[c] - s[a]
+    for i in range(a + 1, c):
+        f = (s[i] - s[a]) / h if h > 0.0 else 0.0
+        for j in range(3):
+            if abs(T[i, j] - (T[a, j] + f * (T[c, j] - T[a, j]))) > eps_t:
+                return False
+            if abs(K[i, j] - (K[a, j] + f * (K[c, j] - K[a, j]))) > eps_k:
+                return False
+    return True
+
+
+@njit(cache=True)
+def _held(keep: np.ndarray, D: np.ndarray, jump: np.ndarray, cap: np.ndarray) -> tuple:
+    """D, jump (m, 3) and cap (m,) at the kept knots ``keep`` (m,) of a grid of n points:
+    each knot holds the largest D and jump and the smallest cap of every point between
+    it and the knots on either side (a point between two knots is passed at speeds
+    between theirs, so both carry its limits)."""
+    m, n = len(keep), len(cap)
+    D2, jump2, cap2 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m)
+    for j in range(m):
+        a = keep[j - 1] + 1 if j > 0 else 0
+        b = keep[j + 1] - 1 if j + 1 < m else n - 1
+        a, b = min(a, keep[j]), max(b, keep[j])
+        cap2[j] = cap[a]
+        for i in range(3):
+            D2[j, i] = D[a, i]
+            jump2[j, i] = jump[a, i]
+        for p in range(a + 1, b + 1):
+            cap2[j] = min(cap2[j], cap[p])
+            for i in range(3):
+                D2[j, i] = max(D2[j, i], D[p, i])
+                jump2[j, i] = max(jump2[j, i], jump[p, i])
+    return D2, jump2, cap2
 
 
 def _run(first: int, pieces: list[Piece], machine: Machine, joins: list) -> Run:

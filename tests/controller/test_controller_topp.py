@@ -154,7 +154,8 @@ def test_knots_keep_the_ends_and_no_step_below_min_knot(n):
     dropped only within MIN_KNOT of the knot before it, or (one) of the end."""
     rng = np.random.default_rng(n)
     s = np.cumsum(np.r_[0.0, rng.exponential(runs.MIN_KNOT, n - 1)])
-    keep = runs._knots(s)
+    flat = np.zeros((n, 3))
+    keep = runs._linear_knots(s, flat, flat, 0.0, 0.0, 0.0)   # no merging but MIN_KNOT's
     assert keep[0] == 0 and keep[-1] == n - 1
     assert n == 1 or (np.diff(keep) > 0).all()
     assert (np.diff(s[keep[:-1]]) >= runs.MIN_KNOT).all()
@@ -162,6 +163,65 @@ def test_knots_keep_the_ends_and_no_step_below_min_knot(n):
     far = dropped[s[dropped] - s[keep[np.searchsorted(keep, dropped) - 1]] >= runs.MIN_KNOT]
     assert len(far) <= 1 and (s[-1] - s[far] < runs.MIN_KNOT).all()
     assert n < 50 or len(dropped) > 0   # the sample has points to drop
+
+
+def _wavy(n: int, seed: int) -> tuple:
+    """A cut-like grid: steps of about 0.1 mm (some of a few nm), T and K of a wave with
+    a little noise, D, jump and cap drawn at random."""
+    rng = np.random.default_rng(seed)
+    h = np.where(rng.random(n - 1) < 0.05, 1e-6, rng.uniform(0.05, 0.15, n - 1))
+    s = np.cumsum(np.r_[0.0, h])
+    phase = s[:, None] / np.array([17.0, 23.0, 41.0]) + np.array([0.0, 1.0, 2.0])
+    T = np.cos(phase) + 1e-6 * rng.standard_normal((n, 3))
+    K = 0.05 * np.sin(2.0 * phase) + 1e-6 * rng.standard_normal((n, 3))
+    D, jump = rng.exponential(0.01, (n, 3)), rng.exponential(1e-4, (n, 3))
+    return s, T, K, D, jump, rng.uniform(10.0, 100.0, n)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_knots_merge_only_where_T_and_K_pass_linearly(seed):
+    """A cut's points merge into knots at most CUT_KNOT apart between which every
+    point's T and K lie within eps of the line through the two knots' values, each knot
+    taken as far as that allows; no knot shorter than MIN_KNOT (the last excepted if the
+    cut has one step)."""
+    s, T, K, *_ = _wavy(3000, seed)
+    eps_t, eps_k = runs._linear_room(K)
+    assert eps_t == runs.KNOT_SHARE and eps_k == runs.KNOT_SHARE * np.abs(K).max()
+    keep = runs._linear_knots(s, T, K, runs.CUT_KNOT, eps_t, eps_k)
+    n = len(s)
+    assert keep[0] == 0 and keep[-1] == n - 1 and (np.diff(keep) > 0).all()
+    assert (np.diff(s[keep]) >= runs.MIN_KNOT).all()
+    assert 4 * len(keep) < n   # merging happens on such a wave
+
+    def straight(a: int, c: int) -> bool:
+        f = ((s[a + 1:c] - s[a]) / (s[c] - s[a]))[:, None]
+        return bool((np.abs(T[a + 1:c] - (T[a] + f * (T[c] - T[a]))) <= eps_t).all()
+                    and (np.abs(K[a + 1:c] - (K[a] + f * (K[c] - K[a]))) <= eps_k).all())
+
+    for a, c in zip(keep[:-1], keep[1:]):
+        forced = s[c - 1] - s[a] < runs.MIN_KNOT   # the knot grown only to MIN_KNOT
+        assert forced or (s[c] - s[a] <= runs.CUT_KNOT and straight(a, c))
+        if c + 1 < n and not forced:   # one point more would break a rule
+            assert s[c + 1] - s[a] > runs.CUT_KNOT or not straight(a, c + 1)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_merged_knots_carry_the_limits_of_every_point_they_pass(seed):
+    """Each point between two knots has its D and jump at most, and its speed cap at
+    least, those of both knots (the motion passes it at speeds between theirs); a knot
+    has its own."""
+    s, T, K, D, jump, cap = _wavy(1500, seed)
+    keep = runs._linear_knots(s, T, K, runs.CUT_KNOT, *runs._linear_room(K))
+    D2, jump2, cap2 = runs._held(keep, D, jump, cap)
+    for j, k in enumerate(keep):
+        assert (D2[j] >= D[k]).all() and (jump2[j] >= jump[k]).all() and cap2[j] <= cap[k]
+    for j, (a, c) in enumerate(zip(keep[:-1], keep[1:])):
+        inner = slice(a + 1, c)
+        for x in (j, j + 1):
+            assert (D2[x] >= D[inner]).all() and (jump2[x] >= jump[inner]).all()
+            assert (cap2[x] <= cap[inner]).all()
+    # nothing more than that: a knot's values are those of the points it stands for
+    assert set(D2[:, 0]) <= set(D[:, 0]) and set(cap2) <= set(cap)
 
 
 def _root_bisected(q: float, p: float, c: float, x: float) -> float:
