@@ -58,8 +58,12 @@ class FaceSurface:
     """
 
     def __init__(self, face, number: int | None = None, tol: Tolerances = DEFAULT,
-                 part=None):
+                 part=None, whole: bool = False):
         self.topods = as_topods_face(face)
+        self.whole = whole
+        """True for a face whose boundary no one asks (a guide plane streamed with its
+        steppers' boundary checks off): its kernel's trim grid reads every point inside,
+        built at no cost."""
         self.number = number
         self.part = part
         self.tol = tol
@@ -147,7 +151,8 @@ class FaceSurface:
             # listing a part's faces (`cadcnc faces`) does not need
             from .trim_grid import TrimGrid
 
-            self._kernel = (data, TrimGrid.build(self, data=data)) if data is not None else ()
+            grid = TrimGrid.whole(self) if self.whole else TrimGrid.build(self, data=data)
+            self._kernel = (data, grid) if data is not None else ()
         return self._kernel or None
 
     # -- evaluation ---------------------------------------------------------------------

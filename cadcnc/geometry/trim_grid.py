@@ -134,6 +134,15 @@ class TrimGrid:
         stats["build_s"] = time.perf_counter() - t_start
         return grid
 
+    @classmethod
+    def whole(cls, face_surface) -> "TrimGrid":
+        """One cell, inside, for a face whose boundary is never asked (``FaceSurface.whole``:
+        a guide plane in a stream, whose steppers check no boundary): every point reads
+        inside, with no exact call and no build."""
+        stats = {"exact_only": False, "regions": 0, "suspect": 0, "calls": 0, "build_s": 0.0}
+        return cls(face_surface, np.full((1, 1), CELL_INSIDE, np.int8), (0.0, 0.0),
+                   (1.0, 1.0), [(0.0, 0.0)] * 2, None, stats)
+
     def _label_regions(self, mask: np.ndarray, checks: int) -> None:
         """One exact call per 4-connected region of free cells (mask 0; plus confirmations)."""
         region, picks = regions(mask)

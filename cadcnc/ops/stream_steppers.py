@@ -75,7 +75,7 @@ def stepper_factory(part):
             plane = level_of(path) or guide_plane_of(path)
             if plane is None:
                 return None
-            s2 = guide_face(plane, size, job)
+            s2 = guide_face(plane, size, job, whole=True)   # (check_boundary=False)
         else:
             s2 = part.face(j)
         start, end = _tangency(path, 0), _tangency(path, len(path) - 1)

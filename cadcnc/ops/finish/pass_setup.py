@@ -56,8 +56,9 @@ def pass_setup(part: Part, faces: Sequence[int], job: Job) -> PassSetup:
     return per_part[key]
 
 
-def guide_face(plane, size: float, job: Job) -> FaceSurface:
+def guide_face(plane, size: float, job: Job, whole: bool = False) -> FaceSurface:
     """The guide plane as a square face of half size ``size`` (mm), centred on the
-    plane's point nearest the origin; u along the pass direction."""
+    plane's point nearest the origin; u along the pass direction. ``whole``: for steppers
+    that check no boundary (its trim grid not built: :attr:`FaceSurface.whole`)."""
     return plane_surface(plane.offset * plane.normal, plane.normal, plane.direction, size,
-                         job.tolerances)
+                         job.tolerances, whole)
