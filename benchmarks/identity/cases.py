@@ -264,7 +264,11 @@ SHARED = [
          (("finish", "{part}", "--faces", "7", "8", "--radius", "1", "--axis", "-Z",
            "--strategy", "steep-shallow", "--stepover", "0.5", "--stepdown", "1",
            "--allow-partial", *PROGRAM),), exits=(6,)),
-    _refused(finish("shared-finish-raster-toroidal", TORUS, (1,), 3, "--stepover", "2")),
+    # refused by the gate (exit 5): cuts under the torus that a plunge along +Z reaches
+    # through the face (exit 3 before 2026-11-29: every guide plane, centred on the
+    # origin, missed the part at z 114-161)
+    replace(finish("shared-finish-raster-toroidal", TORUS, (1,), 3, "--stepover", "2"),
+            exits=(5,)),
 ]
 
 GROUPS = {"fast": FAST, "slow": SLOW, "shared": SHARED}

@@ -20,7 +20,7 @@ import numpy as np
 from ..interp.compiled import new_stepper
 from ..interp.stepper import Tangency
 from .finish.loops import Level
-from .finish.pass_setup import GUIDE_MARGIN, guide_face
+from .finish.pass_setup import guide_face, guide_half_size
 from .finish.passes import GuidePlane
 
 END_REACHED = 1e-12  # mm
@@ -62,7 +62,6 @@ def level_of(path) -> Level | None:
 def stepper_factory(part):
     """``steppers(cut_index, segment, period)`` for the cuts of programs on ``part``."""
     lo, hi = part.bounding_box()
-    size = float(np.linalg.norm(hi - lo)) + GUIDE_MARGIN   # as the finishing pass's guide
 
     def steppers(k: int, segment, period: float):
         path = segment.path
@@ -75,7 +74,8 @@ def stepper_factory(part):
             plane = level_of(path) or guide_plane_of(path)
             if plane is None:
                 return None
-            s2 = guide_face(plane, size, job, whole=True)   # (check_boundary=False)
+            s2 = guide_face(plane, guide_half_size(plane, lo, hi), job,
+                            whole=True)   # (check_boundary=False)
         else:
             s2 = part.face(j)
         start, end = _tangency(path, 0), _tangency(path, len(path) - 1)

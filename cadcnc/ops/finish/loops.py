@@ -109,7 +109,7 @@ class _Level:
         self.setup, self.job, self.side = setup, job, side
         self.plane, self.nrm = Level(float(z)), Z
         self.tangent = loop_tangent(side)
-        self.guide = guide_face(self.plane, setup.size, job)
+        self.guide = guide_face(self.plane, setup.guide_size(self.plane), job)
         self.offset_faces = offset_faces
         self.here = np.asarray(near, float) if near is not None else None
         self.beat = beat or (lambda text: False)

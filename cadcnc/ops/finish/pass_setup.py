@@ -9,6 +9,7 @@ surface. Lengths mm.
 
 from __future__ import annotations
 
+from itertools import product
 from typing import Sequence
 
 import numpy as np
@@ -39,8 +40,11 @@ class PassSetup:
                       for f, s in self.surfaces.items()}
         self._guards = {f: guard_for(part, (f,), job, own_share=FINISH_OWN_SHARE)
                         for f in self.faces} if guarded else {}
-        lo, hi = part.bounding_box()
-        self.size = float(np.linalg.norm(hi - lo)) + GUIDE_MARGIN
+        self.box = part.bounding_box()
+
+    def guide_size(self, plane) -> float:
+        """The half size (mm) of ``plane``'s guide square (:func:`guide_half_size`)."""
+        return guide_half_size(plane, *self.box)
 
     def guard(self, face: int):
         """The guard of cuts on ``face`` (None when the setup is unguarded)."""
@@ -54,6 +58,17 @@ def pass_setup(part: Part, faces: Sequence[int], job: Job) -> PassSetup:
     if key not in per_part:
         per_part[key] = PassSetup(part, faces, job)
     return per_part[key]
+
+
+def guide_half_size(plane, lo: np.ndarray, hi: np.ndarray) -> float:
+    """Half size (mm) of ``plane``'s guide square (:func:`guide_face`, centred on the
+    plane's point nearest the origin) holding the part's bounding box ``lo``, ``hi`` (3,)
+    with GUIDE_MARGIN to spare: at least the box's diagonal, more for a part away from
+    the origin (else its passes would leave the guide and stop short)."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    corners = np.array(list(product(*zip(lo, hi))))
+    reach = float(np.max(np.linalg.norm(corners - plane.offset * plane.normal, axis=1)))
+    return max(float(np.linalg.norm(hi - lo)), reach) + GUIDE_MARGIN
 
 
 def guide_face(plane, size: float, job: Job, whole: bool = False) -> FaceSurface:

@@ -132,7 +132,7 @@ class _Pass:
         self.nrm = plane.normal
         self.origin = plane.offset * plane.normal
         self.y_axis = np.cross(plane.normal, plane.direction)
-        self.guide = guide_face(plane, setup.size, job)
+        self.guide = guide_face(plane, setup.guide_size(plane), job)
         self.fixed_guard = guard
         self.crossings = {f: sorted(e.crossings(self.nrm, plane.offset, self.travel),
                                     key=lambda c: c.s) for f, e in setup.edges.items()}
