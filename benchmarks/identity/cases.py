@@ -264,11 +264,11 @@ SHARED = [
          (("finish", "{part}", "--faces", "7", "8", "--radius", "1", "--axis", "-Z",
            "--strategy", "steep-shallow", "--stepover", "0.5", "--stepdown", "1",
            "--allow-partial", *PROGRAM),), exits=(6,)),
-    # refused by the gate (exit 5): cuts under the torus that a plunge along +Z reaches
-    # through the face (exit 3 before 2026-11-29: every guide plane, centred on the
-    # origin, missed the part at z 114-161)
-    replace(finish("shared-finish-raster-toroidal", TORUS, (1,), 3, "--stepover", "2"),
-            exits=(5,)),
+    # 19 cuts, exit 0 (2026-11-29: exit 3 while every guide plane, centred on the origin,
+    # missed the part at z 114-161; then exit 5 while the guard took OCCT's wrong shank
+    # distance to this torus; a link of this program still comes 2.89 mm near the face
+    # with its shank: docs/notes/guard-calls.md)
+    finish("shared-finish-raster-toroidal", TORUS, (1,), 3, "--stepover", "2"),
 ]
 
 GROUPS = {"fast": FAST, "slow": SLOW, "shared": SHARED}

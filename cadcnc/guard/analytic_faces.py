@@ -167,6 +167,53 @@ class AnalyticFace:
         is the range of its values at the quartic's real roots and at both ends (numpy's
         companion-matrix roots, polished by Newton).
         """
+        got = self._core_distances(p, length)
+        if got is None:
+            return None
+        lo, hi = min(got[1]), max(got[1])
+        if lo <= self.r <= hi:
+            return 0.0
+        return lo - self.r if lo > self.r else self.r - hi
+
+    def segment_nearest(self, p, length: float) -> float | None:
+        """The s in [0, length] (mm) where the segment p .. p + length z comes nearest the
+        whole torus (where it crosses it, a crossing to 1e-9 mm), from the candidates of
+        :meth:`segment_lower_bound`; None for other kinds or near the axis. The face's
+        distance there bounds the segment's from above: a second opinion where OCCT's
+        curve-to-surface extrema misses the minimum (docs/notes/guard-calls.md)."""
+        got = self._core_distances(p, length)
+        if got is None:
+            return None
+        cands, gs = got
+        order = sorted(range(len(cands)), key=lambda i: cands[i])
+        for i, j in zip(order, order[1:]):   # a crossing: g - r changes sign between two
+            a, b = cands[i], cands[j]
+            fa = gs[i] - self.r
+            if fa == 0.0:
+                return a
+            if fa * (gs[j] - self.r) < 0.0:
+                for _ in range(60):
+                    m = 0.5 * (a + b)
+                    if b - a <= 1e-9:   # mm: the crossing found to a nanometre
+                        break
+                    if (self._core_at(p, m) - self.r) * fa > 0.0:
+                        a = m
+                    else:
+                        b = m
+                return 0.5 * (a + b)
+        return cands[min(range(len(cands)), key=lambda i: abs(gs[i] - self.r))]
+
+    def _core_at(self, p, s: float) -> float:
+        """g(s): the distance from p + s z to the tube's core circle (mm)."""
+        q = (p[0], p[1], p[2] + s)
+        w = _sub(q, self.o)
+        ax = _dot(w, self.z)
+        rho = _norm(_axpy(-ax, self.z, w))
+        return math.hypot(rho - self.r_major, ax)
+
+    def _core_distances(self, p, length: float) -> tuple[list, list] | None:
+        """(candidates s, g at each): both ends and the real roots in [0, length] of g's
+        critical-point quartic (:meth:`segment_lower_bound`), or None."""
         if self.kind != "torus":
             return None
         w0 = _sub(p, self.o)
@@ -198,10 +245,7 @@ class AnalyticFace:
             rho = math.sqrt(max(qa * s * s + 2.0 * qb * s + qc, 0.0))
             ax = _dot(_sub((p[0], p[1], p[2] + s), self.o), self.z)
             gs.append(math.hypot(rho - self.r_major, ax))
-        lo, hi = min(gs), max(gs)
-        if lo <= self.r <= hi:
-            return 0.0
-        return lo - self.r if lo > self.r else self.r - hi
+        return cands, gs
 
 
 def _xyz(v) -> tuple[float, float, float]:

@@ -53,6 +53,11 @@ TIE = 1e-9  # mm: margins this close are the same contact
 BOX_SLACK = 1e-4  # mm added to each face box: OCCT's optimal box is tight, not outer-exact
 
 
+SECOND_OPINION = 1e-7
+"""mm: a torus's second opinion replaces OCCT's segment distance only when nearer by more
+than OCCT's precision (where OCCT is right they agree, and nothing changes)."""
+
+
 class ClearanceGuard:
     """The clearance of ball + shank from a part, for the pair of faces ``pair``.
 
@@ -288,12 +293,34 @@ class ClearanceGuard:
         ext = BRepExtrema_DistShapeShape(shape, face)
         if not ext.IsDone() or ext.NbSolution() == 0:
             return -math.inf, False  # fail closed: an unknown distance is a hit
+        second = self._torus_second_opinion(k, p, z0, z1, ext.Value())
+        if second < ext.Value() - SECOND_OPINION:   # OCCT missed the nearer part
+            return min(second, cut), False
         if ext.Value() > cut:
             return cut, False
         own = all(ext.SupportTypeShape2(n) != BRepExtrema_IsInFace
                   and self._own_shapes.Contains(ext.SupportOnShape2(n))
                   for n in range(1, ext.NbSolution() + 1))
         return ext.Value(), own
+
+    def _torus_second_opinion(self, k: int, p, z0: float, z1: float, occt: float) -> float:
+        """On a torus face, the face's distance (mm) at the point of the segment (p_x,
+        p_y) x [z0, z1] nearest the whole torus (closed form): an upper bound of the
+        segment's distance that OCCT's curve-to-surface extrema can miss (it proposed one
+        extremum, on the seam, for bug28414's torus: docs/notes/guard-calls.md); inf on
+        other faces, or where the whole torus comes no nearer there than ``occt`` (the
+        face, a part of it, cannot either: no distance asked)."""
+        a = self._analytic[k - 1]
+        if a.kind != "torus":
+            return math.inf
+        s = a.segment_nearest((p[0], p[1], z0), z1 - z0)
+        if s is None:
+            return math.inf
+        q = (p[0], p[1], z0 + s)
+        whole = a.point_distance(q, trimmed=False)   # None: no unique foot there
+        if whole is not None and whole >= occt - SECOND_OPINION:
+            return math.inf
+        return self._point_distance(k, q)
 
     def _closed_segment_distance(self, k: int, p, length: float) -> float | None:
         """The closed forms of :meth:`_segment_distance` (mm), or None when none applies."""

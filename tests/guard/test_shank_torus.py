@@ -3,9 +3,10 @@
 
 At the first centre of ``cadcnc finish ... --faces 1 --radius 3 --stepover 2`` the shank
 (straight up, 10 R) comes within 0.71 mm of the face by OCCT's point-to-face distances
-along it, while OCCT's segment-to-face distance says 2.99 mm; the guard ends in the latter
-and passes the centre (docs/notes/guard-calls.md). Known wrong: strict xfail until the
-shank check brackets OCCT's answer.
+along it, while OCCT's segment-to-face distance says 2.99 mm. The guard passed the centre
+on OCCT's word; it now takes a torus's second opinion (the face's distance where the
+segment comes nearest the whole torus, in closed form) and sees the shank hit by as much
+as the points along it show (docs/notes/guard-calls.md).
 """
 
 from __future__ import annotations
@@ -47,8 +48,6 @@ def test_points_along_the_shank_come_within_a_millimetre_of_the_torus(torus):
     assert torus[2] < 0.72
 
 
-@pytest.mark.xfail(strict=True, reason="OCCT's segment-to-face distance misses this torus "
-                   "(2.99 against 0.71 mm): docs/notes/guard-calls.md")
 def test_the_guard_sees_the_shank_cross_the_torus(torus):
     part, job, reach = torus
     guard = guard_for(part, (1,), job, own_share=FINISH_OWN_SHARE)
