@@ -264,10 +264,9 @@ SHARED = [
          (("finish", "{part}", "--faces", "7", "8", "--radius", "1", "--axis", "-Z",
            "--strategy", "steep-shallow", "--stepover", "0.5", "--stepdown", "1",
            "--allow-partial", *PROGRAM),), exits=(6,)),
-    # 19 cuts, exit 0 (2026-11-29: exit 3 while every guide plane, centred on the origin,
+    # 18 cuts, exit 0 (2026-11-29: exit 3 while every guide plane, centred on the origin,
     # missed the part at z 114-161; then exit 5 while the guard took OCCT's wrong shank
-    # distance to this torus; a link of this program still comes 2.89 mm near the face
-    # with its shank: docs/notes/guard-calls.md)
+    # distance to this torus: docs/notes/guard-calls.md)
     finish("shared-finish-raster-toroidal", TORUS, (1,), 3, "--stepover", "2"),
 ]
 

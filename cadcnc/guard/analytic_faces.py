@@ -19,6 +19,8 @@ from OCP.gp import gp_Pnt2d
 from OCP.TopAbs import TopAbs_IN
 
 EPS = 1e-12   # relative: below this a direction or radius is degenerate
+SAMPLE_STEP = 0.01   # mm: a torus's nearest segment point sampled this finely where its
+                     # quartic degenerates (the segment meets the axis)
 
 
 class AnalyticFace:
@@ -183,7 +185,7 @@ class AnalyticFace:
         curve-to-surface extrema misses the minimum (docs/notes/guard-calls.md)."""
         got = self._core_distances(p, length)
         if got is None:
-            return None
+            return self._sampled_nearest(p, length) if self.kind == "torus" else None
         cands, gs = got
         order = sorted(range(len(cands)), key=lambda i: cands[i])
         for i, j in zip(order, order[1:]):   # a crossing: g - r changes sign between two
@@ -202,6 +204,17 @@ class AnalyticFace:
                         b = m
                 return 0.5 * (a + b)
         return cands[min(range(len(cands)), key=lambda i: abs(gs[i] - self.r))]
+
+    def _sampled_nearest(self, p, length: float) -> float:
+        """Where the segment meets the torus's axis (its quartic degenerates there): the
+        s of the least |g - r| over points SAMPLE_STEP mm apart (an upper bound's place,
+        enough for a second opinion that only lowers a distance)."""
+        s = np.linspace(0.0, length, max(int(math.ceil(length / SAMPLE_STEP)), 1) + 1)
+        w = np.stack([p[0] - self.o[0] + 0.0 * s, p[1] - self.o[1] + 0.0 * s,
+                      p[2] - self.o[2] + s], axis=1)
+        ax = w @ np.asarray(self.z)
+        rho = np.linalg.norm(w - np.outer(ax, self.z), axis=1)
+        return float(s[int(np.argmin(np.abs(np.hypot(rho - self.r_major, ax) - self.r)))])
 
     def _core_at(self, p, s: float) -> float:
         """g(s): the distance from p + s z to the tube's core circle (mm)."""

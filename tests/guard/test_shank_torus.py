@@ -23,6 +23,7 @@ from helpers.fixtures import FIXTURES
 
 R = 3.0
 CENTRE = np.array([-24.28685105, -8.0, 113.73716078])   # the finish program's first centre
+ON_AXIS = np.array([-37.8412, 0.0, 116.4141])   # a centre whose shank meets the torus's axis
 
 
 @pytest.fixture(scope="module")
@@ -32,12 +33,12 @@ def torus():
     return part, job, _sampled_shank_distance(part, job.tool.shank)
 
 
-def _sampled_shank_distance(part, shank: float) -> float:
+def _sampled_shank_distance(part, shank: float, centre=CENTRE) -> float:
     """The least OCCT point-to-face distance over 200 points of the shank's axis."""
     face = part.face(1).topods
     out = np.inf
-    for z in CENTRE[2] + np.linspace(0.0, shank, 200):
-        v = BRepBuilderAPI_MakeVertex(gp_Pnt(CENTRE[0], CENTRE[1], float(z))).Vertex()
+    for z in centre[2] + np.linspace(0.0, shank, 200):
+        v = BRepBuilderAPI_MakeVertex(gp_Pnt(centre[0], centre[1], float(z))).Vertex()
         x = BRepExtrema_DistShapeShape(v, face)
         x.Perform()
         out = min(out, x.Value())
@@ -52,4 +53,16 @@ def test_the_guard_sees_the_shank_cross_the_torus(torus):
     part, job, reach = torus
     guard = guard_for(part, (1,), job, own_share=FINISH_OWN_SHARE)
     margin, detail = guard.margin(tuple(CENTRE))
+    assert "shank" in detail and margin <= reach - job.tool.offset + 1e-3
+
+
+def test_the_guard_sees_the_shank_where_it_meets_the_torus_axis(torus):
+    """Where the vertical shank meets the torus's axis (y = 0 here) the closed form's
+    quartic degenerates; the second opinion samples the segment instead (cut 28's last
+    centre: the shank 2.84 mm from the face by the points along it)."""
+    part, job, _ = torus
+    reach = _sampled_shank_distance(part, job.tool.shank, ON_AXIS)
+    assert reach < job.tool.offset - 0.1
+    margin, detail = guard_for(part, (1,), job, own_share=FINISH_OWN_SHARE).margin(
+        tuple(ON_AXIS))
     assert "shank" in detail and margin <= reach - job.tool.offset + 1e-3
