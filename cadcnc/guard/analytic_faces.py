@@ -186,7 +186,7 @@ class AnalyticFace:
         got = self._core_distances(p, length)
         if got is None:
             return self._sampled_nearest(p, length) if self.kind == "torus" else None
-        cands, gs = got
+        cands, gs, g = got
         order = sorted(range(len(cands)), key=lambda i: cands[i])
         for i, j in zip(order, order[1:]):   # a crossing: g - r changes sign between two
             a, b = cands[i], cands[j]
@@ -198,7 +198,7 @@ class AnalyticFace:
                     m = 0.5 * (a + b)
                     if b - a <= 1e-9:   # mm: the crossing found to a nanometre
                         break
-                    if (self._core_at(p, m) - self.r) * fa > 0.0:
+                    if (g(m) - self.r) * fa > 0.0:
                         a = m
                     else:
                         b = m
@@ -216,17 +216,10 @@ class AnalyticFace:
         rho = np.linalg.norm(w - np.outer(ax, self.z), axis=1)
         return float(s[int(np.argmin(np.abs(np.hypot(rho - self.r_major, ax) - self.r)))])
 
-    def _core_at(self, p, s: float) -> float:
-        """g(s): the distance from p + s z to the tube's core circle (mm)."""
-        q = (p[0], p[1], p[2] + s)
-        w = _sub(q, self.o)
-        ax = _dot(w, self.z)
-        rho = _norm(_axpy(-ax, self.z, w))
-        return math.hypot(rho - self.r_major, ax)
-
-    def _core_distances(self, p, length: float) -> tuple[list, list] | None:
-        """(candidates s, g at each): both ends and the real roots in [0, length] of g's
-        critical-point quartic (:meth:`segment_lower_bound`), or None."""
+    def _core_distances(self, p, length: float) -> tuple[list, list, object] | None:
+        """(candidates s, g at each, g): both ends and the real roots in [0, length] of
+        g's critical-point quartic (:meth:`segment_lower_bound`), g(s) the distance from
+        p + s z to the tube's core circle (mm); or None."""
         if self.kind != "torus":
             return None
         w0 = _sub(p, self.o)
@@ -253,12 +246,13 @@ class AnalyticFace:
                 s = t
             if 0.0 <= s <= length:
                 cands.append(s)
-        gs = []
-        for s in cands:
+
+        def g(s: float) -> float:
             rho = math.sqrt(max(qa * s * s + 2.0 * qb * s + qc, 0.0))
             ax = _dot(_sub((p[0], p[1], p[2] + s), self.o), self.z)
-            gs.append(math.hypot(rho - self.r_major, ax))
-        return cands, gs
+            return math.hypot(rho - self.r_major, ax)
+
+        return cands, [g(s) for s in cands], g
 
 
 def _xyz(v) -> tuple[float, float, float]:
