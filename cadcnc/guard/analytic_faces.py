@@ -187,13 +187,42 @@ class AnalyticFace:
         if got is None:
             return self._sampled_nearest(p, length) if self.kind == "torus" else None
         cands, gs, g = got
+        crossings = self._crossings(cands, gs, g, first=True)
+        if crossings:
+            return crossings[0]
+        return cands[min(range(len(cands)), key=lambda i: abs(gs[i] - self.r))]
+
+    def segment_interior(self, p, length: float) -> list[float] | None:
+        """The distances (mm) from the segment p .. p + length z to a torus face at the
+        segment's points where its distance to the whole torus is locally least (both ends,
+        the quartic's critical points, the crossings) whose foot lies strictly inside the
+        face: every nearest pair of the segment and the face's interior is one of them (a
+        torus has one local foot per point off its axis and core). None for other kinds,
+        near the axis, or where a foot is not unique: the caller asks OCCT."""
+        got = self._core_distances(p, length)
+        if got is None:
+            return None
+        cands, gs, g = got
+        out = []
+        for s in cands + self._crossings(cands, gs, g):
+            foot_d = self._surface_foot((p[0], p[1], p[2] + s))
+            if foot_d is None:
+                return None
+            if self._inside(foot_d[0]):
+                out.append(foot_d[1])
+        return out
+
+    def _crossings(self, cands: list, gs: list, g, first: bool = False) -> list[float]:
+        """The s where g - r changes sign between two consecutive candidates, each found
+        to a nanometre by bisection (only the first when ``first``)."""
         order = sorted(range(len(cands)), key=lambda i: cands[i])
-        for i, j in zip(order, order[1:]):   # a crossing: g - r changes sign between two
+        out = []
+        for i, j in zip(order, order[1:]):
             a, b = cands[i], cands[j]
             fa = gs[i] - self.r
             if fa == 0.0:
-                return a
-            if fa * (gs[j] - self.r) < 0.0:
+                out.append(a)
+            elif fa * (gs[j] - self.r) < 0.0:
                 for _ in range(60):
                     m = 0.5 * (a + b)
                     if b - a <= 1e-9:   # mm: the crossing found to a nanometre
@@ -202,8 +231,10 @@ class AnalyticFace:
                         a = m
                     else:
                         b = m
-                return 0.5 * (a + b)
-        return cands[min(range(len(cands)), key=lambda i: abs(gs[i] - self.r))]
+                out.append(0.5 * (a + b))
+            if first and out:
+                break
+        return out
 
     def _sampled_nearest(self, p, length: float) -> float:
         """Where the segment meets the torus's axis (its quartic degenerates there): the

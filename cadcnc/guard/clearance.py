@@ -53,6 +53,9 @@ TIE = 1e-9  # mm: margins this close are the same contact
 BOX_SLACK = 1e-4  # mm added to each face box: OCCT's optimal box is tight, not outer-exact
 
 
+OWN_SLOPE = 2.0
+"""The own-face margin's Lipschitz constant in the centre (mm per mm): the segment's
+distance less the ball's, each 1-Lipschitz."""
 SECOND_OPINION = 1e-7
 """mm: a torus's second opinion replaces OCCT's segment distance only when nearer by more
 than OCCT's precision (where OCCT is right they agree, and nothing changes)."""
@@ -102,6 +105,7 @@ class ClearanceGuard:
         self.exact_calls = 0     # OCCT distances
         self.closed_calls = 0    # closed-form distances
         self.broad_calls = 0
+        self.proven_calls = 0    # answers proven without a distance
 
     # -- the guard ------------------------------------------------------------------------
     def margin(self, p) -> tuple[float, str]:
@@ -117,7 +121,7 @@ class ClearanceGuard:
         from the lowest bound up): (clearance or, on such a hit, the hit face's exact
         margin, an upper bound of the clearance, mm; detail; whether it is the exact
         clearance). For a verdict that needs only the sign."""
-        return self._margin(p, True)
+        return self._margin(p, True)[:3]
 
     def clears(self, p) -> bool:
         """Whether the tool at ``p`` clears the part (``margin(p) >= 0``), stopping at the
@@ -125,17 +129,62 @@ class ClearanceGuard:
         (the setups' reach samples)."""
         return self._margin(p, True)[0] >= 0.0
 
-    def _margin(self, p, stop: bool) -> tuple[float, str, bool]:
-        """:meth:`margin`, stopping at the first hit when ``stop`` (:meth:`first_hit`)."""
+    def clear_along(self, points) -> list[bool]:
+        """Whether the tool clears the part at each of ``points`` ((m, 3) mm, in order
+        along a run: a free run past a collision), as ``margin(p)[0] >= 0`` says, measured
+        only where no hit measured before decides: an own face's margin is 2-Lipschitz in
+        the centre (the segment's distance less the ball's), so a hit m0 < 0 on it at p0
+        is still one at p while m0 + 2 |p - p0| < 0; on an own torus face a point of the
+        shank proves one (:meth:`_torus_hit`); a third face's hits go through
+        :meth:`proven_hit` (its shared edges can clear it)."""
+        out = []
+        own_hit = None   # (p0, m0) of the last own face's measured hit
+        for q in points:
+            p = (float(q[0]), float(q[1]), float(q[2]))
+            if own_hit is not None and \
+                    own_hit[1] + OWN_SLOPE * distance(p, own_hit[0]) < 0.0:
+                self.proven_calls += 1
+                out.append(False)
+                continue
+            if (self._hits and self.proven_hit(p) is not None) or self._torus_hit(p):
+                self.proven_calls += 1
+                out.append(False)
+                continue
+            m, _, _, face = self._margin(p, False)
+            own_hit = (p, m) if m < 0.0 and face in self.pair else None
+            out.append(m >= 0.0)
+        return out
+
+    def _torus_hit(self, p) -> bool:
+        """Whether an own torus face proves a hit at ``p`` without OCCT's segment distance:
+        the face's distance at the shank's point nearest the whole torus (an upper bound
+        of the shank's distance) is below the ball's less tol."""
+        for k in self.pair:
+            a = self._analytic[k - 1]
+            if a.kind != "torus" or not self._own_rule[k] or \
+                    self._hi[k - 1][2] - BOX_SLACK <= p[2]:   # (the face below: clear)
+                continue
+            s = a.segment_nearest(p, self.shank)
+            if s is None:
+                continue
+            d_q = self._point_distance(k, (p[0], p[1], p[2] + s))
+            d_p = self._point_distance(k, p)
+            if d_q - (d_p - self.tol) < 0.0:   # (-inf, unknown: a hit, failing closed)
+                return True
+        return False
+
+    def _margin(self, p, stop: bool) -> tuple[float, str, bool, int | None]:
+        """:meth:`margin`, stopping at the first hit when ``stop`` (:meth:`first_hit`),
+        and the face of the margin (None: no face within reach)."""
         self.calls += 1
         p = (float(p[0]), float(p[1]), float(p[2]))
         if not math.isfinite(p[0] + p[1] + p[2]):
-            return -math.inf, "ball centre is not a finite point", True   # fail closed
+            return -math.inf, "ball centre is not a finite point", True, None  # fail closed
         moved = math.inf if self._broad_at is None else distance(p, self._broad_at)
         if moved > self.reach:
             self._broad_phase(p)
             moved = 0.0
-        best, detail = self.reach - moved, ""   # lower bound for the faces not near
+        best, detail, face = self.reach - moved, "", None   # the faces not near: reach left
         bounds = [(self._bound[k][1] - self._bound[k][2] * distance(p, self._bound[k][0]), k)
                   for k in self._near]
         for m, k in sorted(bounds) if stop else bounds:
@@ -144,12 +193,12 @@ class ClearanceGuard:
                 m, who = self._exact(k, p)
             # on a tie (a wall and its rim at once) name the ball: it is what the user sees
             if m < best - TIE or (m < best + TIE and who == "ball"):
-                best = m
+                best, face = m, k
                 detail = f"{who} touches face {k}" if m < 0.0 else \
                     (f"{who} nearest face {k}" if who else f"face {k} within reach")
             if stop and best < 0.0:
-                return best, detail, False
-        return best, detail, True
+                return best, detail, False, face
+        return best, detail, True, face
 
     def _broad_phase(self, p) -> None:
         """Faces whose box may come within R' of the tool before the centre moves
@@ -278,11 +327,14 @@ class ClearanceGuard:
             face = self._free_edges(k)
             if face is None:
                 return math.inf, False
-        elif self._analytic[k - 1].kind is None:
+        elif self._analytic[k - 1].kind in (None, "torus"):
             # no closed forms (a B-spline): OCCT's pieces, its edges only where they can win
-            # (guard/face_distance.py); on r0901_ec's cylinders they rarely prune
+            # (guard/face_distance.py; on r0901_ec's cylinders they rarely prune); a torus:
+            # its interior in closed form (OCCT's extrema can miss it), its edges so
             if k not in self._pieces:
-                self._pieces[k] = FaceDistance(face, self._own_shapes)
+                a = self._analytic[k - 1]
+                self._pieces[k] = FaceDistance(face, self._own_shapes,
+                                               a if a.kind == "torus" else None)
             pieces = self._pieces[k]
             got = pieces.distance(p, z0, z1) if pieces.useful else None
             if got is not None:

@@ -82,17 +82,19 @@ class FaceDistance:
     """The distance from vertical segments to one face (module doc); ``own_shapes``: the
     edges and vertices of the pair's faces (an OCCT indexed map)."""
 
-    def __init__(self, face, own_shapes):
+    def __init__(self, face, own_shapes, closed=None):
         self.face = TopoDS.Face_s(face)
         self.own_shapes = own_shapes
+        self.closed = closed   # a torus's AnalyticFace: the interior in closed form
         edges = TopTools_IndexedMapOfShape()
         TopExp.MapShapes_s(self.face, TopAbs_EDGE, edges)
         # a degenerated edge (a surface's pole) is a point: its vertex ends the edges beside it
         self.edges = [edges.FindKey(e) for e in range(1, edges.Extent() + 1)
                       if not BRep_Tool.Degenerated_s(TopoDS.Edge_s(edges.FindKey(e)))]
         self.boxes = [span_boxes(TopoDS.Edge_s(e)) for e in self.edges]
-        # worth it only where an edge can be skipped (OCCT's line-circle extrema cost 0.1 ms)
-        self.useful = any(b is not None for b in self.boxes)
+        # worth it only where an edge can be skipped (OCCT's line-circle extrema cost 0.1 ms),
+        # or where the interior has a closed form
+        self.useful = closed is not None or any(b is not None for b in self.boxes)
         self.classifier = BRepClass_FaceClassifier()
         self.tolerance = BRep_Tool.Tolerance_s(self.face)
 
@@ -115,18 +117,9 @@ class FaceDistance:
                 for z in ((z0, z1) if z1 > z0 else (z0,))]
         seg = BRepBuilderAPI_MakeEdge(gp_Pnt(p[0], p[1], z0), gp_Pnt(p[0], p[1], z1)).Edge() \
             if z1 > z0 else ends[0]
-        pieces: list[tuple[float, bool]] = []
-        if z1 > z0:
-            ext = BRepExtrema_ExtCF(TopoDS.Edge_s(seg), self.face)
-            if not ext.IsDone():
-                return None
-            if not ext.IsParallel():   # parallel: its least is met at an end or an edge
-                pieces += self._inside(ext, ext.ParameterOnFace)
-        for v in ends:
-            ext = BRepExtrema_ExtPF(TopoDS.Vertex_s(v), self.face)
-            if not ext.IsDone():
-                return None
-            pieces += self._inside(ext, ext.Parameter)
+        pieces = self._interior(p, z0, z1, seg, ends)
+        if pieces is None:
+            return None
         best = min((d for d, _ in pieces), default=math.inf)
         bounds = self.lower_bounds(p, z0, z1)
         for i in np.argsort(bounds, kind="stable").tolist():
@@ -142,6 +135,27 @@ class FaceDistance:
         if not pieces:
             return None
         return best, all(own for d, own in pieces if d <= best + SOLUTION)
+
+    def _interior(self, p, z0: float, z1: float, seg, ends) -> list | None:
+        """(distance, False) of every nearest pair of the segment and the face's interior:
+        OCCT's extrema, or a torus's closed form (:meth:`.AnalyticFace.segment_interior`);
+        None where either cannot answer."""
+        if self.closed is not None:
+            got = self.closed.segment_interior((p[0], p[1], z0), z1 - z0)
+            return None if got is None else [(d, False) for d in got]
+        pieces: list[tuple[float, bool]] = []
+        if z1 > z0:
+            ext = BRepExtrema_ExtCF(TopoDS.Edge_s(seg), self.face)
+            if not ext.IsDone():
+                return None
+            if not ext.IsParallel():   # parallel: its least is met at an end or an edge
+                pieces += self._inside(ext, ext.ParameterOnFace)
+        for v in ends:
+            ext = BRepExtrema_ExtPF(TopoDS.Vertex_s(v), self.face)
+            if not ext.IsDone():
+                return None
+            pieces += self._inside(ext, ext.Parameter)
+        return pieces
 
     def _inside(self, ext, parameter) -> list[tuple[float, bool]]:
         """The interior pieces of an extrema search as ``BRepExtrema_DistShapeShape`` takes

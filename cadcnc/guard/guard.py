@@ -62,7 +62,6 @@ class OperationGuard(ClearanceGuard):
         self._trees: dict = {}
         self._walls: dict = {}
         self._last_point: tuple = (None, None, None)   # (face, p, d(p, face))
-        self.proven_calls = 0
 
     def height_cells(self, k: int) -> HeightCells | None:
         """The height cells of followed face k (None when it has none)."""

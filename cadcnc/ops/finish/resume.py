@@ -70,19 +70,20 @@ def clear_again(ps, face: int, at: Tangency, end, guard, why: str) -> Tangency |
 def free_run(ps, face: int, at: Tangency, end, guard):
     """(free, k, hit): the plane's curve on ``face`` from ``at`` run without the guard,
     in runs of FREE_CHUNK cycles doubling, until a clear point after a hit (index k,
-    else None) or its end; ``hit``: whether the guard's margin went negative."""
+    else None) or its end; ``hit``: whether the guard's margin went negative (the guard
+    asked along the run: :meth:`~cadcnc.guard.clearance.ClearanceGuard.clear_along`)."""
     chunk, start, hit, total = FREE_CHUNK, at, False, 0
     while True:
         free = ps.run_stepper(face, start, end, None, max_cycles=chunk)
         total += chunk
-        margins = [guard.margin(tuple(p))[0] for p in free.points[1:]]
-        for k, m in enumerate(margins, 1):
-            hit = hit or m < 0.0
-            if m >= 0.0 and hit:
+        clear = guard.clear_along(free.points[1:])
+        for k, ok in enumerate(clear, 1):
+            hit = hit or not ok
+            if ok and hit:
                 return free, k, hit
         from_max = free.stop_reason == MAX_CYCLES and len(free) > 1
         if not from_max or total >= PASS_CYCLES:
-            return free, (len(margins) if margins and margins[-1] >= 0.0 else None), hit
+            return free, (len(clear) if clear and clear[-1] else None), hit
         start, chunk = last_state(free), min(2 * chunk, PASS_CYCLES - total)
 
 
