@@ -36,6 +36,14 @@ def offset_point_and_jacobian(surface, offset: float, u: float, w: float):
     return axpy(offset, n, r), tuple(cols), n
 
 
+STALLS, PROGRESS = 3, 1e-3
+"""Newton steps in a row that brought the residual no lower than PROGRESS of the least so
+far: the search hovers at a least residual that is not 0 (no position touches both faces
+near the seed; its damped steps halve to their floor), and the steps left would too.
+A search that converges lowers it by 7 % or more a step (about 11 000 solves on
+bug27453's corners, 2 to 6 steps each)."""
+
+
 def _solve4(a: list[list[float]], b: list[float]) -> list[float]:
     """x with a x = b (4 x 4, Gaussian elimination with partial pivoting); the least-squares
     solution (numpy) where a is (nearly) singular."""
@@ -63,7 +71,8 @@ def solve_tangency(s1, s2, offsets: tuple[float, float], seed_uv1, seed_uv2, anc
     through ``anchor`` (mm) normal to ``direction`` (default n1 x n2 at the seed).
 
     Converges to |o1 - o2| and the plane residual below ``tol.start`` (mm) or raises
-    StartPointError naming ``what`` and the anchor.
+    StartPointError naming ``what`` and the anchor (after ``max_iter`` steps, or STALLS
+    steps in a row that lowered the least residual by less than PROGRESS of it).
     """
     x = [float(v) for v in (*seed_uv1, *seed_uv2)]
     anchor = tuple(float(v) for v in anchor)
@@ -84,8 +93,8 @@ def solve_tangency(s1, s2, offsets: tuple[float, float], seed_uv1, seed_uv2, anc
         raise StartPointError(f"{what}: the faces are tangent near {label}: "
                               "no intersection direction")
     t0 = scale(t0, 1.0 / norm(t0))
-    err = math.inf
-    for _ in range(max_iter):
+    err, best, stalled, steps = math.inf, math.inf, 0, 0
+    for steps in range(1, max_iter + 1):
         F = equations(o1, o2)
         err = max(abs(v) for v in F)
         if err < tol.start:
@@ -93,6 +102,12 @@ def solve_tangency(s1, s2, offsets: tuple[float, float], seed_uv1, seed_uv2, anc
             u1, w1 = s1.wrap(x[0], x[1])
             u2, w2 = s2.wrap(x[2], x[3])
             return Tangency(p, (float(u1), float(w1)), (float(u2), float(w2)))
+        if err < best * (1.0 - PROGRESS):
+            best, stalled = err, 0
+        else:
+            stalled += 1
+            if stalled >= STALLS:
+                break
         J = [[j1[0][i], j1[1][i], -j2[0][i], -j2[1][i]] for i in range(3)]
         J.append([0.5 * dot(t0, j1[0]), 0.5 * dot(t0, j1[1]),
                   0.5 * dot(t0, j2[0]), 0.5 * dot(t0, j2[1])])
@@ -117,4 +132,4 @@ def solve_tangency(s1, s2, offsets: tuple[float, float], seed_uv1, seed_uv2, anc
         o1, o2, j1, j2, n1, n2 = trial
     raise StartPointError(
         f"{what}: no cutter position touching both surfaces found near "
-        f"{label} (residual {err:.3g} mm after {max_iter} Newton steps)")
+        f"{label} (least residual {min(best, err):.3g} mm in {steps} Newton steps)")
