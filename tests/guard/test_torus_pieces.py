@@ -3,10 +3,10 @@ guard's yes-or-no along a free run.
 
 - :class:`~cadcnc.guard.face_distance.FaceDistance` with a torus's closed-form interior
   (:meth:`~cadcnc.guard.analytic_faces.AnalyticFace.segment_interior`) and OCCT's edges
-  equals the least of OCCT's point-to-face distances along the segment (301 samples,
+  equals the least of OCCT's point-to-face distances along the segment (201 samples,
   the best refined by golden section to 1e-10 mm) within 1e-7 mm, on the tori of
-  torus_cone, an inclined quarter torus and bug28414's torus (where OCCT's own segment
-  distance misses the minimum: there it is never above OCCT's).
+  torus_cone, an inclined quarter torus and bug28414's torus, where OCCT's own segment
+  distance misses the minimum on some segment (asserted); it is never above OCCT's.
 - :meth:`~cadcnc.guard.clearance.ClearanceGuard.clear_along` says what ``margin(p) >= 0``
   says at every centre of a run in and out of collision, with fewer OCCT distances.
 """
@@ -42,7 +42,7 @@ def _point(face, p) -> float:
 def sampled_distance(face, p, length: float) -> float:
     """The least OCCT point distance over 301 points of the segment p .. p + length z,
     each of the three best refined by golden section over its neighbours' interval."""
-    s = np.linspace(0.0, length, 301)
+    s = np.linspace(0.0, length, 201)
     d = np.array([_point(face, (p[0], p[1], p[2] + x)) for x in s])
     best = float(d.min())
     for k in np.argsort(d)[:3].tolist():
@@ -74,13 +74,13 @@ def _tori():
 @pytest.mark.parametrize("seed", [5])
 def test_torus_face_distance_equals_sampled_point_distances(seed):
     rng = np.random.default_rng(seed)
-    checked = kinds = 0
+    checked = kinds = missed = 0
     for face in _tori():
         a = AnalyticFace(face)
         assert a.kind == "torus"
         pieces = FaceDistance(face.topods, TopTools_IndexedMapOfShape(), a)
         answered = 0
-        for p, _ in samples(face, rng, 8):
+        for p, _ in samples(face, rng, 6):
             length = float(rng.choice([5.0, 30.0]))
             got = pieces.distance(p, p[2], p[2] + length)
             if got is None:
@@ -89,10 +89,13 @@ def test_torus_face_distance_equals_sampled_point_distances(seed):
             ref = sampled_distance(face, p, length)
             assert got[0] == pytest.approx(ref, abs=1e-7), (p, length)
             # OCCT's own segment distance is never nearer (on bug28414's torus it misses)
-            assert got[0] <= occt_distance(face, p, length) + 1e-7
+            occt = occt_distance(face, p, length)
+            assert got[0] <= occt + 1e-7
+            missed += occt > ref + 1e-3
         checked += answered
         kinds += answered > 0
-    assert kinds == 4 and checked >= 24, (kinds, checked)
+    assert kinds == 4 and checked >= 20, (kinds, checked)
+    assert missed, "no segment where OCCT's segment distance misses: the case went untested"
 
 
 def test_clear_along_says_what_the_margins_say():
