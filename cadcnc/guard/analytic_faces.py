@@ -18,6 +18,8 @@ import numpy as np
 from OCP.gp import gp_Pnt2d
 from OCP.TopAbs import TopAbs_IN
 
+from ..geometry.torus_segment import Torus, core_distances, crossings
+
 EPS = 1e-12   # relative: below this a direction or radius is degenerate
 SAMPLE_STEP = 0.01   # mm: a torus's nearest segment point sampled this finely where its
                      # quartic degenerates (the segment meets the axis)
@@ -44,6 +46,7 @@ class AnalyticFace:
             self.r_major, self.r = g.MajorRadius(), g.MinorRadius()
             if self.r >= self.r_major:     # a horn or spindle torus: no simple foot
                 return
+            self._torus = Torus(self.o, self.z, self.r_major, self.r)
         self.kind = face.kind
         self._uv = gp_Pnt2d()
 
@@ -187,9 +190,9 @@ class AnalyticFace:
         if got is None:
             return self._sampled_nearest(p, length) if self.kind == "torus" else None
         cands, gs, g = got
-        crossings = self._crossings(cands, gs, g, first=True)
-        if crossings:
-            return crossings[0]
+        first = crossings(self._torus, cands, gs, g, first=True)
+        if first:
+            return first[0]
         return cands[min(range(len(cands)), key=lambda i: abs(gs[i] - self.r))]
 
     def segment_interior(self, p, length: float) -> list[float] | None:
@@ -204,36 +207,12 @@ class AnalyticFace:
             return None
         cands, gs, g = got
         out = []
-        for s in cands + self._crossings(cands, gs, g):
+        for s in cands + crossings(self._torus, cands, gs, g):
             foot_d = self._surface_foot((p[0], p[1], p[2] + s))
             if foot_d is None:
                 return None
             if self._inside(foot_d[0]):
                 out.append(foot_d[1])
-        return out
-
-    def _crossings(self, cands: list, gs: list, g, first: bool = False) -> list[float]:
-        """The s where g - r changes sign between two consecutive candidates, each found
-        to a nanometre by bisection (only the first when ``first``)."""
-        order = sorted(range(len(cands)), key=lambda i: cands[i])
-        out = []
-        for i, j in zip(order, order[1:]):
-            a, b = cands[i], cands[j]
-            fa = gs[i] - self.r
-            if fa == 0.0:
-                out.append(a)
-            elif fa * (gs[j] - self.r) < 0.0:
-                for _ in range(60):
-                    m = 0.5 * (a + b)
-                    if b - a <= 1e-9:   # mm: the crossing found to a nanometre
-                        break
-                    if (g(m) - self.r) * fa > 0.0:
-                        a = m
-                    else:
-                        b = m
-                out.append(0.5 * (a + b))
-            if first and out:
-                break
         return out
 
     def _sampled_nearest(self, p, length: float) -> float:
@@ -248,42 +227,12 @@ class AnalyticFace:
         return float(s[int(np.argmin(np.abs(np.hypot(rho - self.r_major, ax) - self.r)))])
 
     def _core_distances(self, p, length: float) -> tuple[list, list, object] | None:
-        """(candidates s, g at each, g): both ends and the real roots in [0, length] of
-        g's critical-point quartic (:meth:`segment_lower_bound`), g(s) the distance from
-        p + s z to the tube's core circle (mm); or None."""
+        """(candidates s, g at each, g) of the vertical segment on a torus
+        (:func:`~cadcnc.geometry.torus_segment.core_distances`); None for other kinds or
+        where the segment meets the axis."""
         if self.kind != "torus":
             return None
-        w0 = _sub(p, self.o)
-        w0 = _axpy(-_dot(w0, self.z), self.z, w0)            # radial part at s = 0
-        e = _axpy(-self.z[2], self.z, (0.0, 0.0, 1.0))       # radial part of +z
-        qa, qb, qc = _dot(e, e), _dot(w0, e), _dot(w0, w0)   # rho^2 = qa s^2 + 2 qb s + qc
-        s_v = min(max(-qb / qa, 0.0), length) if qa > EPS else 0.0
-        if qa * s_v * s_v + 2.0 * qb * s_v + qc < (EPS * self.r_major) ** 2 + 1e-18:  # mm^2
-            return None                                     # the segment meets the axis
-        b = p[2] - self.o[2]                                 # q' / 2 = s + b
-        quartic = np.convolve([1.0, 2.0 * b, b * b], [qa, 2.0 * qb, qc])   # 5 coefficients
-        quartic[2:] -= self.r_major ** 2 * np.array([qa * qa, 2.0 * qa * qb, qb * qb])
-        cands = [0.0, length]
-        deriv = np.polyder(quartic)
-        # every root's real part is a candidate: g's value at an extra point stays within
-        # g's true range, and a near-double real root may come out slightly complex
-        for root in np.roots(quartic) if np.any(quartic) else ():
-            s = float(root.real)
-            for _ in range(2):   # polish on the quartic, only where it improves
-                d = float(np.polyval(deriv, s))
-                t = s - float(np.polyval(quartic, s)) / d if d else s
-                if not abs(np.polyval(quartic, t)) < abs(np.polyval(quartic, s)):
-                    break
-                s = t
-            if 0.0 <= s <= length:
-                cands.append(s)
-
-        def g(s: float) -> float:
-            rho = math.sqrt(max(qa * s * s + 2.0 * qb * s + qc, 0.0))
-            ax = _dot(_sub((p[0], p[1], p[2] + s), self.o), self.z)
-            return math.hypot(rho - self.r_major, ax)
-
-        return cands, [g(s) for s in cands], g
+        return core_distances(self._torus, p, length)
 
 
 def _xyz(v) -> tuple[float, float, float]:

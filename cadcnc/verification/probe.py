@@ -30,6 +30,7 @@ from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_OUT, TopAbs_REVERSED
 from ..core.tolerances import DEFAULT, Tolerances
 from ..core.trim_labels import BOUNDARY, INSIDE, OUTSIDE
 from ..geometry.boxes import optimal_box
+from ..geometry.torus_segment import Torus, local_nearest
 from .box_face import whole_box
 from .face_boundary import FaceEdges
 from .surface_bound import SurfaceBound
@@ -88,6 +89,7 @@ class FaceProbe:
         self._natural = None
         self._inner = None
         self._bound = False   # the SurfaceBound, made on first use (None: none applies)
+        self._ring = False    # the face's Torus, made on first use (None: not a ring torus)
 
     # -- surface -----------------------------------------------------------------------
     def normal(self, u: float, w: float) -> np.ndarray:
@@ -222,7 +224,10 @@ class FaceProbe:
 
     def segment_distance(self, a, b) -> float:
         """Exact distance from the straight segment a-b to the trimmed face (nan if OCCT
-        cannot say): BRepExtrema_DistShapeShape of an edge built on the segment."""
+        cannot say): BRepExtrema_DistShapeShape of an edge built on the segment; on a
+        torus also the face's distances at the segment's points where the whole torus
+        is locally nearest (:func:`~cadcnc.geometry.torus_segment.local_nearest`), as
+        OCCT's extrema can miss the interior's minimum there (bug28414's torus)."""
         a, b = np.asarray(a, float), np.asarray(b, float)
         length = float(np.linalg.norm(b - a))
         if length <= SEGMENT_AS_POINT:  # no edge: the midpoint, less half the length
@@ -234,7 +239,25 @@ class FaceProbe:
         self._dss.Perform()
         if not self._dss.IsDone() or self._dss.NbSolution() == 0:
             return math.nan
-        return self._dss.Value()
+        x = self._dss.Value()
+        torus = self._torus()
+        if torus is not None:   # OCCT's curve-to-torus extrema can miss the interior's
+            d = (b - a) / length   # minimum: the face's distance where it may lie, too
+            for s in local_nearest(torus, tuple(a), length, tuple(d)):
+                x = min(x, self.face_distance(a + s * d)[1])   # (nan: no lower)
+        return x
+
+    def _torus(self) -> Torus | None:
+        """The face's torus (a ring torus: major > minor radius), else None."""
+        if self._ring is False:
+            self._ring = None
+            if self.adaptor.GetType() == GeomAbs_Torus:
+                g = self.adaptor.Torus()
+                o, z = g.Position().Location(), g.Position().Direction()
+                if g.MinorRadius() < g.MajorRadius():
+                    self._ring = Torus((o.X(), o.Y(), o.Z()), (z.X(), z.Y(), z.Z()),
+                                       g.MajorRadius(), g.MinorRadius())
+        return self._ring
 
     def edge_gap(self, point, enough: float = math.inf) -> float:
         """The distance from ``point`` to the face's boundary, or a lower bound of it

@@ -13,12 +13,8 @@ guard's yes-or-no along a free run.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
-from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.gp import gp_Pnt, gp_Vec
 from OCP.TopTools import TopTools_IndexedMapOfShape
 from test_analytic_distance import inclined_torus, occt_distance, samples
@@ -28,39 +24,7 @@ from cadcnc.guard import FINISH_OWN_SHARE, guard_for
 from cadcnc.guard.analytic_faces import AnalyticFace
 from cadcnc.guard.face_distance import FaceDistance
 from helpers.fixtures import FIXTURES
-
-GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
-
-
-def _point(face, p) -> float:
-    ext = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(*p)).Vertex(),
-                                     face.topods)
-    assert ext.IsDone()
-    return ext.Value()
-
-
-def sampled_distance(face, p, length: float) -> float:
-    """The least OCCT point distance over 301 points of the segment p .. p + length z,
-    each of the three best refined by golden section over its neighbours' interval."""
-    s = np.linspace(0.0, length, 201)
-    d = np.array([_point(face, (p[0], p[1], p[2] + x)) for x in s])
-    best = float(d.min())
-    for k in np.argsort(d)[:3].tolist():
-        a, b = s[max(k - 1, 0)], s[min(k + 1, len(s) - 1)]
-        f = lambda x: _point(face, (p[0], p[1], p[2] + x))   # noqa: E731
-        c, e = b - GOLDEN * (b - a), a + GOLDEN * (b - a)
-        fc, fe = f(c), f(e)
-        while b - a > 1e-10:
-            if fc < fe:
-                b, e, fe = e, c, fc
-                c = b - GOLDEN * (b - a)
-                fc = f(c)
-            else:
-                a, c, fc = c, e, fe
-                e = a + GOLDEN * (b - a)
-                fe = f(e)
-        best = min(best, fc, fe)
-    return best
+from helpers.segment_reference import sampled_segment_distance
 
 
 def _tori():
@@ -86,7 +50,7 @@ def test_torus_face_distance_equals_sampled_point_distances(seed):
             if got is None:
                 continue
             answered += 1
-            ref = sampled_distance(face, p, length)
+            ref = sampled_segment_distance(face.topods, p, (p[0], p[1], p[2] + length))
             assert got[0] == pytest.approx(ref, abs=1e-7), (p, length)
             # OCCT's own segment distance is never nearer (on bug28414's torus it misses)
             occt = occt_distance(face, p, length)

@@ -1,0 +1,137 @@
+"""Where a straight segment comes locally nearest a whole torus, in closed form.
+
+A torus (centre o, unit axis z, major radius R, minor r) is at distance |g - r| from a
+point, g the point's distance to the tube's core circle. Along the segment p + s d
+(|d| = 1, s in [0, length]) g^2 = q - 2 R rho + R^2, q the squared distance to o and rho
+the distance to the axis, both square roots of quadratics in s; g's critical points solve
+(s + b)^2 rho^2(s) = R^2 (A s + B)^2 (b = (p - o).d, rho^2 = A s^2 + 2 B s + C), a
+quartic. So the places where |g - r| is locally least are among: both ends, the quartic's
+real roots, and the crossings of g = r between them. A face of the torus is met at its
+interior only where the segment's point has its (unique) foot inside the face, i.e. at one
+of these places, or at a point on the axis (every point of a circle is then a foot).
+
+Used by the guard (:mod:`cadcnc.guard.analytic_faces`, vertical segments) and by the gate
+(:mod:`cadcnc.verification.probe`, any move), each measuring the face itself. Lengths mm.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+EPS = 1e-12   # relative: below this a direction or radius is degenerate
+UP = (0.0, 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class Torus:
+    """A torus: centre ``o``, unit axis ``z`` (3-tuples), radii ``major`` > ``minor``."""
+
+    o: tuple[float, float, float]
+    z: tuple[float, float, float]
+    major: float
+    minor: float
+
+
+def core_distances(t: Torus, p, length: float, d=UP) -> tuple[list, list, Callable] | None:
+    """(candidates s, g at each, g): both ends and the real parts of the quartic's roots
+    in [0, length] (polished by Newton where that lowers the quartic), g(s) the distance
+    from p + s d to the core circle (mm); None where the segment meets the axis (there g
+    has a kink and the quartic degenerates)."""
+    w0 = _sub(p, t.o)
+    w0 = _axpy(-_dot(w0, t.z), t.z, w0)                 # radial part at s = 0
+    e = _axpy(-_dot(d, t.z), t.z, d)                     # radial part of d
+    qa, qb, qc = _dot(e, e), _dot(w0, e), _dot(w0, w0)   # rho^2 = qa s^2 + 2 qb s + qc
+    s_v = axis_nearest(t, p, length, d)
+    if qa * s_v * s_v + 2.0 * qb * s_v + qc < (EPS * t.major) ** 2 + 1e-18:  # mm^2
+        return None                                      # the segment meets the axis
+    b = _dot(_sub(p, t.o), d)                            # q' / 2 = s + b
+    quartic = np.convolve([1.0, 2.0 * b, b * b], [qa, 2.0 * qb, qc])   # 5 coefficients
+    quartic[2:] -= t.major ** 2 * np.array([qa * qa, 2.0 * qa * qb, qb * qb])
+    cands = [0.0, length]
+    deriv = np.polyder(quartic)
+    # every root's real part is a candidate: g's value at an extra point stays within
+    # g's true range, and a near-double real root may come out slightly complex
+    for root in np.roots(quartic) if np.any(quartic) else ():
+        s = float(root.real)
+        for _ in range(2):   # polish on the quartic, only where it improves
+            dq = float(np.polyval(deriv, s))
+            t1 = s - float(np.polyval(quartic, s)) / dq if dq else s
+            if not abs(np.polyval(quartic, t1)) < abs(np.polyval(quartic, s)):
+                break
+            s = t1
+        if 0.0 <= s <= length:
+            cands.append(s)
+
+    def g(s: float) -> float:
+        rho = math.sqrt(max(qa * s * s + 2.0 * qb * s + qc, 0.0))
+        ax = _dot(_sub(_axpy(s, d, p), t.o), t.z)
+        return math.hypot(rho - t.major, ax)
+
+    return cands, [g(s) for s in cands], g
+
+
+def axis_nearest(t: Torus, p, length: float, d=UP) -> float:
+    """The s in [0, length] where p + s d comes nearest the torus's axis."""
+    w0 = _sub(p, t.o)
+    w0 = _axpy(-_dot(w0, t.z), t.z, w0)
+    e = _axpy(-_dot(d, t.z), t.z, d)
+    qa, qb = _dot(e, e), _dot(w0, e)
+    return min(max(-qb / qa, 0.0), length) if qa > EPS else 0.0
+
+
+def crossings(t: Torus, cands: list, gs: list, g, first: bool = False) -> list[float]:
+    """The s where g - r changes sign between two consecutive candidates, each found to a
+    nanometre by bisection (only the first when ``first``)."""
+    order = sorted(range(len(cands)), key=lambda i: cands[i])
+    out = []
+    for i, j in zip(order, order[1:]):
+        a, b = cands[i], cands[j]
+        fa = gs[i] - t.minor
+        if fa == 0.0:
+            out.append(a)
+        elif fa * (gs[j] - t.minor) < 0.0:
+            for _ in range(60):
+                m = 0.5 * (a + b)
+                if b - a <= 1e-9:   # mm: the crossing found to a nanometre
+                    break
+                if (g(m) - t.minor) * fa > 0.0:
+                    a = m
+                else:
+                    b = m
+            out.append(0.5 * (a + b))
+        if first and out:
+            break
+    return out
+
+
+def local_nearest(t: Torus, p, length: float, d=UP) -> list[float]:
+    """Every s in [0, length] where p + s d may come locally nearest a face of the torus
+    at the face's interior: the ends, the quartic's roots, the crossings and the point
+    nearest the axis (where the segment meets it, the quartic's roots are replaced by
+    those of its factored form, s = -b +- R sqrt(A))."""
+    s_v = axis_nearest(t, p, length, d)
+    got = core_distances(t, p, length, d)
+    if got is not None:
+        cands, gs, g = got
+        return cands + crossings(t, cands, gs, g) + [s_v]
+    e = _axpy(-_dot(d, t.z), t.z, d)
+    b, root = _dot(_sub(p, t.o), d), t.major * math.sqrt(_dot(e, e))
+    out = [0.0, length, s_v] + [s for s in (-b - root, -b + root) if 0.0 <= s <= length]
+    return out
+
+
+def _sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _dot(a, b) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _axpy(s: float, a, b):
+    """s a + b."""
+    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
