@@ -52,26 +52,34 @@ def core_distances(t: Torus, p, length: float, d=UP) -> tuple[list, list, Callab
     quartic = np.convolve([1.0, 2.0 * b, b * b], [qa, 2.0 * qb, qc])   # 5 coefficients
     quartic[2:] -= t.major ** 2 * np.array([qa * qa, 2.0 * qa * qb, qb * qb])
     cands = [0.0, length]
-    deriv = np.polyder(quartic)
+    coef = quartic.tolist()
+    deriv = np.polyder(quartic).tolist()
     # every root's real part is a candidate: g's value at an extra point stays within
     # g's true range, and a near-double real root may come out slightly complex
-    for root in np.roots(quartic) if np.any(quartic) else ():
+    for root in _roots(quartic):
         s = float(root.real)
         for _ in range(2):   # polish on the quartic, only where it improves
-            dq = float(np.polyval(deriv, s))
-            t1 = s - float(np.polyval(quartic, s)) / dq if dq else s
-            if not abs(np.polyval(quartic, t1)) < abs(np.polyval(quartic, s)):
+            dq = _horner(deriv, s)
+            t1 = s - _horner(coef, s) / dq if dq else s
+            if not abs(_horner(coef, t1)) < abs(_horner(coef, s)):
                 break
             s = t1
         if 0.0 <= s <= length:
             cands.append(s)
 
+    g = _core_distance(t, p, d, qa, qb, qc)
+    return cands, [g(s) for s in cands], g
+
+
+def _core_distance(t: Torus, p, d, qa: float, qb: float, qc: float) -> Callable:
+    """g(s): the distance (mm) from p + s d to the core circle, rho^2 = qa s^2 + 2 qb s +
+    qc."""
     def g(s: float) -> float:
         rho = math.sqrt(max(qa * s * s + 2.0 * qb * s + qc, 0.0))
         ax = _dot(_sub(_axpy(s, d, p), t.o), t.z)
         return math.hypot(rho - t.major, ax)
 
-    return cands, [g(s) for s in cands], g
+    return g
 
 
 def axis_nearest(t: Torus, p, length: float, d=UP) -> float:
@@ -115,13 +123,39 @@ def local_nearest(t: Torus, p, length: float, d=UP) -> list[float]:
     those of its factored form, s = -b +- R sqrt(A))."""
     s_v = axis_nearest(t, p, length, d)
     got = core_distances(t, p, length, d)
-    if got is not None:
-        cands, gs, g = got
-        return cands + crossings(t, cands, gs, g) + [s_v]
-    e = _axpy(-_dot(d, t.z), t.z, d)
-    b, root = _dot(_sub(p, t.o), d), t.major * math.sqrt(_dot(e, e))
-    out = [0.0, length, s_v] + [s for s in (-b - root, -b + root) if 0.0 <= s <= length]
-    return out
+    if got is None:   # through the axis: rho = sqrt(A) |s - s_v|, the quartic factored
+        w0 = _sub(p, t.o)
+        w0 = _axpy(-_dot(w0, t.z), t.z, w0)
+        e = _axpy(-_dot(d, t.z), t.z, d)
+        qa, qb, qc = _dot(e, e), _dot(w0, e), _dot(w0, w0)
+        b, root = _dot(_sub(p, t.o), d), t.major * math.sqrt(qa)
+        cands = [0.0, length, s_v] + [s for s in (-b - root, -b + root) if 0.0 <= s <= length]
+        g = _core_distance(t, p, d, qa, qb, qc)
+        got = cands, [g(s) for s in cands], g
+    cands, gs, g = got
+    return cands + crossings(t, cands, gs, g) + [s_v]
+
+
+_SUB = np.eye(4, k=-1)   # the companion matrix's ones below its diagonal
+
+
+def _roots(quartic: np.ndarray) -> np.ndarray:
+    """np.roots(quartic), made as np.roots makes it (the companion matrix's eigenvalues)
+    without its checks where the first and last coefficients are not 0."""
+    if quartic[0] == 0.0 or quartic[-1] == 0.0:
+        return np.roots(quartic) if np.any(quartic) else np.empty(0)
+    a = _SUB.copy()
+    a[0, :] = -quartic[1:] / quartic[0]
+    return np.linalg.eigvals(a)
+
+
+def _horner(c: list[float], x: float) -> float:
+    """The polynomial with coefficients ``c`` (highest first) at ``x``: numpy's polyval's
+    operations in its order, on plain floats."""
+    y = 0.0
+    for v in c:
+        y = y * x + v
+    return y
 
 
 def _sub(a, b):

@@ -47,6 +47,8 @@ class AnalyticFace:
             if self.r >= self.r_major:     # a horn or spindle torus: no simple foot
                 return
             self._torus = Torus(self.o, self.z, self.r_major, self.r)
+            self._core_key: tuple | None = None
+            self._core = None
         self.kind = face.kind
         self._uv = gp_Pnt2d()
 
@@ -232,7 +234,10 @@ class AnalyticFace:
         where the segment meets the axis."""
         if self.kind != "torus":
             return None
-        return core_distances(self._torus, p, length)
+        key = (p[0], p[1], p[2], length)   # the guard asks twice at a centre: the bound,
+        if key != self._core_key:           # then the shank's nearest point
+            self._core_key, self._core = key, core_distances(self._torus, p, length)
+        return self._core
 
 
 def _xyz(v) -> tuple[float, float, float]:
