@@ -22,6 +22,8 @@ from typing import Callable
 
 import numpy as np
 
+from ..interp.vec3 import axpy, dot, sub
+
 EPS = 1e-12   # relative: below this a direction or radius is degenerate
 UP = (0.0, 0.0, 1.0)
 
@@ -41,14 +43,11 @@ def core_distances(t: Torus, p, length: float, d=UP) -> tuple[list, list, Callab
     in [0, length] (polished by Newton where that lowers the quartic), g(s) the distance
     from p + s d to the core circle (mm); None where the segment meets the axis (there g
     has a kink and the quartic degenerates)."""
-    w0 = _sub(p, t.o)
-    w0 = _axpy(-_dot(w0, t.z), t.z, w0)                 # radial part at s = 0
-    e = _axpy(-_dot(d, t.z), t.z, d)                     # radial part of d
-    qa, qb, qc = _dot(e, e), _dot(w0, e), _dot(w0, w0)   # rho^2 = qa s^2 + 2 qb s + qc
+    qa, qb, qc = _radial(t, p, d)
     s_v = axis_nearest(t, p, length, d)
     if qa * s_v * s_v + 2.0 * qb * s_v + qc < (EPS * t.major) ** 2 + 1e-18:  # mm^2
         return None                                      # the segment meets the axis
-    b = _dot(_sub(p, t.o), d)                            # q' / 2 = s + b
+    b = dot(sub(p, t.o), d)                            # q' / 2 = s + b
     quartic = np.convolve([1.0, 2.0 * b, b * b], [qa, 2.0 * qb, qc])   # 5 coefficients
     quartic[2:] -= t.major ** 2 * np.array([qa * qa, 2.0 * qa * qb, qb * qb])
     cands = [0.0, length]
@@ -76,18 +75,23 @@ def _core_distance(t: Torus, p, d, qa: float, qb: float, qc: float) -> Callable:
     qc."""
     def g(s: float) -> float:
         rho = math.sqrt(max(qa * s * s + 2.0 * qb * s + qc, 0.0))
-        ax = _dot(_sub(_axpy(s, d, p), t.o), t.z)
+        ax = dot(sub(axpy(s, d, p), t.o), t.z)
         return math.hypot(rho - t.major, ax)
 
     return g
 
 
+def _radial(t: Torus, p, d) -> tuple[float, float, float]:
+    """(qa, qb, qc): the squared distance from p + s d to the axis, qa s^2 + 2 qb s + qc."""
+    w0 = sub(p, t.o)
+    w0 = axpy(-dot(w0, t.z), t.z, w0)                 # radial part at s = 0
+    e = axpy(-dot(d, t.z), t.z, d)                     # radial part of d
+    return dot(e, e), dot(w0, e), dot(w0, w0)
+
+
 def axis_nearest(t: Torus, p, length: float, d=UP) -> float:
     """The s in [0, length] where p + s d comes nearest the torus's axis."""
-    w0 = _sub(p, t.o)
-    w0 = _axpy(-_dot(w0, t.z), t.z, w0)
-    e = _axpy(-_dot(d, t.z), t.z, d)
-    qa, qb = _dot(e, e), _dot(w0, e)
+    qa, qb, _ = _radial(t, p, d)
     return min(max(-qb / qa, 0.0), length) if qa > EPS else 0.0
 
 
@@ -124,11 +128,8 @@ def local_nearest(t: Torus, p, length: float, d=UP) -> list[float]:
     s_v = axis_nearest(t, p, length, d)
     got = core_distances(t, p, length, d)
     if got is None:   # through the axis: rho = sqrt(A) |s - s_v|, the quartic factored
-        w0 = _sub(p, t.o)
-        w0 = _axpy(-_dot(w0, t.z), t.z, w0)
-        e = _axpy(-_dot(d, t.z), t.z, d)
-        qa, qb, qc = _dot(e, e), _dot(w0, e), _dot(w0, w0)
-        b, root = _dot(_sub(p, t.o), d), t.major * math.sqrt(qa)
+        qa, qb, qc = _radial(t, p, d)
+        b, root = dot(sub(p, t.o), d), t.major * math.sqrt(qa)
         cands = [0.0, length, s_v] + [s for s in (-b - root, -b + root) if 0.0 <= s <= length]
         g = _core_distance(t, p, d, qa, qb, qc)
         got = cands, [g(s) for s in cands], g
@@ -156,16 +157,3 @@ def _horner(c: list[float], x: float) -> float:
     for v in c:
         y = y * x + v
     return y
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _dot(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def _axpy(s: float, a, b):
-    """s a + b."""
-    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])

@@ -19,6 +19,7 @@ from OCP.gp import gp_Pnt2d
 from OCP.TopAbs import TopAbs_IN
 
 from ..geometry.torus_segment import Torus, core_distances, crossings
+from ..interp.vec3 import axpy, dot, norm, sub
 
 EPS = 1e-12   # relative: below this a direction or radius is degenerate
 SAMPLE_STEP = 0.01   # mm: a torus's nearest segment point sampled this finely where its
@@ -55,8 +56,8 @@ class AnalyticFace:
     # -- the foot's parameters and the trim ------------------------------------------------
     def _inside(self, q) -> bool:
         """Whether surface point q lies strictly inside the trimmed face."""
-        w = _sub(q, self.o)
-        lx, ly, lz = _dot(w, self.x), _dot(w, self.y), _dot(w, self.z)
+        w = sub(q, self.o)
+        lx, ly, lz = dot(w, self.x), dot(w, self.y), dot(w, self.z)
         if self.kind == "plane":
             u, v = lx, ly
         elif self.kind == "cylinder":
@@ -87,30 +88,30 @@ class AnalyticFace:
 
     def _surface_foot(self, p):
         """(nearest point of the untrimmed surface, distance) or None when not unique."""
-        w = _sub(p, self.o)
+        w = sub(p, self.o)
         if self.kind == "plane":
-            h = _dot(w, self.z)
-            return _axpy(-h, self.z, p), abs(h)
+            h = dot(w, self.z)
+            return axpy(-h, self.z, p), abs(h)
         if self.kind == "sphere":
-            n = _norm(w)
+            n = norm(w)
             if n < EPS * max(self.r, 1.0):
                 return None
-            return _axpy(self.r / n, w, self.o), abs(n - self.r)
-        a = _dot(w, self.z)
-        radial = _axpy(-a, self.z, w)          # w minus its axial part
-        rho = _norm(radial)
+            return axpy(self.r / n, w, self.o), abs(n - self.r)
+        a = dot(w, self.z)
+        radial = axpy(-a, self.z, w)          # w minus its axial part
+        rho = norm(radial)
         if rho < EPS * max(self.r, 1.0):
             return None
         if self.kind == "cylinder":
-            foot = _axpy(self.r / rho, radial, _axpy(a, self.z, self.o))
+            foot = axpy(self.r / rho, radial, axpy(a, self.z, self.o))
             return foot, abs(rho - self.r)
         # torus: the tube circle's centre in the meridian plane of p, then a sphere
-        c = _axpy(self.r_major / rho, radial, self.o)
-        t = _sub(p, c)
-        n = _norm(t)
+        c = axpy(self.r_major / rho, radial, self.o)
+        t = sub(p, c)
+        n = norm(t)
         if n < EPS * max(self.r, 1.0):
             return None
-        return _axpy(self.r / n, t, c), abs(n - self.r)
+        return axpy(self.r / n, t, c), abs(n - self.r)
 
     # -- vertical segment ----------------------------------------------------------------
     def segment_distance(self, p, length: float, trimmed: bool = True) -> float | None:
@@ -127,7 +128,7 @@ class AnalyticFace:
         if self.kind not in ("plane", "cylinder", "sphere"):
             return None
         if self.kind == "plane":
-            h0 = _dot(_sub(p, self.o), self.z)
+            h0 = dot(sub(p, self.o), self.z)
             h1 = h0 + length * self.z[2]
             if h0 * h1 <= 0.0 and h0 != h1:
                 s = -h0 / self.z[2]
@@ -136,13 +137,13 @@ class AnalyticFace:
             s = 0.0 if abs(h0) < abs(h1) else length
             return self.point_distance((p[0], p[1], p[2] + s), trimmed)
         # squared distance to the axis (cylinder) or centre (sphere): A s^2 + 2 B s + C
-        w0 = _sub(p, self.o)
+        w0 = sub(p, self.o)
         if self.kind == "cylinder":
-            w0 = _axpy(-_dot(w0, self.z), self.z, w0)
-            e = _axpy(-self.z[2], self.z, (0.0, 0.0, 1.0))
+            w0 = axpy(-dot(w0, self.z), self.z, w0)
+            e = axpy(-self.z[2], self.z, (0.0, 0.0, 1.0))
         else:
             e = (0.0, 0.0, 1.0)
-        qa, qb, qc = _dot(e, e), _dot(w0, e), _dot(w0, w0)
+        qa, qb, qc = dot(e, e), dot(w0, e), dot(w0, w0)
         r2 = self.r * self.r
         f0, f1 = qc, qa * length * length + 2.0 * qb * length + qc
         s_min = min(max(-qb / qa, 0.0), length) if qa > EPS else 0.0
@@ -242,20 +243,3 @@ class AnalyticFace:
 
 def _xyz(v) -> tuple[float, float, float]:
     return (v.X(), v.Y(), v.Z())
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _dot(a, b) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def _axpy(s: float, a, b):
-    """s a + b."""
-    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
-
-
-def _norm(a) -> float:
-    return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
