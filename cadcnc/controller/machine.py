@@ -13,6 +13,8 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from ..core.errors import InputError
 from .ini_file import IniFile, leading_number
 
@@ -91,6 +93,11 @@ class Machine:
         a = (15 * INCH, 15 * INCH, 10 * INCH)
         return cls(0.001, v, a, tuple(x / DEFAULT_JERK_RAMP for x in a),
                    "Tormach PCNC 770 (LinuxCNC 2.9 sample config pcnc-770.ini), jerk A / 0.05 s")
+
+    def limits(self) -> np.ndarray:
+        """(3, 3) the velocity, acceleration and jerk limits (rows) per axis (columns)."""
+        return np.array([self.max_velocity, self.max_acceleration, self.max_jerk],
+                        dtype=np.float64)
 
     def summary(self) -> str:
         """One line: period and per-axis limits."""

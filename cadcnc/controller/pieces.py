@@ -18,6 +18,7 @@ from ..interp.cycle import MAX_TURN
 from ..program.blending import blend_sizes, round_link
 from ..program.program import Program
 from .machine import Machine
+from .path_derivatives import distinct, substep_need
 
 DUPLICATE = 1e-12   # mm: consecutive points this close are one point
 ACCURACY_SHARE = 0.9
@@ -58,35 +59,12 @@ class Piece:
         return math.isinf(self.cap)
 
 
-def curvature(points: np.ndarray) -> np.ndarray:
-    """(n,) the curvature (1/mm) of the circle through each point and its neighbours
-    (the ends take their neighbour's; 0 for fewer than 3 points)."""
-    n = len(points)
-    if n < 3:
-        return np.zeros(n)
-    a, b = points[1:-1] - points[:-2], points[2:] - points[1:-1]
-    c = points[2:] - points[:-2]
-    area2 = np.linalg.norm(np.cross(a, b), axis=1)
-    k = 2.0 * area2 / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1)
-                       * np.linalg.norm(c, axis=1))
-    return np.r_[k[:1], k, k[-1:]]
-
-
-def arc_lengths(points: np.ndarray, kappa: np.ndarray) -> np.ndarray:
-    """(n,) arc length from the first point: each chord h of a curve of curvature k is
-    an arc of h (1 + k^2 h^2 / 24); the kernel re-run at shorter steps follows the arc."""
-    h = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    k2 = 0.5 * (kappa[:-1] ** 2 + kappa[1:] ** 2)
-    return np.r_[0.0, np.cumsum(h * (1.0 + k2 * h * h / 24.0))]
-
-
 def _distinct(points: np.ndarray):
-    """Points without consecutive duplicates, their arc length, curvature, kept mask."""
-    h = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    mask = np.r_[True, h > DUPLICATE]
-    pts = points[mask]
-    kappa = curvature(pts)
-    return pts, arc_lengths(pts, kappa), kappa, mask
+    """Points without consecutive duplicates, their arc length (each chord of a curve of
+    curvature k an arc of h (1 + k^2 h^2 / 24): the kernel re-run at shorter steps
+    follows the arc), curvature (the circle through each point and its neighbours) and
+    the kept mask (:func:`.path_derivatives.distinct`)."""
+    return distinct(np.ascontiguousarray(points, dtype=np.float64), DUPLICATE)
 
 
 def _step_caps(seg, machine: Machine, mask: np.ndarray,
@@ -127,11 +105,7 @@ def substeps_for(points: np.ndarray, s: np.ndarray, caps: np.ndarray | None, fee
     velocities along its tangent allow: the fewest that lift every cap."""
     if caps is None:
         return 1
-    tangent = np.gradient(points, s, axis=0)
-    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
-    with np.errstate(divide="ignore"):
-        axes = np.min(np.asarray(machine.max_velocity) / np.abs(tangent), axis=1)
-    need = float(np.max(np.minimum(axes, feed) / caps))
+    need = substep_need(points, s, caps, feed, np.asarray(machine.max_velocity, float))
     return int(min(max(math.ceil(need - 1e-9), 1), MAX_SUBSTEPS))   # round-off of need
 
 

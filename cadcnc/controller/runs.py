@@ -25,6 +25,8 @@ import numpy as np
 from numba import njit
 
 from .machine import Machine
+from .path_derivatives import cut_derivatives
+from .path_derivatives import end_derivatives as path_end
 from .pieces import STRAIGHT_K, Piece
 
 LINE_KNOT = 0.25       # mm: the largest knot of a straight move (the plan's resolution)
@@ -75,29 +77,9 @@ class Run:
                     or np.ptp(self.T, axis=0).max() > 0.0)
 
 
-def _lagrange(p: np.ndarray, s: np.ndarray, at: int) -> tuple[np.ndarray, np.ndarray]:
-    """p' and p'' at point ``at`` (0 or 2) of the parabola through 3 points (3, 3)."""
-    s0, s1, s2 = s
-    x = s[at]
-    d0, d1, d2 = (s0 - s1) * (s0 - s2), (s1 - s0) * (s1 - s2), (s2 - s0) * (s2 - s1)
-    first = (p[0] * (2 * x - s1 - s2) / d0 + p[1] * (2 * x - s0 - s2) / d1
-             + p[2] * (2 * x - s0 - s1) / d2)
-    return first, 2.0 * (p[0] / d0 + p[1] / d1 + p[2] / d2)
-
-
 def end_derivatives(piece: Piece, end: bool) -> tuple[np.ndarray, np.ndarray]:
     """Unit tangent and p'' (1/mm) at the piece's start (``end`` False) or end."""
-    p, s = piece.points, piece.s
-    if len(p) < 3:
-        d = p[-1] - p[0]
-        return d / np.linalg.norm(d), np.zeros(3)
-    sl = slice(-3, None) if end else slice(0, 3)
-    t, k = _lagrange(p[sl], s[sl] - s[sl][0], 2 if end else 0)
-    if len(p) >= 4:   # p'' of the next three points too: extrapolated onto the end (a
-        sl = slice(-4, -1) if end else slice(1, 4)   # ramp of curvature is no jump)
-        k2 = _lagrange(p[sl], s[sl] - s[sl][0], 0)[1]
-        k = 2.0 * k - k2
-    return t / np.linalg.norm(t), k
+    return path_end(piece.points, piece.s, end)
 
 
 def join_speed(before: Piece, after: Piece, machine: Machine) -> tuple[float, np.ndarray,
@@ -112,17 +94,26 @@ def join_speed(before: Piece, after: Piece, machine: Machine) -> tuple[float, np
     JOIN_SHARE of the axis's limit."""
     t0, k0 = end_derivatives(before, True)
     t1, k1 = end_derivatives(after, False)
-    dt, dk = t1 - t0, k1 - k0
-    ts = machine.period
-    A, J = np.asarray(machine.max_acceleration), np.asarray(machine.max_jerk)
-    with np.errstate(divide="ignore"):
-        v = np.min(JOIN_SHARE * np.minimum(A * ts, J * ts * ts) / np.abs(dt))
-        v = min(v, float(np.min(np.sqrt(JOIN_SHARE * J * ts / np.abs(dk)))))
-    with np.errstate(divide="ignore"):
-        axes = np.asarray(machine.max_velocity) / np.maximum(np.abs(t0), np.abs(t1))
-    top = min(before.cap, after.cap, float(np.min(axes)))
+    v, axes, dt, dk = _join_limits(t0, k0, t1, k1, machine.limits(), machine.period,
+                                   JOIN_SHARE)
+    top = min(before.cap, after.cap, axes)
     v = min(v, top)
-    return (0.0 if v < max(STOP_SPEED, STOP_SHARE * top) else float(v)), dt, dk
+    return (0.0 if v < max(STOP_SPEED, STOP_SHARE * top) else v), dt, dk
+
+
+@njit(cache=True, error_model="numpy")
+def _join_limits(t0, k0, t1, k1, limits, ts: float, share: float):
+    """The join's speed limit (mm/s) from its tangent and p'' jumps, the axes' velocity
+    limit along either tangent, and the jumps dt, dk (3,); ``limits`` (3, 3): V, A, J
+    per axis."""
+    dt, dk = t1 - t0, k1 - k0
+    v = w = axes = math.inf
+    for i in range(3):
+        A, J = limits[1, i], limits[2, i]
+        v = min(v, share * min(A * ts, J * ts * ts) / abs(dt[i]))
+        w = min(w, math.sqrt(share * J * ts / abs(dk[i])))
+        axes = min(axes, limits[0, i] / max(abs(t0[i]), abs(t1[i])))
+    return min(v, w), axes, dt, dk
 
 
 def _line_grid(piece: Piece) -> np.ndarray:
@@ -132,33 +123,10 @@ def _line_grid(piece: Piece) -> np.ndarray:
 
 
 def _cut_derivatives(piece: Piece) -> tuple[np.ndarray, ...]:
-    """T, K (signed), D = |p'''| and the curvature jumps at the piece's points."""
-    p, s = piece.points, piece.s
-    n = len(p)
-    h = np.diff(s)
-    d1 = np.diff(p, axis=0) / h[:, None]
-    T = np.empty((n, 3))
-    T[1:-1] = (d1[:-1] * h[1:, None] + d1[1:] * h[:-1, None]) / (h[:-1] + h[1:])[:, None]
-    T[0], _ = end_derivatives(piece, False)
-    T[-1], _ = end_derivatives(piece, True)
-    T /= np.linalg.norm(T, axis=1)[:, None]
-    K = np.zeros((n, 3))
-    D = np.zeros((n, 3))
-    jump = np.zeros((n, 3))
-    if n >= 3:
-        K[1:-1] = 2.0 * np.diff(d1, axis=0) / (h[:-1] + h[1:])[:, None]
-        K[0], K[-1] = K[1], K[-2]
-        dk = np.abs(np.diff(K, axis=0))             # (n - 1, 3) per knot
-        D[:-1] = dk / h[:, None]
-        D[1:] = np.maximum(D[1:], D[:-1])
-        # a jump: a knot's change beyond both neighbours' (a smooth change is D's)
-        nb = np.zeros_like(dk)
-        nb[1:] = dk[:-1]
-        nb[:-1] = np.maximum(nb[:-1], dk[1:])
-        excess = np.maximum(dk - nb, 0.0)
-        jump[:-1] = excess
-        jump[1:] = np.maximum(jump[1:], excess)
-    return T, K, D, jump
+    """T, K (signed), D = |p'''| and the curvature jumps at the piece's points
+    (:func:`.path_derivatives.cut_derivatives`)."""
+    return cut_derivatives(piece.points, piece.s, end_derivatives(piece, False)[0],
+                           end_derivatives(piece, True)[0])
 
 
 def _piece_grid(piece: Piece, machine: Machine):

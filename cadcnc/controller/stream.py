@@ -82,7 +82,7 @@ class Stream:
         """Per axis, the largest |v|, |a|, |j| of the positions as a share of the limits
         (a block of rows at a time)."""
         peak, _ = _peaks(self.positions)
-        limits, ts = _limits_of(self.machine), self.machine.period
+        limits, ts = self.machine.limits(), self.machine.period
         return {name: tuple(float(p / ts ** (k + 1) / lim)
                             for p, lim in zip(peak[k].tolist(), limits[k].tolist()))
                 for k, name in enumerate(("velocity", "acceleration", "jerk"))}
@@ -231,18 +231,12 @@ def _peaks(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return peak, where
 
 
-def _limits_of(machine: Machine) -> np.ndarray:
-    """(3, 3) the velocity, acceleration and jerk limits per axis."""
-    return np.array([machine.max_velocity, machine.max_acceleration, machine.max_jerk],
-                    dtype=np.float64)
-
-
 def _over(positions: np.ndarray, machine: Machine) -> list[tuple[float, int, int]]:
     """Per quantity (velocity, acceleration, jerk): the largest finite-difference share
     of an axis's limit, its period and its axis (:func:`_peaks`; of axes at the same
     share, the one reaching it first)."""
     peak, where = _peaks(positions)
-    limits = _limits_of(machine)
+    limits = machine.limits()
     out = []
     for q in range(3):
         share = peak[q] / (machine.period ** (q + 1) * limits[q])
