@@ -9,6 +9,7 @@ from __future__ import annotations
 import hashlib
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -51,9 +52,10 @@ class FeedPlan:
     machine: Machine
     planned: bool = True   # False: at the programmed feed, the limits ignored
 
-    @property
+    @cached_property
     def starts(self) -> np.ndarray:
-        return np.r_[0.0, np.cumsum([p.duration for p in self.profiles])]
+        """(runs + 1,) when each run starts, and the end (s)."""
+        return np.concatenate(([0.0], np.cumsum([p.duration for p in self.profiles])))
 
     @property
     def duration(self) -> float:

@@ -204,7 +204,7 @@ def _grew(run: Run, limits, plan: _Windowed) -> bool:
 def _first_window(run: Run, A, J) -> float:
     """The first averaging window (s): the shortest A_i / J_i of the axes the run moves;
     the plan lengthens it where the profile needs more."""
-    t = np.max(np.abs(run.T), axis=0)
+    t = run.tangent_reach
     return float(np.min(np.where(t > 0.0, A / J, np.inf)))
 
 
@@ -295,7 +295,7 @@ def _profile(run: Run, machine: Machine, limits, chosen: _Windowed) -> Profile:
         plan = _tightened(run, chosen.wl, limits, machine.period, chosen.window,
                           chosen.coriolis, plan)
     t, w, u, v, a, S, need = plan
-    keep = np.r_[np.diff(run.s) > 0.0, True]
+    keep = np.append(run.s[1:] > run.s[:-1], True)
     return Profile(t[keep], run.s[keep], v[keep], a[keep], S[keep], chosen.window)
 
 
@@ -387,7 +387,7 @@ def _even_ratio(run: Run, A: np.ndarray, J: np.ndarray) -> np.ndarray | None:
     quickest one (A_i <= J_i min_k A_k / J_k), or None where they already do. The window
     serves every axis at once, so an axis with more acceleration than that lengthens it:
     planned both ways, the faster kept, a looser acceleration limit never slows a run."""
-    moving = np.max(np.abs(run.T), axis=0) > 0.0
+    moving = run.tangent_reach > 0.0
     if not moving.any():
         return None
     even = np.minimum(A, J * float(np.min((A / J)[moving])))

@@ -70,7 +70,12 @@ class Run:
         """Whether the path bends (p'' over STRAIGHT_K somewhere), not only by round-off."""
         return bool(np.max(np.abs(self.K), initial=0.0) > STRAIGHT_K)
 
-    @property
+    @cached_property
+    def tangent_reach(self) -> np.ndarray:
+        """(3,) the largest |T_i| along the run: how much each axis moves with the path."""
+        return np.max(np.abs(self.T), axis=0)
+
+    @cached_property
     def curved(self) -> bool:
         """Whether the path's derivatives change along the run (curvature, jumps, joins)."""
         return bool(np.any(self.K) or np.any(self.jump) or np.any(self.kink)
@@ -223,7 +228,7 @@ def _held(keep: np.ndarray, D: np.ndarray, jump: np.ndarray, cap: np.ndarray) ->
 
 def _run(first: int, pieces: list[Piece], machine: Machine, joins: list) -> Run:
     grids = [_piece_grid(p, machine) for p in pieces]
-    offsets = np.r_[0.0, np.cumsum([p.length for p in pieces])]
+    offsets = np.concatenate(([0.0], np.cumsum([p.length for p in pieces])))
     s = np.concatenate([g[0] + o for g, o in zip(grids, offsets)])
     T, K, D, jump, cap = (np.concatenate([g[i] for g in grids]) for i in range(1, 6))
     kink = np.zeros_like(T)

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
+from numba import njit
 
 from ..core.errors import GeometryError
 from ..core.progress import Progress
@@ -157,10 +158,11 @@ def follow_plan(piece: Piece, s: np.ndarray, before: float = 0.0,
     ``before``, ``travelled``: the arc length and the target length of the row before
     s[0] (0, 0: s starts the cut), so that a cut's plan is made a block at a time, the
     same numbers as at once."""
-    ds = np.diff(np.r_[before, s])
+    ds = np.diff(s, prepend=before)
     kappa = np.interp(s, piece.s, piece.kappa)
     plan = np.empty((len(s), 3))
-    plan[:, 0] = np.cumsum(np.r_[travelled, ds * (1.0 - kappa ** 2 * ds ** 2 / 24.0)])[1:]
+    plan[:, 0] = np.cumsum(np.concatenate(([travelled],
+                                           ds * (1.0 - kappa ** 2 * ds ** 2 / 24.0))))[1:]
     plan[:, 2] = left = piece.length - s
     x = np.clip(1.0 - left / BLEND, 0.0, 1.0)
     plan[:, 1] = x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)
@@ -170,7 +172,7 @@ def follow_plan(piece: Piece, s: np.ndarray, before: float = 0.0,
 def substep_lengths(s: np.ndarray, before: float, m: int) -> np.ndarray:
     """(len(s) * m,) the arc lengths of m kernel cycles a period: each period's advance
     from the row before (``before`` for s[0]) in m equal parts, the period's own last."""
-    edges = np.r_[before, s]
+    edges = np.concatenate(([before], s))
     parts = np.arange(1, m + 1) / m
     out = edges[:-1, None] + np.diff(edges)[:, None] * parts
     out[:, -1] = s
@@ -216,19 +218,40 @@ def _peaks(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     skipped, the stream's check names it)."""
     peak, where = np.zeros((3, 3)), np.zeros((3, 3), dtype=np.int64)
     for start in range(0, max(len(positions) - 1, 1), CHUNK):
-        block = positions[start:start + CHUNK + 3]
-        for k in range(1, 4):
-            if len(block) <= k:
-                continue
-            d = np.abs(np.diff(block, k, axis=0))
-            top = d.max(axis=0)
-            if np.isnan(top).any():
-                continue
-            row = d.argmax(axis=0)
-            better = top > peak[k - 1]
-            peak[k - 1][better] = top[better]
-            where[k - 1][better] = start + row[better] + k
+        _block_peaks(np.ascontiguousarray(positions[start:start + CHUNK + 3]), start,
+                     peak, where)
     return peak, where
+
+
+@njit(cache=True)
+def _block_peaks(block: np.ndarray, start: int, peak: np.ndarray, where: np.ndarray) -> None:
+    """:func:`_peaks` of one block whose first row is ``start``: each order's differences
+    as NumPy's repeated ``diff`` makes them; an order with a difference that is not a
+    number leaves the peaks as they are."""
+    n = len(block)
+    d = block.copy()
+    for k in range(1, 4):
+        if n <= k:
+            return
+        m = n - k
+        for i in range(m):
+            for a in range(3):
+                d[i, a] = d[i + 1, a] - d[i, a]
+        top, row = np.zeros(3), np.zeros(3, dtype=np.int64)
+        bad = False
+        for a in range(3):
+            for i in range(m):
+                x = abs(d[i, a])
+                if x != x:
+                    bad = True
+                elif x > top[a] or i == 0:
+                    top[a], row[a] = x, i
+        if bad:
+            continue
+        for a in range(3):
+            if top[a] > peak[k - 1, a]:
+                peak[k - 1, a] = top[a]
+                where[k - 1, a] = start + row[a] + k
 
 
 def _over(positions: np.ndarray, machine: Machine) -> list[tuple[float, int, int]]:
