@@ -12,7 +12,8 @@ each used where it binds, at MARGIN of the limit. A run (:mod:`.runs`) is moved 
 from rest to rest:
 
 1. the speed limits: the feed, V_i / |T_i|, the jerk's D_i v^3 term (D_SHARE of J_i;
-   where that term binds, the run is also planned at D_SHARE_HIGH, the faster kept), and
+   where that term binds, the run is also planned at D_SHARE_HIGH, the faster kept; a
+   run that bends there first, as it mostly wins and then lets the others give up), and
    the one-period jolt of a curvature jump or a join (``runs.JOIN_SHARE``);
 2. the time-optimal profile under the acceleration limits (:func:`.topp.passes`), with
    the jerk's Coriolis term 3 K_i v s'' within CORIOLIS_SHARE of J_i;
@@ -23,13 +24,16 @@ from rest to rest:
    window's reach, so that the averaged motion keeps every limit where it is;
 5. on a run that bends, the averaged motion's jerk measured as it is
    (:mod:`.averaged_jerk`) rather than bounded from the window's extremes: the run is
-   planned at BENT_SHARE of J for the Coriolis term, its window grown only as much as
+   planned at BENT_SHARE of J for the Coriolis term (at most 1 - the D share -
+   BENT_ROOM), its window grown only as much as
    the measured jerk asks (from the second growth on, where the secant of the measured
    share through the last two windows reaches 1: :func:`_secant`; and, where it grew,
    its top speed also capped at CAP_FACTORS of the plan's, the faster kept).
 
 A plan tried against another is given up as soon as one of its rounds lasts as long
-(:class:`_Slower`): its rounds only get longer. The acceleration used is at most
+(:class:`_Slower`): its rounds only get longer. Only plans that no later plan depends on
+give up (a capped plan, a next Coriolis share), so the chosen plan is the one planning
+every way in full would choose (tested). The acceleration used is at most
 sqrt(V J) per axis, and (J² L)^(1/3) on a run of length L: with more, the window would
 cost more time than the acceleration saves, and a looser limit could lengthen the plan.
 Times s, lengths mm.
@@ -61,6 +65,9 @@ D_SHARE_HIGH = 0.6      # ... or this much, on a run where that term binds the s
 SHARE_STEP, SHARE_STEPS = 0.025, 3   # the Coriolis share searched per curved run
 BENT_SHARE = 0.65       # of J_i for 3 K_i v s'' on a run that bends (its jerk measured):
                         # the arcs' durations fall up to about 0.65 and are flat beyond
+BENT_ROOM = 0.025       # ... at most what leaves this much of J_i beside the D v³ share
+                        # (0.375 at D_SHARE_HIGH: one plan where a search of 0.025 steps
+                        # from 0.25 took five, and as fast or faster on 8 of 10 streams)
 CAP_FACTORS = (0.95,)   # a bending run whose window grew: also its top speed capped at
                         # these shares of its plan's
 WINDOW_GROWTH = 1.02    # a bending run's window lengthened by at least this factor a round
@@ -305,23 +312,24 @@ def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
     V, A, J = _limits(machine, derate)
     # a short run: the acceleration a jerk ramp up and down over its length reaches
     A = np.minimum(A, np.cbrt(J * J * run.length))
-    plan = _best_share(run, machine, (V, A, J))
     even = _even_ratio(run, A, J)
-    tries = [] if even is None else [(even, D_SHARE)]
+    tries = [(A, D_SHARE)] + ([] if even is None else [(even, D_SHARE)])
     if _d_binds(run, V, J, machine.period):
-        tries += [(A, D_SHARE_HIGH)] + ([] if even is None else [(even, D_SHARE_HIGH)])
+        high = [(A, D_SHARE_HIGH)] + ([] if even is None else [(even, D_SHARE_HIGH)])
+        # a bending run whose D v³ term binds is mostly fastest at the higher share: planned
+        # first, it lets the others give up early (their rounds only get longer)
+        tries = high + tries if run.bends else tries + high
+    plan = None
     for acceleration, d_share in tries:
         # a run that bends is not tightened after: its rounds bound the profile's duration
-        beat = plan.duration if run.bends else math.inf
+        beat = plan.duration if run.bends and plan is not None else math.inf
         try:
             other = _best_share(run, machine, (V, acceleration, J), d_share, beat)
-        except _Slower:
-            continue
         except PlanError:   # no jerk left for the feed to change at that share
-            if d_share == D_SHARE:
+            if d_share == D_SHARE and acceleration is A:
                 raise
             continue
-        if other.duration < plan.duration * (1.0 - TIE):   # an ulp shorter: a tie
+        if plan is None or other.duration < plan.duration * (1.0 - TIE):   # a tie: the first
             plan = other
     return plan
 
@@ -333,15 +341,17 @@ def _best_share(run: Run, machine: Machine, limits, d_share: float = D_SHARE,
     share lets the feed change faster on a curve but asks for a longer window). The shares
     are compared before the derivatives are tightened, and only the chosen one is. A run
     that bends is planned by :func:`_capped` instead (its jerk measured), this way only
-    where no window serves BENT_SHARE. ``beat``: _Slower once no share can beat it (a
-    run that bends only: the others' durations fall when tightened)."""
+    where no window serves BENT_SHARE. ``beat`` (a run that bends only: the others'
+    durations fall when tightened): what :func:`_capped`'s capped plans are to beat; the
+    search's first share is planned in full (a later share may be faster), each next
+    share gives up once it can no longer beat the last."""
     if run.bends:
         try:
             return _profile(run, machine, limits,
                             _capped(run, machine, limits, d_share, beat))
         except PlanError:   # no window for that share: the usual one
             pass
-    first = _windowed(run, machine, limits, CORIOLIS_SHARE, d_share=d_share, beat=beat)
+    first = _windowed(run, machine, limits, CORIOLIS_SHARE, d_share=d_share)
     if not _grew(run, limits, first):
         return _profile(run, machine, limits, first)
     for step, steps in ((-SHARE_STEP, SHARE_STEPS), (SHARE_STEP, SHARE_STEPS)):
@@ -363,18 +373,21 @@ def _best_share(run: Run, machine: Machine, limits, d_share: float = D_SHARE,
 
 def _capped(run: Run, machine: Machine, limits, d_share: float = D_SHARE,
             beat: float = math.inf) -> _Windowed:
-    """A bending run at BENT_SHARE; where its window had to grow, also with its top speed
-    capped at each of CAP_FACTORS of the plan's (a slower top asks for less window), the
-    fastest kept: a looser limit that lets the feed higher never lengthens the run more
-    than these caps can give back."""
-    best = _windowed(run, machine, limits, BENT_SHARE, d_share=d_share, beat=beat)
+    """A bending run at BENT_SHARE (less where the D v³ share leaves less: BENT_ROOM);
+    where its window had to grow, also with its top speed capped at each of CAP_FACTORS
+    of the plan's (a slower top asks for less window), the fastest kept: a looser limit
+    that lets the feed higher never lengthens the run more than these caps can give back.
+    Only the capped plans give up early (against ``beat`` and the uncapped plan): the
+    uncapped one is planned in full, as the caps are shares of its top speed."""
+    bent = min(BENT_SHARE, 1.0 - d_share - BENT_ROOM)
+    best = _windowed(run, machine, limits, bent, d_share=d_share)
     if not _grew(run, limits, best):
         return best
     top = float(np.max(best.plan[3]))
     for factor in CAP_FACTORS:
         try:
-            other = _windowed(run, machine, limits, BENT_SHARE, factor * top, d_share,
-                              best.duration)
+            other = _windowed(run, machine, limits, bent, factor * top, d_share,
+                              min(beat, best.duration))
         except (PlanError, _Slower):
             continue
         if other.duration < best.duration:
