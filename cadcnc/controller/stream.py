@@ -38,7 +38,12 @@ StepperFactory = Callable[[int, object, float], object]
 """steppers(cut_index, cut_segment, period) -> a fresh stepper from the cut's first point
 landing on its last (record off), or None when the cut has none."""
 LANDING = 1e-6   # relative: the last step of a cut commanded this much past its end
-BLEND = 0.2      # mm before a cut's end where the target moves onto the distance left
+BLEND = 1.0
+"""mm before a cut's end (at most its length) where the target moves onto the distance
+left. The kernel's path is a few 1e-7 of its length longer or shorter than the program's
+points say (1e-5 mm on a 40 mm cut); moving that onto the end over the last B mm adds
+about 60 x that x (v / B)³ to the jerk (the weight's third derivative, at a stop's speed
+there): at 0.2 mm 1 % of the limit on the slab's waterline, 125 times less at 1 mm."""
 
 
 @dataclass
@@ -154,7 +159,8 @@ def follow_plan(piece: Piece, s: np.ndarray, before: float = 0.0,
                 travelled: float = 0.0) -> np.ndarray:
     """(rows, 3) the per-period plan the kernel follows on a cut (kernel/follow.py): the
     target length as the kernel's chord sum, the blend weight onto the distance left to
-    the end (C2 from 0 to 1 over the last BLEND mm), and the planned length left.
+    the end (C2 from 0 to 1 over the last BLEND mm, or the whole cut if shorter), and the
+    planned length left.
     ``before``, ``travelled``: the arc length and the target length of the row before
     s[0] (0, 0: s starts the cut), so that a cut's plan is made a block at a time, the
     same numbers as at once."""
@@ -164,7 +170,7 @@ def follow_plan(piece: Piece, s: np.ndarray, before: float = 0.0,
     plan[:, 0] = np.cumsum(np.concatenate(([travelled],
                                            ds * (1.0 - kappa ** 2 * ds ** 2 / 24.0))))[1:]
     plan[:, 2] = left = piece.length - s
-    x = np.clip(1.0 - left / BLEND, 0.0, 1.0)
+    x = np.clip(1.0 - left / min(BLEND, piece.length), 0.0, 1.0)
     plan[:, 1] = x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)
     return plan
 

@@ -12,6 +12,7 @@ from scipy.spatial import cKDTree
 
 import cadcnc
 from cadcnc.controller import Machine, stream_program
+from cadcnc.controller.stream import BLEND
 from cadcnc.interp.planned_follow import follow
 from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job
@@ -142,9 +143,10 @@ def test_programs_computed_at_10000_stream_within_limits_on_the_path(fast_progra
     assert _segments_distance(x, prog.all_moves()).max() <= NEAR
 
 
-def _python_driven(stepper, piece, s, period, blend=0.2, landing=1e-6):
+def _python_driven(stepper, piece, s, period, blend, landing=1e-6):
     """The stream's loop as it ran before the kernel followed the plan: one
-    ``stepper.step(feed)`` call per period from Python (the reference)."""
+    ``stepper.step(feed)`` call per period from Python (the reference), the target
+    moving onto the distance left over the last ``blend`` mm."""
     end = piece.points[-1]
     ds = np.diff(np.r_[0.0, s])
     kappa = np.interp(s, piece.s, piece.kappa)
@@ -186,7 +188,7 @@ def test_the_kernel_loop_streams_what_the_python_loop_did(fast_program):
                                                          m.period)
         if stepper is None or not len(sel) or j == 0:
             continue   # (row 0 is set to the program's first point)
-        ref = _python_driven(stepper, piece, s[sel], m.period)
+        ref = _python_driven(stepper, piece, s[sel], m.period, min(BLEND, piece.length))
         assert np.abs(stream.positions[sel] - ref).max() <= 1e-12
         compared += len(sel)
     assert compared > 500
