@@ -148,14 +148,15 @@ _DERIVATIVES = ("T", "K", "D", "jump", "kink")
 
 def _run_key(run: Run) -> bytes:
     """The run's lengths and speed caps exactly and its path's derivatives to 1e-6: runs
-    that may share a plan (:func:`_same_run` decides)."""
-    h = hashlib.blake2b(digest_size=32)
-    arrays = [run.offsets, run.s, run.cap]
-    arrays += [np.round(getattr(run, name), 6) + 0.0 for name in _DERIVATIVES]   # (no -0)
-    for a in arrays:
-        a = np.ascontiguousarray(a, dtype=np.float64)
-        h.update(np.int64(a.size).tobytes())
-        h.update(a.tobytes())
+    that may share a plan (:func:`_same_run` decides). The arrays' sizes, then their
+    values, in one buffer: equal keys, equal arrays."""
+    exact = [run.offsets, run.s, run.cap]
+    derivatives = [getattr(run, name) for name in _DERIVATIVES]
+    sizes = np.array([a.size for a in exact + derivatives], dtype=np.int64)
+    rounded = np.round(np.concatenate([d.ravel() for d in derivatives]), 6) + 0.0  # (no -0)
+    h = hashlib.blake2b(sizes.tobytes(), digest_size=32)
+    h.update(np.concatenate(exact).tobytes())
+    h.update(rounded.tobytes())
     return h.digest()
 
 
