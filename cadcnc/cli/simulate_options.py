@@ -27,8 +27,9 @@ def add_parser(add, gouge) -> None:
     p.add_argument("--tool-tip", action="store_true",
                    help="G-code programs the tool tip (ball centre Z - R), not the centre")
     p.add_argument("--shank", metavar="MM",
-                   help="shank length above the ball centre, mm (default: up to the "
-                        "clearance height)")
+                   help="shank length above the ball centre, mm (default: a cadcnc "
+                        "program's own tool's, 10 R unless its job set it; G-code: up to "
+                        "its highest point)")
     p.add_argument("--threshold", metavar="MM",
                    help="material left counted in area_over_mm2 (default: the finish "
                         "scallop target, else 0.01)")

@@ -99,7 +99,8 @@ def simulate(part: Part, programs, *, stock="box", resolution: float = RESOLUTIO
     ``stock``: "box" (the part's box grown by 1 mm), ("box", MARGIN), an offset in mm (a
     number), or a STEP file's path; ``resolution``: the rays' spacing (mm); ``jobs``:
     threads (None: every core); ``radius``/``tool_tip``: for G-code; ``shank``: mm of
-    shank above the ball centre (None: up to the clearance height); ``threshold``: the
+    shank above the ball centre (None: a cadcnc program's own tool's, a G-code program's up
+    to its highest point); ``threshold``: the
     material left counted in ``area_over_mm2`` (None: the finish jobs' scallop, else 0.01
     mm). The report's ``exit_code`` is 5 on a gouge or a collision."""
     if not (isinstance(resolution, (int, float)) and resolution > 0):

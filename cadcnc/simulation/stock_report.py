@@ -50,12 +50,24 @@ class SimulationReport:
                  f"{d['rays']} rays at {d['resolution_mm']:g} mm: most material left "
                  f"{worst:.4f} mm; {len(d['gouges'])} gouge(s), {len(d['collisions'])} "
                  f"collision(s)"]
+        lines += [_shank_line([p.get("shank_mm") for p in d["programs"]])]
         lines += [f"  gouge: face {g['face']} {g['depth_mm']:.4f} mm deep at "
                   f"({', '.join(f'{c:.3f}' for c in g['at'])})" for g in d["gouges"][:10]]
         lines += [f"  collision: move {c['move']} (a rapid of program {c['program']}) "
                   f"meets stock at ({', '.join(f'{v:.3f}' for v in c['at'])})"
                   for c in d["collisions"][:10]]
         return "\n".join(lines)
+
+
+def _shank_line(shanks: list) -> str:
+    """Which shank the simulation swept: mm above the ball centre per program (None: up to
+    a G-code program's highest point)."""
+    if len(set(shanks)) == 1 and shanks[0] is not None:
+        return (f"  shank {shanks[0]:g} mm above the ball centre (a cadcnc program's "
+                "tool's unless --shank MM gives another)")
+    return "  shank above the ball centre: " + ", ".join(
+        f"program {i + 1} " + ("up to its highest point" if s is None else f"{s:g} mm")
+        for i, s in enumerate(shanks))
 
 
 def weighted_quantile(values: np.ndarray, weights: np.ndarray, q: float) -> float:
@@ -130,7 +142,8 @@ def build_report(part, runs, stock: Stock, samples: Samples, stock_desc: dict, d
         "part": str(part.source), "resolution_mm": stock.res,
         "stock": {**stock_desc, "lo": stock.lo.tolist(), "hi": stock.hi.tolist()},
         "programs": [{"name": r.name, "radius_mm": r.radius, "axis": r.axis.tolist(),
-                      "moves": int((moves.run == i).sum())} for i, r in enumerate(runs)],
+                      "shank_mm": r.shank, "moves": int((moves.run == i).sum())}
+                     for i, r in enumerate(runs)],
         "moves": len(moves), "rays": rays(stock.lo, stock.hi, stock.res),
         "threshold_mm": threshold, "gouge_limit_mm": limit,
         "faces": faces, "gouges": gouges[:MAX_GOUGES],

@@ -41,8 +41,9 @@ def run_of_program(program: Program, setup=None, shank: float | None = None,
                    name: str = "") -> Run:
     """The :class:`Run` of a cadcnc ``program`` (its setup's work coordinates, ``setup`` a
     :class:`~cadcnc.geometry.setup.Setup` or None): every cut's and link's moves in order.
-    The shank reaches ``shank`` mm above the ball centre, by default up to the clearance
-    height (the job's, else the program's highest point along the axis)."""
+    The shank reaches ``shank`` mm above the ball centre, by default the program's own
+    tool's (:attr:`~cadcnc.core.tool.Tool.shank`: what the program was computed and
+    guarded for)."""
     part = in_part_coordinates(program, setup)
     pts: list[np.ndarray] = []
     rapid: list[np.ndarray] = []
@@ -63,7 +64,8 @@ def run_of_program(program: Program, setup=None, shank: float | None = None,
     heights = (points - origin) @ axis
     clearance = job.clearance if job.clearance is not None else float(heights.max())
     return Run(points, np.concatenate(rapid), job.tool.radius, axis,
-               float(clearance + origin @ axis), shank, name,
+               float(clearance + origin @ axis), job.tool.shank if shank is None else shank,
+               name,
                getattr(job.operation, "scallop", None))
 
 
