@@ -67,7 +67,7 @@ BENT_SHARE = 0.65       # of J_i for 3 K_i v s'' on a run that bends (its jerk m
                         # the arcs' durations fall up to about 0.65 and are flat beyond
 BENT_ROOM = 0.025       # ... at most what leaves this much of J_i beside the D v³ share
                         # (0.375 at D_SHARE_HIGH: one plan where a search of 0.025 steps
-                        # from 0.25 took five, and as fast or faster on 8 of 10 streams)
+                        # from 0.25 took five; shorter on 8 of the 9 streams it changed)
 CAP_FACTORS = (0.95,)   # a bending run whose window grew: also its top speed capped at
                         # these shares of its plan's
 WINDOW_GROWTH = 1.02    # a bending run's window lengthened by at least this factor a round
