@@ -147,14 +147,22 @@ def test_a_hal_that_cannot_start_says_why_and_leaves_nothing_loaded(tmp_path):
     assert rtapi_pids() == [] and live_hal_processes() == []
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
-def test_ctrl_c_unloads_hal_and_exits_130(tmp_path, sig):
-    """Ctrl-C, and SIGTERM likewise (issue 36): HAL unloaded, exit 130, its folder gone."""
+def _ignore_ctrl_c() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@pytest.mark.parametrize("sig, start", [(signal.SIGINT, None), (signal.SIGTERM, None),
+                                        (signal.SIGINT, _ignore_ctrl_c)],
+                         ids=["ctrl-c", "sigterm", "ctrl-c-inherited-ignored"])
+def test_ctrl_c_unloads_hal_and_exits_130(tmp_path, sig, start):
+    """Ctrl-C, and SIGTERM likewise (issue 36): HAL unloaded, exit 130, its folder gone;
+    also when the process was started with Ctrl-C ignored (a background job, or a test
+    runner's worker that ignores it), as the ``cadcnc`` command."""
     stream = write_stream_txt(constant_feed_circle(60_000, MACHINE), tmp_path / "s.txt")
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     proc = subprocess.Popen([sys.executable, "-m", "cadcnc.controller.hal", str(stream),
                              "--wide"], stderr=subprocess.PIPE, stdout=subprocess.PIPE,
-                            text=True, env=env)
+                            text=True, env=env, preexec_fn=start)
     try:
         assert proc.stderr.readline().strip() == "HAL running"
         time.sleep(0.3)

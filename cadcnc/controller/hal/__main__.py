@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ...core.errors import EXIT_PARTIAL, CadcncError
+from ...core.interrupts import ctrl_c_interrupts
 from .loop import run_hal_loop, summary
 from .session import HalError, hal_available
 
@@ -42,6 +43,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--wide", action="store_true", help="limit3 at 1e20: pass everything")
     ap.add_argument("--executed", type=Path, help="write executed positions here (.npy)")
     args = ap.parse_args(argv)
+    ctrl_c_interrupts()   # as the cadcnc command: even when started with Ctrl-C ignored
     try:
         missing = hal_available()
         if missing:
