@@ -44,9 +44,9 @@ import numpy as np
 
 import cadcnc
 from cadcnc.controller import Machine, stream_program
+from cadcnc.controller.cut_rows import LANDING, follow_plan
 from cadcnc.controller.feed_plan import plan_feed
 from cadcnc.controller.pieces import pieces_of
-from cadcnc.controller.stream import LANDING, follow_plan
 from cadcnc.core.tolerances import DEFAULT
 from cadcnc.interp.planned_follow import follow
 from cadcnc.ops.finish.shortcut import finish

@@ -17,7 +17,8 @@ from ..core.errors import InputError
 from . import topp
 from .machine import Machine
 from .pieces import Piece, constant_speed
-from .run_plan import PlanError, Profile, plan_run
+from .profile import Profile
+from .run_plan import PlanError, plan_run
 from .runs import Run, runs_of
 
 __all__ = ["BLOCK_ROWS", "MAX_PERIODS", "FeedPlan", "PlanError", "Profile", "plan_feed"]

@@ -45,11 +45,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from ..core.errors import EXIT_GOUGE, CadcncError
 from . import averaged_jerk, plan_once, topp
 from .machine import Machine
+from .profile import Profile
 from .runs import JOIN_SHARE, Run
 
 MARGIN = 0.995
@@ -95,47 +95,6 @@ class PlanError(CadcncError):
     period and the limit; exit 5, as any stream over the limits)."""
 
     exit_code = EXIT_GOUGE
-
-
-@dataclass
-class Profile:
-    """One run's planned motion s(t), t from 0 (at rest at s = 0) to ``duration`` (at
-    rest at s = L): the profile on ``t``, ``s``, ``v``, ``a`` (the interval k from t[k]
-    has acceleration a[k]) and ``S`` = its time integral, averaged over ``window`` s."""
-
-    t: np.ndarray
-    s: np.ndarray
-    v: np.ndarray
-    a: np.ndarray
-    S: np.ndarray
-    window: float
-
-    @property
-    def length(self) -> float:
-        return float(self.s[-1])
-
-    @property
-    def duration(self) -> float:
-        return float(self.t[-1]) + self.window
-
-    def position(self, tau: np.ndarray) -> np.ndarray:
-        """s (mm) at local times ``tau`` (s), clipped to [0, L]."""
-        tau = np.ascontiguousarray(tau, dtype=float)
-        out = np.empty(tau.shape)
-        _positions(self.t, self.s, self.v, self.a, self.S, self.window, tau.ravel(),
-                   out.ravel())
-        return out
-
-
-@njit(cache=True, error_model="numpy")
-def _positions(t, s, v, a, S, window: float, tau, out) -> None:
-    """Profile.position into ``out``: s(t) averaged over ``window`` (or s(t) if 0),
-    ``tau`` non-decreasing or not (sorted sweeps are linear)."""
-    if len(tau) and (tau[1:] >= tau[:-1]).all():
-        topp.averaged_sweep(t, s, v, a, S, window, tau, out)
-        return
-    for i in range(len(tau)):
-        out[i] = topp.averaged(t, s, v, a, S, window, tau[i], 0)
 
 
 def _limits(machine: Machine, derate=(1.0, 1.0, 1.0)):

@@ -12,7 +12,7 @@ from scipy.spatial import cKDTree
 
 import cadcnc
 from cadcnc.controller import Machine, stream_program
-from cadcnc.controller.stream import BLEND
+from cadcnc.controller.cut_rows import BLEND
 from cadcnc.interp.planned_follow import follow
 from cadcnc.ops.finish.shortcut import finish
 from cadcnc.ops.path.pair_path import pair_job

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import cadcnc
-from cadcnc.controller import Machine
+from cadcnc.controller import Machine, cut_rows
 from cadcnc.controller import stream as st
 from cadcnc.ops.path.pair_path import pair_job
 from cadcnc.ops.path.pair_program import program_for_job
@@ -35,7 +35,7 @@ def _jerk_share(corner, blend: float, monkeypatch) -> float:
     stream planned once with the cuts' arc lengths OFF too long."""
     part, program = corner
     machine = Machine.default()
-    monkeypatch.setattr(st, "BLEND", blend)
+    monkeypatch.setattr(cut_rows, "BLEND", blend)
     pieces = [dataclasses.replace(p, s=p.s * (1.0 + OFF)) if p.cut is not None else p
               for p in st.stream_pieces(program, machine, 10_000.0)]
     stream = st._stream(program, machine, pieces, stepper_factory(part), True, np.ones(3),
@@ -45,7 +45,7 @@ def _jerk_share(corner, blend: float, monkeypatch) -> float:
 
 
 def test_the_end_blend_keeps_the_jerk_within_its_limit(corner, monkeypatch):
-    assert _jerk_share(corner, st.BLEND, monkeypatch) <= 1.0
+    assert _jerk_share(corner, cut_rows.BLEND, monkeypatch) <= 1.0
 
 
 def test_a_short_end_blend_breaks_it(corner, monkeypatch):

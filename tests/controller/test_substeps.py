@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from cadcnc.controller import Machine
+from cadcnc.controller.cut_rows import substep_lengths
 from cadcnc.controller.pieces import MAX_SUBSTEPS, substeps_for
-from cadcnc.controller.stream import substep_lengths
 from cadcnc.controller.topp import flatten
 
 UM = 1e-3   # mm
