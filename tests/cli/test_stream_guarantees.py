@@ -125,7 +125,7 @@ def test_an_origin_far_outside_the_part_is_an_input_error(tmp_path):
 def test_periods_are_estimated_and_bounded_before_work(program, tmp_path, monkeypatch):
     """Finding 4: an estimate before the work, and a refusal over --max-periods (exit 2)
     before any position is computed."""
-    import cadcnc.controller.stream as stream
+    import cadcnc.controller.cut_rows as cut_rows
 
     run = cadcnc_cli("stream", program, "-o", tmp_path / "s.npy")
     assert run.returncode == 0
@@ -135,7 +135,7 @@ def test_periods_are_estimated_and_bounded_before_work(program, tmp_path, monkey
     def never(*args, **kwargs):
         raise AssertionError("no position of a stream over --max-periods is computed")
 
-    monkeypatch.setattr(stream, "follow", never)   # the kernel's loop over a cut
+    monkeypatch.setattr(cut_rows, "follow", never)   # the kernel's loop over a cut
     run = cadcnc_cli("stream", program, "-o", tmp_path / "t.npy", "--max-periods",
                      str(periods // 2))
     assert run.returncode == 2 and "--max-periods" in run.stderr, run.stderr
