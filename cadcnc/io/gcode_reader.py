@@ -10,6 +10,7 @@ program); the first position is the first move's end.
 from __future__ import annotations
 
 import math
+import os
 import re
 import shutil
 import subprocess
@@ -44,8 +45,10 @@ def canonical_calls(file, strict: bool = False) -> list[tuple[str, list[str]]]:
         raise InputError(f"{file}: no such file")
     with tempfile.TemporaryDirectory(prefix="cadcnc-rs274-") as tmp:
         out = Path(tmp) / "canon.txt"
+        # rs274 keeps its tool table in $HOME/.tool.mmap, truncated by each run: runs at
+        # once (worker threads, other commands) each get a home of their own
         run = subprocess.run([rs274_path(), "-g", str(file), str(out)], capture_output=True,
-                             text=True, timeout=TIMEOUT_S)
+                             text=True, timeout=TIMEOUT_S, env={**os.environ, "HOME": tmp})
         text = out.read_text() if out.exists() else ""
     calls = [(m.group(1), [a.strip() for a in m.group(2).split(",")])
              for m in map(CALL.match, text.splitlines()) if m]

@@ -15,6 +15,7 @@ y 5..13 (plus --setup-overlap).
 
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import subprocess
@@ -113,7 +114,8 @@ def test_cli_writes_one_program_per_setup(shared_corner, tmp_path):
         ngc = tmp_path / f"P{tag}.ngc"
         assert f"tool axis {tag}" in ngc.read_text() or tag == "+Z"
         proc = subprocess.run([RS274, "-g", str(ngc), str(tmp_path / "canon")],
-                              capture_output=True, text=True, timeout=60)
+                              capture_output=True, text=True, timeout=60,
+                              env={**os.environ, "HOME": str(tmp_path)})   # own .tool.mmap
         assert proc.returncode == 0 and "PROGRAM_END" in (tmp_path / "canon").read_text()
 
 
