@@ -23,18 +23,31 @@ EPS = 2.0 ** -52
 
 
 @njit(cache=True, error_model="numpy")
-def coefficients(k: int, h: float, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs) -> float:
-    """Knot k's acceleration constraints cu u + cw w <= rhs (ROWS, into the buffers) for
-    the speed w at its start, and its Coriolis bound: |u| <= returned / sqrt(w)."""
+def coefficients(k: int, h: float, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs) -> tuple:
+    """Knot k's acceleration constraints cu u + cw w <= rhs (at most ROWS, into the
+    buffers' first rows) for the speed w at its start, and its Coriolis bound: (c, m),
+    |u| <= c / sqrt(w) and the m rows written. A row the same as one before it (no box
+    on T: both of its corners; the knot's end where nothing changes along it and there is
+    no curvature: its start's) and a row with no term (an axis the knot does not move)
+    are left out: every bound is a minimum or maximum over the rows, and a row left out
+    is one already there or one that bounds nothing, so the bounds are the same floats."""
     n = 0
     for e in range(2):
         j = k + e
         reach = 2.0 * h if e == 1 else 0.0
         for i in range(3):
+            if e == 1 and (Tc[j, i] == Tc[k, i] and Tr[j, i] == Tr[k, i]
+                           and Kc[k, i] == 0.0 and Kr[k, i] == 0.0
+                           and Kc[j, i] == 0.0 and Kr[j, i] == 0.0):
+                continue   # the end's rows are the start's
+            corners = 1 if Tr[j, i] == 0.0 else 2
             for s1 in (-1.0, 1.0):
                 kw = s1 * Kc[j, i] + Kr[j, i]
-                for s2 in (-1.0, 1.0):
-                    cu[n] = s1 * Tc[j, i] + s2 * Tr[j, i] + kw * reach
+                for q in range(corners):
+                    x = s1 * Tc[j, i] + (1.0 if q else -1.0) * Tr[j, i] + kw * reach
+                    if x == 0.0 and kw == 0.0 and A[i] > 0.0:   # bounds nothing
+                        continue
+                    cu[n] = x
                     cw[n] = kw
                     rhs[n] = A[i]
                     n += 1
@@ -43,7 +56,7 @@ def coefficients(k: int, h: float, Tc, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs) -> f
         km = max(Kmax[k, i], Kmax[k + 1, i])
         if km > 0.0:
             c = min(c, C[i] / (3.0 * km))
-    return c
+    return c, n
 
 
 @njit(cache=True, error_model="numpy")
@@ -154,13 +167,14 @@ def _crossing(w: float, lp, lq, nl: int, up, uq, nu: int) -> float:
 
 @njit(cache=True, error_model="numpy")
 def largest(top: float, h: float, w_next: float, cu, cw, rhs, coriolis: float,
-            buf) -> float:
+            buf, a_max: float) -> float:
     """The largest w in [0, top] from which the knot ends at <= w_next, in closed form:
     every bound on u is affine in w (u >= lp + lq w, u <= up + uq w; buffers of ROWS + 1)
     or the Coriolis ±coriolis / sqrt(w); each pair (lower, upper) caps w linearly, or, with
     the Coriolis term, at the first root of a cubic in sqrt(w). Checked with
     :func:`feasible` (lowered by round-off amounts where it fails; then the bisection of
-    the feasible interval)."""
+    the feasible interval, whose bracket scales with ``a_max``, the largest acceleration
+    limit of any axis)."""
     lp, lq, up, uq = buf[0], buf[1], buf[2], buf[3]
     nl, nu = 1, 1
     lp[0], lq[0] = 0.0, -0.5 / h            # w_next >= 0
@@ -189,7 +203,7 @@ def largest(top: float, h: float, w_next: float, cu, cw, rhs, coriolis: float,
             return best
         best *= 1.0 - shrink
         shrink *= 10.0
-    a, b = 0.0, min(top, w_next + 2.0 * h * np.max(np.abs(rhs)) * 1e3)
+    a, b = 0.0, min(top, w_next + 2.0 * h * a_max * 1e3)
     for _ in range(BISECTIONS):
         m = 0.5 * (a + b)
         if feasible(m, h, w_next, cu, cw, rhs, coriolis):

@@ -35,7 +35,9 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
     n = len(s)
     cu, cw, rhs = np.empty((n, ROWS)), np.empty((n, ROWS)), np.empty((n, ROWS))
     cor = np.empty(n)   # each knot's constraints, made once for both passes
+    rows = np.zeros(n, dtype=np.int64)   # how many of each knot's rows are written
     buf = np.empty((4, ROWS + 1))   # largest's: the affine bounds on u
+    a_max = np.max(np.abs(A))
     wb = np.empty(n)
     wb[n - 1] = 0.0
     for k in range(n - 2, -1, -1):
@@ -44,11 +46,13 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
         if h <= 0.0:
             wb[k] = min(top, wb[k + 1])
             continue
-        cor[k] = coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu[k], cw[k], rhs[k])
-        if feasible(top, h, wb[k + 1], cu[k], cw[k], rhs[k], cor[k]):
+        cor[k], m = coefficients(k, h, Tc, Tr, Kc, Kr, Kmax, A, C, cu[k], cw[k], rhs[k])
+        rows[k] = m
+        if feasible(top, h, wb[k + 1], cu[k, :m], cw[k, :m], rhs[k, :m], cor[k]):
             wb[k] = top
         else:
-            wb[k] = largest(top, h, wb[k + 1], cu[k], cw[k], rhs[k], cor[k], buf)
+            wb[k] = largest(top, h, wb[k + 1], cu[k, :m], cw[k, :m], rhs[k, :m], cor[k],
+                            buf, a_max)
     w = np.empty(n)
     u = np.zeros(n - 1)
     w[0] = 0.0
@@ -57,7 +61,8 @@ def passes(s, wl, Tc, Tr, Kc, Kr, Kmax, A, C):
         if h <= 0.0:
             w[k + 1] = min(w[k], wb[k + 1])
             continue
-        lo, hi = bounds(w[k], h, cu[k], cw[k], rhs[k], cor[k])
+        m = rows[k]
+        lo, hi = bounds(w[k], h, cu[k, :m], cw[k, :m], rhs[k, :m], cor[k])
         x = min(hi, (wb[k + 1] - w[k]) / (2.0 * h))
         x = max(x, lo)
         u[k] = x

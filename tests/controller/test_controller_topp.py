@@ -103,7 +103,7 @@ def test_the_closed_form_largest_speed_is_the_bisected_one():
     """Random curved knots (curvature, its box, the Coriolis term binding or not): the
     closed form is feasible and equals the bisection of the feasibility test."""
     rng = np.random.default_rng(7)
-    cu, cw, rhs = (np.empty(knot.ROWS) for _ in range(3))
+    cu_all, cw_all, rhs_all = (np.empty(knot.ROWS) for _ in range(3))
     buf = np.empty((4, knot.ROWS + 1))
     A, checked = np.array([1000.0, 800.0, 500.0]), 0
     for _ in range(400):
@@ -114,11 +114,12 @@ def test_the_closed_form_largest_speed_is_the_bisected_one():
         Kmax = np.abs(Kc) + Kr
         C = np.full(3, rng.choice([math.inf, 5_000.0, 500.0]))
         h, w_next = rng.uniform(0.01, 1.0), rng.uniform(0.0, 2e4)
-        cor = knot.coefficients(0, h, T, Tr, Kc, Kr, Kmax, A, C, cu, cw, rhs)
+        cor, m = knot.coefficients(0, h, T, Tr, Kc, Kr, Kmax, A, C, cu_all, cw_all, rhs_all)
+        cu, cw, rhs = cu_all[:m], cw_all[:m], rhs_all[:m]
         top = 1e6
         if knot.feasible(top, h, w_next, cu, cw, rhs, cor):
             continue
-        got = knot.largest(top, h, w_next, cu, cw, rhs, cor, buf)
+        got = knot.largest(top, h, w_next, cu, cw, rhs, cor, buf, float(A.max()))
         ref = _bisected(top, h, w_next, cu, cw, rhs, cor)
         assert knot.feasible(got, h, w_next, cu, cw, rhs, cor)
         assert got == pytest.approx(ref, rel=1e-9, abs=1e-9)
@@ -256,3 +257,55 @@ def test_the_coriolis_root_is_the_first_root_on_its_feasible_side():
         assert abs(got - want) <= 1e-14 * max(want, 1.0), (q, p, c, x, got, want)
         checked += want < x
     assert checked > 500   # most cases bind: the root lies below x
+
+
+def _all_rows(k, h, Tc, Tr, Kc, Kr, A):
+    """Every one of a knot's ROWS constraints, duplicates and empty rows included (the
+    definition: 2 ends x 3 axes x the 4 corners of the (T, K) box)."""
+    rows = []
+    for e in range(2):
+        j = k + e
+        reach = 2.0 * h if e == 1 else 0.0
+        for i in range(3):
+            for s1 in (-1.0, 1.0):
+                kw = s1 * Kc[j, i] + Kr[j, i]
+                for s2 in (-1.0, 1.0):
+                    rows.append((s1 * Tc[j, i] + s2 * Tr[j, i] + kw * reach, kw, A[i]))
+    return (np.array(c) for c in zip(*rows))
+
+
+@pytest.mark.parametrize("kind", ["straight", "planar", "curved", "boxed"])
+def test_the_rows_left_out_change_no_bound(kind):
+    """The rows :func:`knot.coefficients` leaves out (repeats, rows that bound nothing)
+    change no float: the bounds at any speed, feasibility and the largest speed equal
+    those of all ROWS rows, on straight, planar and curved knots."""
+    rng = np.random.default_rng(11)
+    cu_all, cw_all, rhs_all = (np.empty(knot.ROWS) for _ in range(3))
+    buf = np.empty((4, knot.ROWS + 1))
+    A, fewer = np.array([1000.0, 800.0, 500.0]), 0
+    for _ in range(300):
+        T = rng.normal(size=3)
+        if kind == "planar":
+            T[1] = 0.0
+        T = np.tile(T / np.linalg.norm(T), (2, 1))
+        Tr, Kc, Kr = np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3))
+        if kind in ("curved", "boxed"):
+            T += rng.normal(scale=0.05, size=(2, 3))
+            Kc = rng.normal(scale=0.3, size=(2, 3))
+        if kind == "boxed":
+            Tr, Kr = np.full((2, 3), 0.01), np.abs(rng.normal(scale=0.02, size=(2, 3)))
+        Kmax = np.abs(Kc) + Kr
+        C = np.full(3, rng.choice([math.inf, 5_000.0, 500.0]))
+        h, w_next = rng.uniform(0.01, 1.0), rng.uniform(0.0, 2e4)
+        cor, m = knot.coefficients(0, h, T, Tr, Kc, Kr, Kmax, A, C, cu_all, cw_all, rhs_all)
+        rows = (cu_all[:m], cw_all[:m], rhs_all[:m])
+        full = tuple(_all_rows(0, h, T, Tr, Kc, Kr, A))
+        fewer += m < knot.ROWS
+        for w in rng.uniform(0.0, 1e5, size=8):
+            assert knot.bounds(w, h, *rows, cor) == knot.bounds(w, h, *full, cor)
+        for top in (1e6, rng.uniform(0.0, 1e4)):
+            assert knot.feasible(top, h, w_next, *rows, cor) == \
+                knot.feasible(top, h, w_next, *full, cor)
+            assert knot.largest(top, h, w_next, *rows, cor, buf, 1000.0) == \
+                knot.largest(top, h, w_next, *full, cor, buf, 1000.0)
+    assert fewer == (0 if kind == "boxed" else 300)
