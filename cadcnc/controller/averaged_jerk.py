@@ -60,9 +60,21 @@ def peak_share(t, s, v, a, S, window: float, grid, T, K, D, jump, kink, J,
     and every axis; ``grid`` (n,) and T, K, D, jump, kink (n, 3) the run's path
     derivatives and joins (a join's one-period jolt, |jump_i| v^2 / period + |kink_i| v /
     period^2, added where the averaged motion passes it, at its speed there)."""
+    inf = np.full(3, np.inf)
+    return shares(t, s, v, a, S, window, grid, T, K, D, jump, kink, inf, inf, J, period,
+                  np.full(len(grid), np.inf))[2]
+
+
+@njit(cache=True, error_model="numpy")
+def shares(t, s, v, a, S, window: float, grid, T, K, D, jump, kink, V, A, J,
+           period: float, cap) -> tuple:
+    """(velocity, acceleration, jerk): the largest shares of the limits that the profile
+    averaged over ``window`` takes, measured as :func:`peak_share` measures the jerk:
+    |T_i v| / V_i and the speed over the programmed one ``cap`` (n,) (the lower of the
+    two grid points around), |T_i a + K_i v^2| / A_i."""
     n = len(t)
     times = _merged(t, window)
-    worst = 0.0
+    worst_v = worst_a = worst = 0.0
     k1 = k0 = g = 0
     end = t[n - 1]
     for q in range(2 * n - 1):
@@ -91,6 +103,7 @@ def peak_share(t, s, v, a, S, window: float, grid, T, K, D, jump, kink, J,
                 g += 1
             h = grid[g + 1] - grid[g]
             f = min(max((sf - grid[g]) / h, 0.0), 1.0) if h > 0.0 else 0.0
+            worst_v = max(worst_v, vf / min(cap[g], cap[g + 1]))
             for i in range(3):
                 Ti = T[g, i] + f * (T[g + 1, i] - T[g, i])
                 Ki = K[g, i] + f * (K[g + 1, i] - K[g, i])
@@ -99,6 +112,8 @@ def peak_share(t, s, v, a, S, window: float, grid, T, K, D, jump, kink, J,
                         + max(abs(kink[g, i]), abs(kink[g + 1, i])) * vf / period ** 2)
                 jerk = abs(Ti * jf + 3.0 * Ki * vf * af) + Di * vf ** 3 + jolt
                 if not math.isfinite(jerk):
-                    return math.inf
+                    return math.inf, math.inf, math.inf
                 worst = max(worst, jerk / J[i])
-    return worst
+                worst_v = max(worst_v, abs(Ti * vf) / V[i])
+                worst_a = max(worst_a, abs(Ti * af + Ki * vf * vf) / A[i])
+    return worst_v, worst_a, worst

@@ -63,6 +63,11 @@ class FeedPlan:
         return float(self.starts[-1])
 
     @property
+    def measured(self) -> bool:
+        """Whether a run was planned with its limits where they are (Profile.measured)."""
+        return any(p.measured for p in self.profiles)
+
+    @property
     def periods(self) -> int:
         """Periods to the end: the stream has periods + 1 positions (the start at t = 0)."""
         return int(math.ceil(self.duration / self.machine.period - 1e-9))  # ceil's round-off
@@ -123,9 +128,11 @@ def _first_periods(starts: np.ndarray, period: float, n: int) -> list[int]:
 
 
 def plan_feed(pieces: list[Piece], machine: Machine, planned: bool = True,
-              derate=(1.0, 1.0, 1.0)) -> FeedPlan:
+              derate=(1.0, 1.0, 1.0), measured: bool = True) -> FeedPlan:
     """The plan of every run: to the machine's limits (each scaled by ``derate``: v, a,
-    j), or (``planned=False``) every piece at the programmed feed ignoring them."""
+    j), or (``planned=False``) every piece at the programmed feed ignoring them.
+    ``measured`` False: no run that bends is planned with its limits where they are
+    (:func:`.run_plan.plan_run`)."""
     if not pieces:
         raise InputError("the program has nothing to stream (no cut or move)")
     if not planned:
@@ -138,7 +145,7 @@ def plan_feed(pieces: list[Piece], machine: Machine, planned: bool = True,
         same = planned_runs.setdefault(_run_key(run), [])
         profile = next((p for r, p in same if _same_run(r, run)), None)
         if profile is None:
-            profile = plan_run(run, machine, derate)
+            profile = plan_run(run, machine, derate, measured)
             same.append((run, profile))
         profiles.append(profile)
     return FeedPlan(pieces, runs, profiles, machine, True)

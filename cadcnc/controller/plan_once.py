@@ -47,13 +47,15 @@ def speed_limits(cap, T, D, jump, V, J, period: float, d_share: float,
 
 @njit(cache=True, error_model="numpy")
 def plan_once(s, wl, T, K, D, jump, kink, A, J, period: float, window: float,
-              coriolis: float, reach_lo, reach_hi, reach_given: bool):
+              coriolis: float, reach_lo, reach_hi, reach_given: bool, eroded: bool = True):
     """One plan of the run with averaging ``window`` and the Coriolis term's share
     ``coriolis`` of J, the path's derivatives taken over [reach_lo, reach_hi] around each
-    point (``reach_given`` False: +- the top speed times the window): t, w, u, v, a, S and
-    per knot the window needed (:func:`.topp.window_needed`)."""
+    point (``reach_given`` False: +- the top speed times the window), the speed limits
+    held over the window's reach (``eroded`` False: where they are, for a plan whose
+    averaged motion is measured): t, w, u, v, a, S and per knot the window needed
+    (:func:`.topp.window_needed`)."""
     n = len(s)
-    wl_e = reach.erode(s, wl, window)
+    wl_e = reach.erode(s, wl, window) if eroded else wl.copy()
     top2 = 0.0
     for k in range(n):
         if math.isfinite(wl_e[k]):

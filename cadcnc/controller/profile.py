@@ -16,7 +16,9 @@ from . import topp
 class Profile:
     """One run's planned motion s(t), t from 0 (at rest at s = 0) to ``duration`` (at
     rest at s = L): the profile on ``t``, ``s``, ``v``, ``a`` (the interval k from t[k]
-    has acceleration a[k]) and ``S`` = its time integral, averaged over ``window`` s."""
+    has acceleration a[k]) and ``S`` = its time integral, averaged over ``window`` s.
+    ``measured``: planned with its limits where they are, its averaged motion measured
+    (:func:`.run_plan.plan_run`), not held over the window's reach."""
 
     t: np.ndarray
     s: np.ndarray
@@ -24,6 +26,7 @@ class Profile:
     a: np.ndarray
     S: np.ndarray
     window: float
+    measured: bool = False
 
     @property
     def length(self) -> float:

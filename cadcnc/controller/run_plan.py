@@ -28,7 +28,16 @@ from rest to rest:
    BENT_ROOM), its window grown only as much as
    the measured jerk asks (from the second growth on, where the secant of the measured
    share through the last two windows reaches 1: :func:`_secant`; and, where it grew,
-   its top speed also capped at CAP_FACTORS of the plan's, the faster kept).
+   its top speed also capped at CAP_FACTORS of the plan's, the faster kept);
+6. on a run that bends, once the best of the above is known, a *measured* plan with its
+   acceleration and D share (:func:`_measured_window`): the axes' velocity and D v^3
+   limits where they are and the path's derivatives at each point (no reach; the
+   programmed speed and the joins' jolts still held over it), the averaged motion's
+   velocity, acceleration and jerk all measured (:func:`.averaged_jerk.shares`), the
+   limits scaled down where it goes over; kept where faster. The run's grid may not
+   resolve the path where p''' is large (a tight curl), which only the held limits and
+   boxes covered: the stream's own check decides, and a stream it finds over a limit is
+   planned again with no measured plan (:func:`.stream.stream_program`).
 
 A plan tried against another is given up as soon as one of its rounds lasts as long
 (:class:`_Slower`): its rounds only get longer. Only plans that no later plan depends on
@@ -47,7 +56,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.errors import EXIT_GOUGE, CadcncError
-from . import averaged_jerk, plan_once, topp
+from . import averaged_jerk, plan_once, reach, topp
 from .machine import Machine
 from .profile import Profile
 from .runs import JOIN_SHARE, Run
@@ -79,6 +88,8 @@ TIGHTEN_ROUNDS = 2      # plans with the derivatives taken where the motion goes
 TIGHTEN_SLACK = 0.1     # the ranges assumed: those of the last plan, widened this much
 TIE = 1e-12            # plans of a run whose durations agree within this share are a tie:
                        # the first kept (which one an early give-up skips is then moot)
+SCALE_OVER = 5e-4       # a measured plan over a velocity or acceleration limit: its limits
+SCALE_ROUNDS = 4        # scaled by the share over and this much more, at most this often
 NEED_ROUNDOFF = 1e-7    # a window the plan needs to within this share of itself suffices
                         # (round-off; MARGIN covers it), and flattening that shortens the
                         # need by less is no progress: no plan made again for round-off
@@ -120,11 +131,15 @@ def _d_binds(run: Run, V, J, period: float) -> bool:
 
 
 def _plan_once(run: Run, wl: np.ndarray, V, A, J, period: float, window: float,
-               coriolis: float, reach=None):
+               coriolis: float, reach=None, tight: bool = False):
     """One plan of the run with averaging ``window`` and the Coriolis term's share
     ``coriolis`` of J, the path's derivatives taken over ``reach`` ((lo, hi) (n,) arc
-    lengths around each point; None: +- the top speed times the window): t, w, u, v, a,
-    S and per knot the window needed (:func:`.plan_once.plan_once`)."""
+    lengths around each point; None: +- the top speed times the window; ``tight``: at
+    each point only, and ``wl`` not held over the reach): t, w, u, v, a, S and per knot
+    the window needed (:func:`.plan_once.plan_once`)."""
+    if tight:
+        return plan_once.plan_once(run.s, wl, run.T, run.K, run.D, run.jump, run.kink, A,
+                                   J, period, window, coriolis, run.s, run.s, True, False)
     lo, hi = (run.s, run.s) if reach is None else reach
     return plan_once.plan_once(run.s, wl, run.T, run.K, run.D, run.jump, run.kink, A, J,
                                period, window, coriolis, lo, hi, reach is not None)
@@ -148,6 +163,64 @@ def _tightened(run: Run, wl, limits, period: float, window: float, coriolis: flo
             return plan
         lo, hi = np.minimum(lo, lo2), np.maximum(hi, hi2)
     return first
+
+
+class _Loose(Exception):
+    """A plan whose speed limits were not held over the window's reach (``tight``) and
+    whose averaged motion, measured, goes over a velocity or acceleration limit."""
+
+
+def _measured_window(run: Run, machine: Machine, limits, coriolis: float, cap: float,
+                     d_share: float, window: float, beat: float) -> _Windowed:
+    """A bending run's ``tight`` plan: the axes' velocity and D v³ speed limits where they
+    are and its path's derivatives at each point (no reach); the limits that hold at a
+    point (the programmed speed, a join's or a curvature jump's jolt) still held over the
+    window's reach. The averaged motion's velocity, acceleration and jerk are all
+    measured (:func:`.averaged_jerk.shares`). Where the velocity or acceleration goes
+    over, the speed limits (squared) and the accelerations are scaled down by the share
+    measured (a little more: SCALE_OVER), at most SCALE_ROUNDS times (then _Loose); where
+    the jerk does, the window grows as in :func:`_windowed`."""
+    V, A, J = limits
+    period, n = machine.period, len(run.s)
+    smooth = np.minimum(plan_once.speed_limits(
+        np.full(n, np.inf), run.T, run.D, np.zeros_like(run.jump), V, J, period, d_share,
+        JOIN_SHARE), cap * cap)
+    points = plan_once.speed_limits(run.cap, run.T, np.zeros_like(run.D), run.jump,
+                                    np.full(3, np.inf), J, period, d_share, JOIN_SHARE)
+    kv = ka = 1.0
+    grown, scaled, floor = None, 0, 0.0
+    for _ in range(WINDOW_ROUNDS):
+        # the window only grows and the limits only fall: the last raw profile's time
+        # and this window already bound the plan's duration
+        if floor + window >= beat:
+            raise _Slower
+        wl = np.minimum(smooth, reach.erode(run.s, points, window))
+        plan = _plan_once(run, wl * kv, V, A * ka, J, period, window, coriolis, tight=True)
+        t, w, u, v, a, S, need = plan
+        floor = float(t[-1])
+        if floor + window >= beat:
+            raise _Slower
+        sv, sa, sj = averaged_jerk.shares(t, run.s, v, a, S, window, run.s, run.T, run.K,
+                                          run.D, run.jump, run.kink, V, A, J,
+                                          machine.period, run.cap)
+        if not math.isfinite(sj):
+            raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: the "
+                            "curvature leaves no jerk for the feed to change")
+        if sj > 1.0:   # the window first, as in _windowed
+            step = _secant(grown, window, sj)
+            grown = (window, sj)
+            window = window * max(sj, WINDOW_GROWTH) if step is None else step
+            continue
+        if sv <= 1.0 and sa <= 1.0:
+            return _Windowed(coriolis, window, wl * kv, plan, True)
+        scaled += 1
+        if scaled > SCALE_ROUNDS:
+            raise _Loose
+        kv /= max(sv, 1.0) ** 2 * (1.0 + SCALE_OVER)
+        ka /= max(sa, 1.0) * (1.0 + SCALE_OVER)
+        grown = None   # the jerk's secant was of other limits
+    raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: no "
+                    f"averaging window keeps the jerk within {machine.summary()}")
 
 
 def _measured(run: Run, plan: tuple, window: float, J, period: float) -> float:
@@ -183,6 +256,7 @@ class _Windowed:
     window: float
     wl: np.ndarray
     plan: tuple
+    measured: bool = False   # its limits where they are (:func:`_measured_window`)
 
     @property
     def duration(self) -> float:
@@ -191,14 +265,17 @@ class _Windowed:
 
 def _windowed(run: Run, machine: Machine, limits, coriolis: float,
               cap: float = math.inf, d_share: float = D_SHARE,
-              beat: float = math.inf) -> _Windowed:
+              beat: float = math.inf, tight: bool = False) -> _Windowed:
     """The run's plan with the Coriolis term's share ``coriolis`` and the D v³ term's
     ``d_share`` of J (see the module doc), its speed at most ``cap`` (mm/s): turns
     flattened, or the window grown, until the window is long enough. _Slower as soon as
-    a round lasts ``beat`` s or more."""
+    a round lasts ``beat`` s or more. ``tight``: the measured plan instead
+    (:func:`_measured_window`)."""
     V, A, J = limits
     wl = np.minimum(_speed_limits(run, V, J, machine.period, d_share), cap * cap)
     window = _first_window(run, A, J)
+    if tight:
+        return _measured_window(run, machine, limits, coriolis, cap, d_share, window, beat)
     flattening, last = True, math.inf
     grown = None   # (window, measured) of the last window grown from
     for round_ in range(WINDOW_ROUNDS):
@@ -262,12 +339,15 @@ def _profile(run: Run, machine: Machine, limits, chosen: _Windowed) -> Profile:
                           chosen.coriolis, plan)
     t, w, u, v, a, S, need = plan
     keep = np.append(run.s[1:] > run.s[:-1], True)
-    return Profile(t[keep], run.s[keep], v[keep], a[keep], S[keep], chosen.window)
+    return Profile(t[keep], run.s[keep], v[keep], a[keep], S[keep], chosen.window,
+                   chosen.measured)
 
 
-def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
+def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0),
+             measured: bool = True) -> Profile:
     """The jerk-limited, near time-optimal profile of one run (see the module doc);
-    ``derate`` (3,) scales the velocity, acceleration and jerk used."""
+    ``derate`` (3,) scales the velocity, acceleration and jerk used; ``measured`` False:
+    no measured plan (step 6)."""
     V, A, J = _limits(machine, derate)
     # a short run: the acceleration a jerk ramp up and down over its length reaches
     A = np.minimum(A, np.cbrt(J * J * run.length))
@@ -289,7 +369,15 @@ def plan_run(run: Run, machine: Machine, derate=(1.0, 1.0, 1.0)) -> Profile:
                 raise
             continue
         if plan is None or other.duration < plan.duration * (1.0 - TIE):   # a tie: the first
-            plan = other
+            plan, won = other, (acceleration, d_share)
+    if measured and run.bends:   # the winner's limits where they are, the motion measured
+        limits = (V, won[0], J)
+        try:
+            chosen = _capped(run, machine, limits, won[1], plan.duration, tight=True)
+        except (PlanError, _Slower, _Loose):
+            return plan
+        if chosen.duration < plan.duration * (1.0 - TIE):
+            plan = _profile(run, machine, limits, chosen)
     return plan
 
 
@@ -331,23 +419,26 @@ def _best_share(run: Run, machine: Machine, limits, d_share: float = D_SHARE,
 
 
 def _capped(run: Run, machine: Machine, limits, d_share: float = D_SHARE,
-            beat: float = math.inf) -> _Windowed:
+            beat: float = math.inf, tight: bool = False) -> _Windowed:
     """A bending run at BENT_SHARE (less where the D v³ share leaves less: BENT_ROOM);
     where its window had to grow, also with its top speed capped at each of CAP_FACTORS
     of the plan's (a slower top asks for less window), the fastest kept: a looser limit
     that lets the feed higher never lengthens the run more than these caps can give back.
     Only the capped plans give up early (against ``beat`` and the uncapped plan): the
-    uncapped one is planned in full, as the caps are shares of its top speed."""
+    uncapped one is planned in full, as the caps are shares of its top speed. ``tight``:
+    measured plans (:func:`_measured_window`), which no later plan depends on, the
+    uncapped one too giving up against ``beat``."""
     bent = min(BENT_SHARE, 1.0 - d_share - BENT_ROOM)
-    best = _windowed(run, machine, limits, bent, d_share=d_share)
+    best = _windowed(run, machine, limits, bent, d_share=d_share,
+                     beat=beat if tight else math.inf, tight=tight)
     if not _grew(run, limits, best):
         return best
     top = float(np.max(best.plan[3]))
     for factor in CAP_FACTORS:
         try:
             other = _windowed(run, machine, limits, bent, factor * top, d_share,
-                              min(beat, best.duration))
-        except (PlanError, _Slower):
+                              min(beat, best.duration), tight)
+        except (PlanError, _Slower, _Loose):
             continue
         if other.duration < best.duration:
             best = other

@@ -223,37 +223,46 @@ def stream_program(program: Program, machine: Machine, steppers: StepperFactory 
     ``max_periods`` periods is refused before any position is computed (InputError);
     ``progress(done, total, "periods")`` hears of the work after each block of periods
     (:data:`~.feed_plan.BLOCK_ROWS` at most). A planned
-    stream whose finite differences break a limit is planned again with that limit
-    lowered by as much (REPLANS times at most), then refused (PlanError). ``blend`` (mm)
+    stream whose finite differences break a limit is planned again, first with every
+    bending run's limits held over its averaging window's reach (the first plan measures
+    some where they are, which the run's grid may not resolve: :mod:`.run_plan`), then
+    with the limit that was broken lowered by as much (REPLANS times at most), then
+    refused (PlanError). ``blend`` (mm)
     rounds the corners of the links that pay for it within it, but not of the segments
     in ``exact`` (:func:`.link_blends.stream_pieces`); a blend is positioned on its samples by
     the Hermite. ``on_plan(plan)`` hears of each plan before its positions are computed
     (to count, bound or announce the periods; a replan is heard again). ``scratch``: the
     folder of a long stream's positions file (:func:`~cadcnc.core.scratch.rows_array`)."""
     pieces = stream_pieces(program, machine, feed, blend, exact)
-    derate = np.ones(3)
-    for _ in range(REPLANS + 1):
+    derate, measured, replans = np.ones(3), True, 0
+    while True:
         stream = None   # a replan's positions replace these (one scratch file at a time)
         stream = _stream(program, machine, pieces, steppers, planned, derate, max_periods,
-                         progress, on_plan, scratch)
+                         progress, on_plan, scratch, measured)
         if not planned:
             return stream
         over = _over(stream.positions, machine)
         shares = np.array([o[0] for o in over])
         if (shares <= 1.0 + SLACK).all():
             return stream
-        if shares.max() > NOISE:
+        if measured and stream.plan.measured:   # limits taken where they are: now held
+            measured = False
+            continue
+        measured = False
+        if shares.max() > NOISE or replans == REPLANS:
             break
+        replans += 1
         # the path's derivatives between coarse points: plan again with less of the limit
         derate = np.where(shares > 1.0, derate / (shares * (1.0 + 1e-2)), derate)  # 1 % under
     raise _refusal(over, machine)
 
 
 def _stream(program, machine, pieces, steppers, planned, derate, max_periods,
-            progress, on_plan=None, scratch=None) -> Stream:
-    """One plan (limits scaled by ``derate``) and its positions, a block of periods at a
-    time (:meth:`FeedPlan.blocks`: no per-period array but the positions)."""
-    plan = plan_feed(pieces, machine, planned, tuple(derate))
+            progress, on_plan=None, scratch=None, measured: bool = True) -> Stream:
+    """One plan (limits scaled by ``derate``; ``measured``: see
+    :func:`~.feed_plan.plan_feed`) and its positions, a block of periods at a time
+    (:meth:`FeedPlan.blocks`: no per-period array but the positions)."""
+    plan = plan_feed(pieces, machine, planned, tuple(derate), measured)
     if on_plan is not None:
         on_plan(plan)
     total = plan.checked_periods(max_periods)

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from cadcnc.controller import plan_once
-from cadcnc.controller.averaged_jerk import peak_share
+from cadcnc.controller.averaged_jerk import peak_share, shares
 
 RADIUS = 9.0
 A = np.array([381.0, 381.0, 254.0])
@@ -104,3 +104,27 @@ def test_a_joins_jolt_is_added_where_the_motion_passes_it():
     jump[70] = [0.0, 0.0, 0.05]   # a jump of p'' mid-arc, on Z
     jolted = peak_share(t, s, v, a, S, 0.05, s, T, K, D, jump, zero, J, PERIOD)
     assert jolted > plain
+
+
+@pytest.mark.parametrize("coriolis, window", [(0.65, 0.05), (1.0, 0.07)])
+def test_the_velocity_and_acceleration_measured_are_the_averaged_motions(coriolis,
+                                                                         window):
+    """:func:`shares` measures the averaged motion's velocity (against each axis's V and
+    the programmed speed) and acceleration (|T_i a + K_i v^2| against A_i) as it measures
+    the jerk: against the circle's T, K and finite differences of s_f."""
+    (t, s, v, a, S), (T, K, D, zero) = _plan(coriolis, window)
+    cap = np.full(len(s), 60.0)
+    got_v, got_a, got_j = shares(t, s, v, a, S, window, s, T, K, D, zero, zero, V, A, J,
+                                 PERIOD, cap)
+    tau, sf = _averaged_arc_length(t, s, v, a, window)
+    vf = np.gradient(sf, DT)
+    af = np.gradient(vf, DT)
+    th = sf / RADIUS
+    Tc = np.c_[np.cos(th), np.zeros_like(th), np.sin(th)]
+    Kc = np.c_[-np.sin(th), np.zeros_like(th), np.cos(th)] / RADIUS
+    ref_v = max(float((np.abs(Tc * vf[:, None]) / V).max()), float(vf.max() / 60.0))
+    ref_a = float((np.abs(Tc * af[:, None] + Kc * (vf ** 2)[:, None]) / A)[5:-5].max())
+    assert got_v == pytest.approx(ref_v, rel=2e-3)
+    assert got_a == pytest.approx(ref_a, rel=5e-3)
+    assert got_j == peak_share(t, s, v, a, S, window, s, T, K, D, zero, zero, J, PERIOD)
+    assert 0.5 < got_v and 0.5 < got_a   # a real motion, near its limits

@@ -166,6 +166,7 @@ def test_a_replan_lets_the_last_positions_go_first(monkeypatch):
 
     class _Made:
         positions = np.zeros((5, 3))
+        plan = feed_plan.FeedPlan([], [], [], Machine.default())   # nothing measured
 
     def fake_stream(*args):
         alive.append(sum(ref() is not None for ref in made))
@@ -179,3 +180,27 @@ def test_a_replan_lets_the_last_positions_go_first(monkeypatch):
     with pytest.raises(PlanError):
         stream_program(None, Machine.default())
     assert alive == [0] * (stream_module.REPLANS + 1)
+
+
+def test_a_measured_plan_over_a_limit_is_planned_again_with_its_limits_held(monkeypatch):
+    """A first plan that took some run's limits where they are (``plan.measured``) and
+    breaks a limit is planned again with every limit held over the reach, before any
+    limit is lowered; then REPLANS lowered limits at most, then refused."""
+    from types import SimpleNamespace
+
+    from cadcnc.controller.feed_plan import PlanError
+
+    asked = []
+
+    def fake_stream(*args):
+        asked.append((args[-1], tuple(args[5])))   # measured, derate
+        return SimpleNamespace(positions=np.zeros((5, 3)),
+                               plan=SimpleNamespace(measured=args[-1]))
+
+    monkeypatch.setattr(stream_module, "stream_pieces", lambda *a: [])
+    monkeypatch.setattr(stream_module, "_stream", fake_stream)
+    monkeypatch.setattr(stream_module, "_over", lambda positions, machine: [(1.01, 1, 0)] * 3)
+    with pytest.raises(PlanError):
+        stream_program(None, Machine.default())
+    assert [m for m, _ in asked] == [True] + [False] * (stream_module.REPLANS + 1)
+    assert asked[0][1] == asked[1][1] == (1.0, 1.0, 1.0) and asked[2][1] < (1.0, 1.0, 1.0)
