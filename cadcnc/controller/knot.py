@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 ROWS = 24   # acceleration constraints per knot: 2 ends x 3 axes x 4 corners of the box
