@@ -197,6 +197,7 @@ def _measured_window(run: Run, machine: Machine, limits, coriolis: float, cap: f
         wl = np.minimum(smooth, reach.erode(run.s, points, window))
         plan = _plan_once(run, wl * kv, V, A * ka, J, period, window, coriolis, tight=True)
         t, w, u, v, a, S, need = plan
+        _moves(run, t)
         floor = float(t[-1])
         if floor + window >= beat:
             raise _Slower
@@ -281,6 +282,7 @@ def _windowed(run: Run, machine: Machine, limits, coriolis: float,
     for round_ in range(WINDOW_ROUNDS):
         plan = _plan_once(run, wl, V, A, J, machine.period, window, coriolis)
         t, w, u, v, a, S, need = plan
+        _moves(run, t)
         if float(t[-1]) + window >= beat:
             raise _Slower
         top = float(np.max(need, initial=0.0))
@@ -314,6 +316,14 @@ def _windowed(run: Run, machine: Machine, limits, coriolis: float,
         window = min(top, window * max(measured, WINDOW_GROWTH) if step is None else step)
     raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: no "
                     f"averaging window keeps the jerk within {machine.summary()}")
+
+
+def _moves(run: Run, t: np.ndarray) -> None:
+    """PlanError where the plan's time is not finite: a speed limit of 0 inside the run,
+    or a grid with no knot to accelerate on and another to brake on."""
+    if not math.isfinite(float(t[-1])):
+        raise PlanError(f"pieces {run.first + 1}..{run.first + len(run.pieces)}: the speed "
+                        "limits leave no motion from rest to rest")
 
 
 def _secant(before, window: float, measured: float) -> float | None:

@@ -134,8 +134,9 @@ def _cut_derivatives(piece: Piece) -> tuple[np.ndarray, ...]:
                            end_derivatives(piece, True)[0])
 
 
-def _piece_grid(piece: Piece, machine: Machine):
-    """s, T, K, D, jump, cap at the grid points of one piece."""
+def _piece_grid(piece: Piece, machine: Machine, alone: bool = False):
+    """s, T, K, D, jump, cap at the grid points of one piece (``alone``: a run of its own,
+    moved from rest to rest: at least two knots, one to accelerate and one to brake)."""
     if len(piece.points) == 2:   # a straight move (or a cut of one step)
         s = _line_grid(piece)
         n = len(s)
@@ -148,6 +149,8 @@ def _piece_grid(piece: Piece, machine: Machine):
         cap = np.minimum(cap, piece.step_cap)
     eps_t, eps_k = _linear_room(K)
     keep = _linear_knots(piece.s, T, K, CUT_KNOT, eps_t, eps_k)
+    if alone and len(keep) == 2 and len(piece.s) > 2:   # a short straight cut alone
+        keep = np.array([0, len(piece.s) // 2, len(piece.s) - 1])
     D, jump, cap = _held(keep, D, jump, cap)
     return piece.s[keep], T[keep], K[keep], D, jump, cap
 
@@ -227,7 +230,7 @@ def _held(keep: np.ndarray, D: np.ndarray, jump: np.ndarray, cap: np.ndarray) ->
 
 
 def _run(first: int, pieces: list[Piece], machine: Machine, joins: list) -> Run:
-    grids = [_piece_grid(p, machine) for p in pieces]
+    grids = [_piece_grid(p, machine, len(pieces) == 1) for p in pieces]
     offsets = np.concatenate(([0.0], np.cumsum([p.length for p in pieces])))
     s = np.concatenate([g[0] + o for g, o in zip(grids, offsets)])
     T, K, D, jump, cap = (np.concatenate([g[i] for g in grids]) for i in range(1, 6))

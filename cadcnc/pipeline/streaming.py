@@ -24,8 +24,9 @@ from ..core.tolerances import DEFAULT, STREAM_BLEND
 from ..core.units import check_number
 from ..core.work_limits import MAX_STREAM_PERIODS, Ticker, refuse_over, sigterm_as_interrupt
 from ..geometry.part import load_step
+from ..geometry.setup import setup_part
 from ..io.output_set import OutputSet
-from ..io.program_json import read_program
+from ..io.program_json import read_program_and_setup
 from ..ops.stream_steppers import stepper_factory
 from ..verification import gate_program
 from ..verification.stream_check import StreamChecker, check_program_on_part, check_stream
@@ -53,7 +54,7 @@ def stream_saved(program_file, part_file, machine, outputs, *, ini=None, toleran
     """Stream the program saved in ``program_file`` on its part (``part_file``, default
     the STEP file it records) to ``outputs`` (.npy, .txt); ``ini``: the machine's INI
     file (an input no output may overwrite); ``options``: as :func:`stream_to`."""
-    program = read_program(program_file)
+    program, setup = read_program_and_setup(program_file)   # in its work coordinates
     source = part_file or program.job.source
     if not source:
         raise InputError(f"{program_file}: the program names no part: give --part PART.step")
@@ -61,6 +62,8 @@ def stream_saved(program_file, part_file, machine, outputs, *, ini=None, toleran
     if outputs:   # every destination against every input before any work
         OutputSet(outputs, SUFFIXES, inputs=inputs)
     part = load_step(source, flip_material=flip_material)
+    if setup is not None:   # a program of another tool axis: the part turned as it was
+        part = setup_part(part, setup)
     check_program_on_part(program, part, str(program_file), str(source), tolerances.gouge)
     return stream_to(program, part, machine, outputs, tolerances=tolerances, say=say,
                      inputs=inputs, **options)

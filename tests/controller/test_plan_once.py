@@ -210,3 +210,23 @@ def test_each_runs_first_period_is_the_one_a_time_per_period_gives():
                         len(durations) - 1)
             want = np.searchsorted(r, np.arange(len(durations) + 1), side="left")
             assert _first_periods(starts, period, n) == want.tolist()
+
+
+def test_a_short_straight_cut_alone_is_planned_from_rest_to_rest():
+    """A cut of 5 points over 3.8 µm in a straight line (r0901_ec's pencil at R 2 has
+    one) merges into one knot; alone in its run it moves from rest to rest, which one
+    knot cannot do (no time would do): it keeps a middle knot and is planned in a
+    finite time, within its limits."""
+    from cadcnc.controller import Machine
+    from cadcnc.controller.feed_plan import plan_feed
+    from cadcnc.controller.pieces import Piece
+
+    p = np.linspace([0.0, 0.0, 0.0], [-8.1e-7, 1.02e-6, 3.83e-3], 5)
+    s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
+    corner = np.array([p[-1], p[-1] + (5.0, 0.0, 0.0)])   # a rapid at a right angle
+    pieces = [Piece(p, s, 166.7, 0, cut=0),
+              Piece(corner, np.array([0.0, 5.0]), math.inf, 1)]
+    plan = plan_feed(pieces, Machine.default())
+    assert len(plan.runs) == 2 and len(plan.runs[0].s) == 3
+    duration = plan.profiles[0].duration
+    assert 0.0 < duration < 0.1 and plan.profiles[0].v.max() > 0.0

@@ -203,3 +203,27 @@ def test_setup_top_measured_once_per_axis(monkeypatch):
     assert np.array_equal(setup_module.setup_of(fresh, job.axis).origin, first.origin)
     other = setup_module.setup_of(fresh, (0, -1, 0))
     assert len(boxes) == 2 and not np.allclose(other.origin, first.origin)
+
+
+def test_a_program_of_another_axis_streams_on_its_turned_part(part, tmp_path):
+    """``cadcnc stream`` on a program computed with ``--axis -Z``: the part is turned into
+    the program's recorded setup before the stream is checked and gated (it had been read
+    in part coordinates, and the program refused as "computed on another part"). The
+    streamed positions, in work coordinates, mapped back to part coordinates through the
+    recorded rotation and work zero, lie R from both faces along the cut (OCCT)."""
+    facts = FACTS["sides"]["-Z"]
+    floor, wall = facts["floor"], facts["wall"]
+    program, npy = tmp_path / "p.json", tmp_path / "s.npy"
+    cadcnc_cli("path", STEP, "--faces", floor, wall, "--radius", R, "--axis", "-Z",
+               "-o", program)
+    run = cadcnc_cli("stream", program, "--feed", "3000", "-o", npy, check=0)
+    assert "wrote" in run.stdout
+    setup = json.loads(program.read_text())["setup"]
+    rot, zero = np.array(setup["rotation"]), np.array(setup["origin"])
+    pts = np.load(npy) @ rot + zero                      # part coordinates
+    d = np.array(AXES["-Z"], float)
+    on_cut = pts[np.abs(pts @ d - (15 + R)) < DIGITS]
+    assert len(on_cut) > 100
+    for p in on_cut[::50]:
+        for n in (floor, wall):
+            assert abs(face_distance(part, n, p) - R) <= DIGITS, (n, p)
