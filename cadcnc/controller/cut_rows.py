@@ -16,6 +16,10 @@ from ..interp.cycle import CLOSED, END
 from ..interp.planned_follow import follow
 from .pieces import Piece
 
+SHORT_CUT = 0.01  # mm: a cut shorter than this is positioned from its points (cubic
+                  # Hermite through the kernel's own points, nm from the path): the kernel
+                  # re-run on it can step past its end before its end test applies (the
+                  # test waits for two steps' travel, for closed loops)
 LANDING = 1e-6   # relative: the last step of a cut commanded this much past its end
 BLEND = 1.0
 """mm before a cut's end (at most its length) where the target moves onto the distance
@@ -127,8 +131,8 @@ def piece_rows(program, machine, piece: Piece, steppers, counts: dict):
     if piece.cut is None:   # a link's straight move, or a blend by its samples
         line = len(piece.points) == 2
         return lambda s: (_line if line else _hermite)(piece, s)
-    stepper = None if steppers is None else steppers(piece.cut, program.cuts[piece.cut],
-                                                     machine.period)
+    stepper = None if steppers is None or piece.length < SHORT_CUT else steppers(
+        piece.cut, program.cuts[piece.cut], machine.period)
     if stepper is None:
         counts["hermite"] += 1
         return lambda s: _hermite(piece, s)

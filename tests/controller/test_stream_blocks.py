@@ -204,3 +204,24 @@ def test_a_measured_plan_over_a_limit_is_planned_again_with_its_limits_held(monk
         stream_program(None, Machine.default())
     assert [m for m, _ in asked] == [True] + [False] * (stream_module.REPLANS + 1)
     assert asked[0][1] == asked[1][1] == (1.0, 1.0, 1.0) and asked[2][1] < (1.0, 1.0, 1.0)
+
+
+def test_a_cut_shorter_than_short_cut_is_positioned_from_its_points():
+    """A cut under SHORT_CUT (r0901_ec's pencil at R 2 has a 3.8 µm one, which the kernel
+    re-run stepped past) takes its positions from its points: no stepper is built, and
+    its rows at its points' arc lengths are those points (its ends exactly)."""
+    from cadcnc.controller import cut_rows
+    from cadcnc.controller.pieces import Piece
+
+    p = np.linspace([0.0, 0.0, 0.0], [-8.1e-7, 1.02e-6, 3.83e-3], 5)
+    s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
+    piece = Piece(p, s, 166.7, 0, cut=0, kappa=np.zeros(5))
+    assert piece.length < cut_rows.SHORT_CUT
+
+    def no_stepper(*args):
+        raise AssertionError("a stepper was built for a short cut")
+
+    counts = {"kernel": 0, "hermite": 0}
+    rows = cut_rows.piece_rows(None, Machine.default(), piece, no_stepper, counts)
+    assert counts == {"kernel": 0, "hermite": 1}
+    assert np.abs(rows(s) - p).max() < 1e-15
