@@ -20,6 +20,10 @@ SHORT_CUT = 0.01  # mm: a cut shorter than this is positioned from its points (c
                   # Hermite through the kernel's own points, nm from the path): the kernel
                   # re-run on it can step past its end before its end test applies (the
                   # test waits for two steps' travel, for closed loops)
+SETTLE_STEP = 1e-12   # mm: the steps that settle a cut's start onto the kernel's path,
+SETTLE_STEPS = 8      # at most this many (until one moves less than SETTLE_MIN)
+SETTLE = 1.0      # mm: the settling move given out over this much of the cut's ends
+SETTLE_MIN = 1e-9  # mm: ... where it is over this (below, the rows are the kernel's)
 LANDING = 1e-6   # relative: the last step of a cut commanded this much past its end
 BLEND = 1.0
 """mm before a cut's end (at most its length) where the target moves onto the distance
@@ -103,22 +107,67 @@ def _landed(stepper, piece: Piece, what: str) -> None:
                             "mm from it)")
 
 
+def _blend(x: np.ndarray) -> np.ndarray:
+    """The C2 weight from 0 (x <= 0) to 1 (x >= 1): 10 x³ - 15 x⁴ + 6 x⁵."""
+    x = np.clip(x, 0.0, 1.0)
+    return x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)
+
+
 class _CutRows:
     """One cut's positions by its stepper, a block of rows at a time (the plan it follows
-    made a block at a time too: the same numbers as at once)."""
+    made a block at a time too: the same numbers as at once).
+
+    The kernel's first step corrects the recorded start onto its exact path (a few nm
+    across it where the start came from a search): before the cut is followed, one step
+    of SETTLE_STEP mm settles it there, the plan's lengths are counted from there, and
+    where the move is over SETTLE_MIN it is taken back and given out over the cut's
+    first SETTLE mm (C2; at most a third of the cut), and, on a closed loop, which lands
+    on its recorded start again, over its last SETTLE mm: no period jolts, and the
+    positions leave the exact path by at most that move."""
 
     def __init__(self, stepper, piece: Piece, what: str):
         self.stepper, self.piece, self.what = stepper, piece, what
         self.before = self.travelled = 0.0
+        self.across = None   # (3,) the settling move, once made (zeros: none to give out)
+
+    def _settle(self) -> None:
+        start = np.asarray(self.stepper.p, float)
+        self.across = np.zeros(3)
+        for _ in range(SETTLE_STEPS):   # each step's correction is a Newton step's
+            dp = self.stepper.step(SETTLE_STEP * 60.0 / self.stepper.period)
+            if dp is None:   # stopped there: the rows will say so
+                return
+            self.travelled = self.stepper.travelled
+            if np.linalg.norm(dp) <= SETTLE_MIN:
+                break
+        moved = np.asarray(self.stepper.p, float) - start
+        if np.linalg.norm(moved) > SETTLE_MIN:
+            self.across = moved
 
     def __call__(self, s: np.ndarray) -> np.ndarray:
         piece, m = self.piece, self.piece.substeps
+        if self.across is None:
+            self._settle()
         plan = follow_plan(piece, substep_lengths(s, self.before, m), self.before,
                            self.travelled)
         out = follow(self.stepper, plan, piece.points[-1], float(piece.kappa[-1]), LANDING)
         if len(s):
             self.before, self.travelled = float(s[-1]), float(plan[-1, 0])
-        return out[m - 1::m]
+        rows = out[m - 1::m]
+        if self.across.any():
+            rows = self._given_out(rows, s)
+        return rows
+
+    def _given_out(self, rows: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """The rows with the settling move taken back near the start and, on a closed loop
+        (which lands on its recorded start), near the end, but the rows landed there."""
+        piece = self.piece
+        span = min(SETTLE, piece.length / 3.0)
+        back = 1.0 - _blend(s / span)
+        if getattr(self.stepper, "closed", False):
+            landed = np.all(rows == piece.points[-1], axis=1)
+            back = back + np.where(landed, 0.0, _blend((s - piece.length + span) / span))
+        return rows - back[:, None] * self.across
 
     def close(self) -> None:
         _landed(self.stepper, self.piece, self.what)

@@ -11,7 +11,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 import cadcnc
-from cadcnc.controller import Machine, stream_program
+from cadcnc.controller import Machine, cut_rows, stream_program
 from cadcnc.controller.cut_rows import BLEND
 from cadcnc.interp.planned_follow import follow
 from cadcnc.ops.finish.shortcut import finish
@@ -150,12 +150,20 @@ def _python_driven(stepper, piece, s, period, blend, landing=1e-6):
     end = piece.points[-1]
     ds = np.diff(np.r_[0.0, s])
     kappa = np.interp(s, piece.s, piece.kappa)
-    chords = np.cumsum(ds * (1.0 - kappa ** 2 * ds ** 2 / 24.0))
     left = piece.length - s
     x = np.clip(1.0 - left / blend, 0.0, 1.0)
     weight = x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)
     k_end, to_feed = float(piece.kappa[-1]), 60.0 / period
     (ex, ey, ez), (x, y, z) = map(float, end), map(float, stepper.p)
+    for _ in range(cut_rows.SETTLE_STEPS):   # the start settled onto the kernel's path
+        dp = stepper.step(cut_rows.SETTLE_STEP * to_feed)
+        if dp is None:
+            break
+        x, y, z = x + dp[0], y + dp[1], z + dp[2]
+        if math.sqrt(dp[0] ** 2 + dp[1] ** 2 + dp[2] ** 2) <= cut_rows.SETTLE_MIN:
+            break
+    chords = np.cumsum(np.concatenate(([stepper.travelled],
+                                       ds * (1.0 - kappa ** 2 * ds ** 2 / 24.0))))[1:]
     rows = []
     for n, target in enumerate(chords.tolist()):
         if stepper.stop_reason is None:
