@@ -53,6 +53,12 @@ def _hermite(piece: Piece, s: np.ndarray) -> np.ndarray:
     return h00 * p[k] + h10 * h[:, None] * d[k] + h01 * p[k + 1] + h11 * h[:, None] * d[k + 1]
 
 
+def _blend(x: np.ndarray) -> np.ndarray:
+    """The C2 weight from 0 (x <= 0) to 1 (x >= 1): 10 x³ - 15 x⁴ + 6 x⁵."""
+    x = np.clip(x, 0.0, 1.0)
+    return x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)
+
+
 def follow_plan(piece: Piece, s: np.ndarray, before: float = 0.0,
                 travelled: float = 0.0) -> np.ndarray:
     """(rows, 3) the per-period plan the kernel follows on a cut (kernel/follow.py): the
@@ -68,8 +74,7 @@ def follow_plan(piece: Piece, s: np.ndarray, before: float = 0.0,
     plan[:, 0] = np.cumsum(np.concatenate(([travelled],
                                            ds * (1.0 - kappa ** 2 * ds ** 2 / 24.0))))[1:]
     plan[:, 2] = left = piece.length - s
-    x = np.clip(1.0 - left / min(BLEND, piece.length), 0.0, 1.0)
-    plan[:, 1] = x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)
+    plan[:, 1] = _blend(1.0 - left / min(BLEND, piece.length))
     return plan
 
 
@@ -107,19 +112,13 @@ def _landed(stepper, piece: Piece, what: str) -> None:
                             "mm from it)")
 
 
-def _blend(x: np.ndarray) -> np.ndarray:
-    """The C2 weight from 0 (x <= 0) to 1 (x >= 1): 10 x³ - 15 x⁴ + 6 x⁵."""
-    x = np.clip(x, 0.0, 1.0)
-    return x ** 3 * (10.0 - 15.0 * x + 6.0 * x * x)
-
-
 class _CutRows:
     """One cut's positions by its stepper, a block of rows at a time (the plan it follows
     made a block at a time too: the same numbers as at once).
 
     The kernel's first step corrects the recorded start onto its exact path (a few nm
-    across it where the start came from a search): before the cut is followed, one step
-    of SETTLE_STEP mm settles it there, the plan's lengths are counted from there, and
+    across it where the start came from a search): before the cut is followed, steps of
+    SETTLE_STEP mm (SETTLE_STEPS at most) settle it there, the plan's lengths are counted from there, and
     where the move is over SETTLE_MIN it is taken back and given out over the cut's
     first SETTLE mm (C2; at most a third of the cut), and, on a closed loop, which lands
     on its recorded start again, over its last SETTLE mm: no period jolts, and the
@@ -164,7 +163,7 @@ class _CutRows:
         piece = self.piece
         span = min(SETTLE, piece.length / 3.0)
         back = 1.0 - _blend(s / span)
-        if getattr(self.stepper, "closed", False):
+        if self.stepper.closed:
             landed = np.all(rows == piece.points[-1], axis=1)
             back = back + np.where(landed, 0.0, _blend((s - piece.length + span) / span))
         return rows - back[:, None] * self.across

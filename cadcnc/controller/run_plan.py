@@ -194,8 +194,8 @@ def _measured_window(run: Run, machine: Machine, limits, coriolis: float, cap: f
         # and this window already bound the plan's duration
         if floor + window >= beat:
             raise _Slower
-        wl = np.minimum(smooth, reach.erode(run.s, points, window))
-        plan = _plan_once(run, wl * kv, V, A * ka, J, period, window, coriolis, tight=True)
+        wl = np.minimum(smooth, reach.erode(run.s, points, window)) * kv
+        plan = _plan_once(run, wl, V, A * ka, J, period, window, coriolis, tight=True)
         t, w, u, v, a, S, need = plan
         _moves(run, t)
         floor = float(t[-1])
@@ -213,7 +213,7 @@ def _measured_window(run: Run, machine: Machine, limits, coriolis: float, cap: f
             window = window * max(sj, WINDOW_GROWTH) if step is None else step
             continue
         if sv <= 1.0 and sa <= 1.0:
-            return _Windowed(coriolis, window, wl * kv, plan, True)
+            return _Windowed(coriolis, window, wl, plan, True)
         scaled += 1
         if scaled > SCALE_ROUNDS:
             raise _Loose
@@ -273,10 +273,10 @@ def _windowed(run: Run, machine: Machine, limits, coriolis: float,
     a round lasts ``beat`` s or more. ``tight``: the measured plan instead
     (:func:`_measured_window`)."""
     V, A, J = limits
-    wl = np.minimum(_speed_limits(run, V, J, machine.period, d_share), cap * cap)
     window = _first_window(run, A, J)
     if tight:
         return _measured_window(run, machine, limits, coriolis, cap, d_share, window, beat)
+    wl = np.minimum(_speed_limits(run, V, J, machine.period, d_share), cap * cap)
     flattening, last = True, math.inf
     grown = None   # (window, measured) of the last window grown from
     for round_ in range(WINDOW_ROUNDS):
